@@ -1,0 +1,213 @@
+/* cli.c - the `voxlight` command-line tool: `render` and `info`. Every
+ * failure ends with one line "voxlight: error: ..." and exit status 1. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "voxlight.h"
+
+static const char usage[] =
+    "usage:\n"
+    "  voxlight render INPUT -o OUT.png|OUT.exr [--size WxH] [--filter NAME] [--sample-distance D]\n"
+    "                  [--reuse-gradients] [--step S] [--azimuth DEG] [--elevation DEG] [--preset NAME]\n"
+    "                  [--window LO:HI] [--no-shading] [--backend auto|osmesa|egl] [--memory-budget SIZE]\n"
+    "                  [--gradient-store 8bit|16f|32f] [--no-jitter] [--no-skip]\n"
+    "  voxlight info INPUT\n"
+    "filters: central forward3 sobel8 sobel14 sobel26 precomputed; presets: auto gray bone hot mri ct\n";
+
+static int die(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("voxlight: error: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    return 1;
+}
+
+static int parse_float(const char *s, float *out)
+{
+    char *end;
+    double v = strtod(s, &end);
+    if (end == s || *end || !isfinite(v)) return 0;
+    *out = (float)v;
+    return 1;
+}
+
+/* "2G", "512M", "1048576" -> bytes */
+static int parse_size(const char *s, uint64_t *out)
+{
+    char *end;
+    double v = strtod(s, &end);
+    if (end == s || !(v > 0) || !isfinite(v)) return 0;
+    double mul = 1;
+    if (*end) {
+        switch (*end) {
+        case 'k': case 'K': mul = 1024.0; break;
+        case 'm': case 'M': mul = 1048576.0; break;
+        case 'g': case 'G': mul = 1073741824.0; break;
+        case 't': case 'T': mul = 1099511627776.0; break;
+        default: return 0;
+        }
+        if (end[1] && strcasecmp(end + 1, "b") && strcasecmp(end + 1, "ib")) return 0;
+    }
+    if (v * mul >= 1.8e19) return 0;
+    *out = (uint64_t)(v * mul);
+    return 1;
+}
+
+static const char *dtype_name(uint32_t t)
+{
+    static const char *const names[] = {"?", "uint8", "int8", "uint16", "int16", "uint32", "int32", "float32", "float64"};
+    return t < sizeof names / sizeof *names ? names[t] : "?";
+}
+
+static int cmd_info(int argc, char **argv)
+{
+    if (argc != 1) return die("info takes one INPUT file\n%s", usage);
+    vxl_volume *v = NULL;
+    if (vxl_volume_load(argv[0], NULL, &v)) return die("%s", vxl_last_error());
+    vxl_volume_info in = {.struct_size = sizeof in};
+    vxl_volume_get_info(v, &in);
+    static const char *const src[] = {"none (pixdim)", "qform", "sform"};
+    printf("file:        %s\n", argv[0]);
+    printf("format:      NIfTI-%u\n", in.nifti_version);
+    printf("dimensions:  %u x %u x %u\n", in.dims[0], in.dims[1], in.dims[2]);
+    printf("spacing:     %g x %g x %g mm\n", in.spacing[0], in.spacing[1], in.spacing[2]);
+    printf("data type:   %s (stored as %u-bit %s)\n", dtype_name(in.dtype), in.texture_bits,
+           in.texture_bits == 32 ? "float" : "normalised");
+    printf("value range: %g .. %g\n", in.value_min, in.value_max);
+    printf("nan voxels:  %llu\n", (unsigned long long)in.nan_count);
+    printf("inf voxels:  %llu\n", (unsigned long long)in.inf_count);
+    printf("affine:      %s (voxel -> world mm)\n", in.affine_source < 3 ? src[in.affine_source] : "?");
+    for (int r = 0; r < 4; r++)
+        printf("  [%10.4f %10.4f %10.4f %10.4f]\n", in.affine[r], in.affine[4 + r], in.affine[8 + r], in.affine[12 + r]);
+    vxl_volume_destroy(v);
+    return 0;
+}
+
+typedef struct render_args {
+    const char *input, *output;
+    vxl_render_params p;
+    vxl_renderer_options ro;
+    vxl_load_options lo;
+} render_args;
+
+static int parse_render(int argc, char **argv, render_args *a)
+{
+    vxl_render_params *p = &a->p;
+    for (int i = 0; i < argc; i++) {
+        const char *o = argv[i];
+        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+#define NEED_VALUE() do { if (!val) return die("%s needs a value", o); i++; } while (0)
+        if (!strcmp(o, "-o") || !strcmp(o, "--output")) { NEED_VALUE(); a->output = val; }
+        else if (!strcmp(o, "--size")) {
+            NEED_VALUE();
+            unsigned w, h; char extra;
+            if (sscanf(val, "%ux%u%c", &w, &h, &extra) != 2 || !w || !h || w > 16384 || h > 16384)
+                return die("bad --size '%s': use WxH, each 1..16384", val);
+            p->width = w; p->height = h;
+        } else if (!strcmp(o, "--filter")) {
+            NEED_VALUE();
+            if (vxl_filter_from_name(val, &p->filter)) return die("unknown filter '%s' (central, forward3, sobel8, sobel14, sobel26, precomputed)", val);
+        } else if (!strcmp(o, "--sample-distance")) {
+            NEED_VALUE();
+            if (!parse_float(val, &p->sample_distance) || p->sample_distance <= 0) return die("bad --sample-distance '%s'", val);
+        } else if (!strcmp(o, "--reuse-gradients")) p->reuse_gradients = 1;
+        else if (!strcmp(o, "--step")) {
+            NEED_VALUE();
+            if (!parse_float(val, &p->step) || p->step <= 0) return die("bad --step '%s': a positive number of voxels", val);
+        } else if (!strcmp(o, "--azimuth")) { NEED_VALUE(); if (!parse_float(val, &p->azimuth_deg)) return die("bad --azimuth '%s'", val); }
+        else if (!strcmp(o, "--elevation")) { NEED_VALUE(); if (!parse_float(val, &p->elevation_deg)) return die("bad --elevation '%s'", val); }
+        else if (!strcmp(o, "--preset")) {
+            NEED_VALUE();
+            if (vxl_preset_from_name(val, &p->preset)) return die("unknown preset '%s' (auto, gray, bone, hot, mri, ct)", val);
+        } else if (!strcmp(o, "--window")) {
+            NEED_VALUE();
+            char *colon = strchr(val, ':');
+            char lo[64];
+            if (!colon || colon - val >= (long)sizeof lo) return die("bad --window '%s': use LO:HI", val);
+            memcpy(lo, val, (size_t)(colon - val));
+            lo[colon - val] = '\0';
+            if (!parse_float(lo, &p->window_low) || !parse_float(colon + 1, &p->window_high) || p->window_low == p->window_high)
+                return die("bad --window '%s': use LO:HI with LO != HI", val);
+            p->has_window = 1;
+        } else if (!strcmp(o, "--no-shading")) p->shading_off = 1;
+        else if (!strcmp(o, "--no-jitter")) p->jitter_off = 1;
+        else if (!strcmp(o, "--no-skip")) p->no_skip = 1;
+        else if (!strcmp(o, "--gradient-store")) {
+            NEED_VALUE();
+            if (!strcasecmp(val, "8bit")) p->gradient_store = VXL_GRADIENT_STORE_8BIT;
+            else if (!strcasecmp(val, "16f")) p->gradient_store = VXL_GRADIENT_STORE_16F;
+            else if (!strcasecmp(val, "32f")) p->gradient_store = VXL_GRADIENT_STORE_32F;
+            else return die("unknown --gradient-store '%s' (8bit, 16f, 32f)", val);
+        } else if (!strcmp(o, "--backend")) {
+            NEED_VALUE();
+            if (!strcasecmp(val, "auto")) a->ro.backend = VXL_BACKEND_AUTO;
+            else if (!strcasecmp(val, "osmesa")) a->ro.backend = VXL_BACKEND_OSMESA;
+            else if (!strcasecmp(val, "egl")) a->ro.backend = VXL_BACKEND_EGL;
+            else return die("unknown backend '%s' (auto, osmesa, egl)", val);
+        } else if (!strcmp(o, "--memory-budget")) {
+            NEED_VALUE();
+            if (!parse_size(val, &a->ro.memory_budget_bytes)) return die("bad --memory-budget '%s': e.g. 2G or 512M", val);
+            a->lo.memory_budget_bytes = a->ro.memory_budget_bytes;
+        } else if (o[0] == '-' && o[1]) return die("unknown option '%s'\n%s", o, usage);
+        else if (!a->input) a->input = o;
+        else return die("unexpected argument '%s'", o);
+#undef NEED_VALUE
+    }
+    if (!a->input) return die("render needs an INPUT file\n%s", usage);
+    if (!a->output) return die("render needs -o OUT.png or OUT.exr");
+    return 0;
+}
+
+static int cmd_render(int argc, char **argv)
+{
+    render_args a;
+    memset(&a, 0, sizeof a);
+    a.p.struct_size = sizeof a.p;
+    a.ro.struct_size = sizeof a.ro;
+    a.lo.struct_size = sizeof a.lo;
+    if (parse_render(argc, argv, &a)) return 1;
+    uint32_t w = a.p.width ? a.p.width : 512, h = a.p.height ? a.p.height : 512;
+    vxl_volume *v = NULL;
+    vxl_renderer *r = NULL;
+    float *rgba = NULL, *depth = NULL;
+    int status = 1;
+    if (vxl_volume_load(a.input, &a.lo, &v)) { die("%s", vxl_last_error()); goto done; }
+    if (vxl_renderer_create(&a.ro, &r)) { die("%s", vxl_last_error()); goto done; }
+    if (vxl_renderer_set_volume(r, v)) { die("%s", vxl_renderer_error(r)); goto done; }
+    vxl_volume_destroy(v);
+    v = NULL;
+    rgba = malloc((size_t)w * h * 4 * sizeof *rgba);
+    depth = malloc((size_t)w * h * sizeof *depth);
+    if (!rgba || !depth) { die("out of memory for a %ux%u image", w, h); goto done; }
+    if (vxl_render(r, &a.p, rgba, depth)) { die("%s", vxl_renderer_error(r)); goto done; }
+    if (vxl_write_image(a.output, rgba, depth, w, h)) { die("%s", vxl_last_error()); goto done; }
+    vxl_renderer_info ri = {.struct_size = sizeof ri};
+    vxl_renderer_get_info(r, &ri);
+    fprintf(stderr, "voxlight: wrote %s (%ux%u, %s, %s)\n", a.output, w, h, ri.backend_name, ri.gl_renderer);
+    status = 0;
+done:
+    free(rgba);
+    free(depth);
+    vxl_renderer_destroy(r);
+    vxl_volume_destroy(v);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
+        fputs(usage, argc < 2 ? stderr : stdout);
+        return argc < 2 ? 1 : 0;
+    }
+    if (vxl_abi_version() != VXL_ABI_VERSION) return die("libvoxlight ABI %u, expected %u", vxl_abi_version(), VXL_ABI_VERSION);
+    if (!strcmp(argv[1], "render")) return cmd_render(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "info")) return cmd_info(argc - 2, argv + 2);
+    return die("unknown command '%s'\n%s", argv[1], usage);
+}

@@ -1,0 +1,35 @@
+/* context.h - an offscreen OpenGL 4.5 core context from a backend opened
+ * with dlopen at run time (OSMesa or surfaceless EGL). All calls here must
+ * happen on the renderer's GL thread. */
+#ifndef VXL_CONTEXT_H
+#define VXL_CONTEXT_H
+
+#include <stdint.h>
+
+#include "error.h"
+
+typedef void (*vxl_ctx_proc)(void);
+
+typedef struct vxl_context {
+    uint32_t backend;          /* VXL_BACKEND_OSMESA or VXL_BACKEND_EGL */
+    char name[32];             /* "osmesa", "egl-device", "egl-surfaceless" */
+    void *lib;                 /* dlopen handle */
+    vxl_ctx_proc (*get_proc)(struct vxl_context *c, const char *name);
+    void (*close)(struct vxl_context *c);
+    /* backend-private */
+    void *handle_a, *handle_b; /* osmesa: context; egl: display, context */
+    unsigned char osmesa_pixels[16]; /* OSMesa needs a colour buffer; we render to FBOs */
+} vxl_context;
+
+/* Opens and makes current the requested backend (VXL_BACKEND_AUTO tries EGL on
+ * a GPU, then OSMesa, then EGL on Mesa). The environment variable
+ * VOXLIGHT_BACKEND (auto|osmesa|egl) overrides AUTO only. */
+int vxl_context_open(vxl_context *c, uint32_t backend, vxl_err *e);
+void vxl_context_close(vxl_context *c);
+
+/* Backend entry points, in backend_osmesa.c and backend_egl.c. egl_mode: 0
+ * hardware device only, 1 Mesa surfaceless only, 2 device then surfaceless. */
+int vxl_osmesa_open(vxl_context *c, vxl_err *e);
+int vxl_egl_open(vxl_context *c, int egl_mode, vxl_err *e);
+
+#endif

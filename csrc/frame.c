@@ -1,0 +1,243 @@
+/* frame.c - resolves vxl_render_params into a vxl_frame. */
+#include "frame.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mat4.h"
+
+#define DEFAULT_STEP 0.5f
+#define DEFAULT_SAMPLE_DISTANCE 1.0f
+#define MAX_STEP 1000.0f
+#define MAX_SAMPLES_PER_RAY 16384
+
+static const float default_material[4] = {0.3f, 0.7f, 0.3f, 24.0f};
+
+static void world_bounds(const vxl_volume_geom *g, double center[3], double *radius)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int c = 0; c < 8; c++) {
+        double v[4] = {(c & 1) ? g->dims[0] - 0.5 : -0.5, (c & 2) ? g->dims[1] - 0.5 : -0.5,
+                       (c & 4) ? g->dims[2] - 0.5 : -0.5, 1.0}, w[4];
+        vxl_mat4_transform(g->affine, v, w);
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], w[a]);
+            hi[a] = fmax(hi[a], w[a]);
+        }
+    }
+    double r2 = 0;
+    for (int a = 0; a < 3; a++) {
+        center[a] = 0.5 * (lo[a] + hi[a]);
+        r2 += 0.25 * (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    }
+    *radius = sqrt(r2) > 0 ? sqrt(r2) : 1.0;
+}
+
+void vxl_frame_default_camera(const vxl_volume_geom *g, uint32_t w, uint32_t h, double az_deg, double el_deg,
+                              double view[16], double proj[16])
+{
+    double c[3], radius;
+    world_bounds(g, c, &radius);
+    const double fovy = 30.0 * M_PI / 180.0;
+    double aspect = (double)w / (double)h;
+    /* fit the bounding sphere in the narrower of the two fields of view */
+    double half = fovy / 2;
+    if (aspect < 1) half = atan(tan(half) * aspect);
+    double dist = radius / sin(half) * 1.02;
+    double az = az_deg * M_PI / 180.0, el = el_deg * M_PI / 180.0;
+    /* azimuth 0, elevation 0 looks from +Y (anterior in RAS) towards -Y */
+    double eye[3] = {c[0] - dist * cos(el) * sin(az), c[1] + dist * cos(el) * cos(az), c[2] + dist * sin(el)};
+    double up[3] = {0, 0, 1};
+    if (fabs(cos(el)) < 1e-6) {
+        up[1] = -sin(el) * cos(az);
+        up[0] = sin(el) * sin(az);
+        up[2] = 0;
+    }
+    vxl_mat4_look_at(view, eye, c, up);
+    vxl_mat4_perspective(proj, fovy, aspect, fmax(dist - radius * 1.5, dist * 1e-3), dist + radius * 1.5);
+}
+
+static int check_float(vxl_err *e, const char *name, float v, float lo, float hi)
+{
+    if (!(v >= lo && v <= hi))
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "%s = %g is out of range [%g, %g]", name, v, lo, hi);
+    return VXL_OK;
+}
+
+static int resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e)
+{
+    uint32_t preset = vxl_preset_resolve(p->preset, g->value_min, g->value_max);
+    if (p->tf_rgba) {
+        if (p->tf_size < 2 || p->tf_size > 65536)
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "tf_size %u must be in [2, 65536]", p->tf_size);
+        f->tf_copy = malloc((size_t)p->tf_size * 4 * sizeof(float));
+        if (!f->tf_copy) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the transfer function");
+        for (uint32_t i = 0; i < p->tf_size * 4; i++) {
+            float v = p->tf_rgba[i];
+            f->tf_copy[i] = v > 0 ? (v < 1 ? v : 1) : 0; /* also maps NaN to 0 */
+        }
+        f->tf = f->tf_copy;
+        f->tf_size = p->tf_size;
+    } else {
+        if (!vxl_preset_table(preset, f->preset_tf))
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown preset %u", p->preset);
+        f->tf = f->preset_tf;
+        f->tf_size = VXL_PRESET_TABLE_SIZE;
+    }
+    double lo, hi;
+    if (p->has_window) {
+        lo = p->window_low;
+        hi = p->window_high;
+        if (!isfinite(lo) || !isfinite(hi))
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "window [%g, %g] is not finite", lo, hi);
+    } else {
+        vxl_preset_window(preset, g->value_min, g->value_max, &lo, &hi);
+    }
+    /* an empty window becomes a step at lo instead of a division by zero */
+    double w = hi - lo, eps = fmax(fabs(lo), fabs(hi)) * 1e-6 + 1e-30;
+    if (fabs(w) < eps) w = eps;
+    double span = g->tex_hi - g->tex_lo;
+    if (span == 0) span = 1;
+    f->window_offset = (float)((lo - g->tex_lo) / span);
+    double scale = span / w;
+    f->window_scale = (float)(fabs(scale) < 1e30 ? scale : copysign(1e30, scale));
+    float os = p->opacity_scale == 0 ? 1.0f : p->opacity_scale;
+    int rc = check_float(e, "opacity_scale", os, 0, 1e6);
+    f->opacity_scale = os;
+    return rc;
+}
+
+static int resolve_lights(vxl_frame *f, const vxl_render_params *p, vxl_err *e)
+{
+    if (p->has_material) {
+        int rc = check_float(e, "ambient", p->ambient, 0, 100);
+        if (!rc) rc = check_float(e, "diffuse", p->diffuse, 0, 100);
+        if (!rc) rc = check_float(e, "specular", p->specular, 0, 100);
+        if (!rc) rc = check_float(e, "shininess", p->shininess, 0, 1e4);
+        if (rc) return rc;
+        f->material[0] = p->ambient;
+        f->material[1] = p->diffuse;
+        f->material[2] = p->specular;
+        f->material[3] = p->shininess < 1 ? 1 : p->shininess; /* pow(0, 0) is undefined */
+    } else {
+        memcpy(f->material, default_material, sizeof f->material);
+    }
+    if (p->light_count > VXL_MAX_LIGHTS)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "light_count %u exceeds %d", p->light_count, VXL_MAX_LIGHTS);
+    if (p->light_count == 0) { /* headlight: from the eye, in view space */
+        f->light_count = 1;
+        f->light_pos[0][2] = 1;
+        f->light_color[0][0] = f->light_color[0][1] = f->light_color[0][2] = 1;
+        return VXL_OK;
+    }
+    f->light_count = (int)p->light_count;
+    for (uint32_t i = 0; i < p->light_count; i++) {
+        const vxl_light *l = &p->lights[i];
+        double in[4] = {l->position[0], l->position[1], l->position[2], l->position[3] != 0 ? 1.0 : 0.0}, v[4];
+        for (int k = 0; k < 4; k++)
+            if (!isfinite(in[k])) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "light %u position is not finite", i);
+        vxl_mat4_transform(f->view, in, v);
+        if (in[3] == 0) {
+            double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            if (!(n > 0)) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "light %u direction is zero", i);
+            for (int k = 0; k < 3; k++) v[k] /= n;
+        }
+        for (int k = 0; k < 3; k++) f->light_pos[i][k] = (float)v[k];
+        f->light_pos[i][3] = (float)in[3];
+        int white = l->color[0] == 0 && l->color[1] == 0 && l->color[2] == 0;
+        float inten = l->intensity == 0 ? 1.0f : l->intensity;
+        int rc = check_float(e, "light intensity", inten, 0, 1e6);
+        if (rc) return rc;
+        for (int k = 0; k < 3; k++) {
+            float c = white ? 1.0f : l->color[k];
+            if (!(c >= 0 && c <= 1e6)) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "light %u colour is invalid", i);
+            f->light_color[i][k] = c * inten;
+        }
+    }
+    return VXL_OK;
+}
+
+static int resolve_matrices(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e)
+{
+    if (p->has_model) vxl_mat4_from_float(f->model, p->model);
+    else memcpy(f->model, g->affine, sizeof f->model);
+    if (p->has_camera) {
+        vxl_mat4_from_float(f->view, p->view);
+        vxl_mat4_from_float(f->proj, p->proj);
+    } else {
+        if (!isfinite(p->azimuth_deg) || !isfinite(p->elevation_deg))
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "azimuth/elevation are not finite");
+        vxl_volume_geom gm = *g;
+        memcpy(gm.affine, f->model, sizeof gm.affine);
+        vxl_frame_default_camera(&gm, f->width, f->height, p->azimuth_deg, p->elevation_deg, f->view, f->proj);
+    }
+    double mv[16], mvp[16], inv[16];
+    vxl_mat4_mul(mv, f->view, f->model);
+    vxl_mat4_mul(mvp, f->proj, mv);
+    if (!vxl_mat4_is_finite(mv) || !vxl_mat4_invert(inv, mvp))
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT,
+                        "the camera and model matrices are singular or not finite (projection * view * model)");
+    if (!vxl_mat3_normal_matrix(f->normal, mv))
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "the view * model matrix is singular");
+    vxl_mat4_to_float(f->inv_mvp, inv);
+    vxl_mat4_to_float(f->mv, mv);
+    return VXL_OK;
+}
+
+int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volume_geom *g, vxl_err *e)
+{
+    static const vxl_render_params zero;
+    const vxl_render_params *p = pin ? pin : &zero;
+    memset(f, 0, sizeof *f);
+    if (p->struct_size != 0 && p->struct_size < sizeof *p)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "render params struct_size %u is smaller than this ABI's %zu",
+                        p->struct_size, sizeof *p);
+    f->width = p->width ? p->width : 512;
+    f->height = p->height ? p->height : 512;
+    if (f->width > 16384 || f->height > 16384)
+        return vxl_fail(e, VXL_ERR_LIMIT, "image %ux%u exceeds 16384 per side", f->width, f->height);
+    if (p->filter >= VXL_FILTER_COUNT)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown filter %u", p->filter);
+    if (p->gradient_store > VXL_GRADIENT_STORE_32F)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown gradient_store %u", p->gradient_store);
+    if (p->classify != 0)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "classify %u is not supported (0 = post)", p->classify);
+    f->filter = p->filter;
+    f->store = p->gradient_store;
+    f->shading = !p->shading_off;
+    f->reuse = p->reuse_gradients != 0;
+    f->jitter = !p->jitter_off;
+    f->seed = p->jitter_seed;
+    f->sample_distance = p->sample_distance == 0 ? DEFAULT_SAMPLE_DISTANCE : p->sample_distance;
+    int rc = check_float(e, "sample_distance", f->sample_distance, 1e-3f, 64);
+    if (rc) return rc;
+    float step = p->step == 0 ? DEFAULT_STEP : p->step;
+    if (!(step > 0) || !isfinite(step))
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "step = %g must be a positive number of voxels", step);
+    /* Bound the samples per ray whatever the step: a 1e-4 step must not hang. */
+    double diag = sqrt((double)g->dims[0] * g->dims[0] + (double)g->dims[1] * g->dims[1] +
+                       (double)g->dims[2] * g->dims[2]);
+    double min_step = diag / MAX_SAMPLES_PER_RAY;
+    f->step = (float)fmin(fmax(step, min_step), MAX_STEP);
+    f->max_steps = (int)ceil(diag / f->step) + 2;
+    float et = p->early_termination == 0 ? 0.99f : p->early_termination;
+    rc = check_float(e, "early_termination", et, 1e-6f, 1);
+    if (rc) return rc;
+    f->early_termination = p->no_skip ? 2.0f : et; /* > 1: never stops early */
+    f->depth_threshold = p->depth_threshold == 0 ? 0.5f : p->depth_threshold;
+    rc = check_float(e, "depth_threshold", f->depth_threshold, 1e-6f, 1);
+    if (rc) return rc;
+    f->scene_depth = p->scene_depth;
+    rc = resolve_matrices(f, p, g, e);
+    if (!rc) rc = resolve_lights(f, p, e);
+    if (!rc) rc = resolve_tf(f, p, g, e);
+    if (rc) vxl_frame_free(f);
+    return rc;
+}
+
+void vxl_frame_free(vxl_frame *f)
+{
+    free(f->tf_copy);
+    f->tf_copy = NULL;
+}

@@ -1,0 +1,48 @@
+/* frame.h - render parameters resolved against the volume: defaults filled
+ * in, values validated, matrices in the form the shaders take. Pure CPU, so
+ * it can be tested and reused by a reference renderer. */
+#ifndef VXL_FRAME_H
+#define VXL_FRAME_H
+
+#include <stdint.h>
+
+#include "error.h"
+#include "transfer.h"
+#include "voxlight.h"
+
+typedef struct vxl_volume_geom {
+    uint32_t dims[3];
+    double affine[16];          /* voxel -> world */
+    double tex_lo, tex_hi;      /* stored [0,1] -> data value */
+    double value_min, value_max;
+} vxl_volume_geom;
+
+typedef struct vxl_frame {
+    uint32_t width, height;
+    uint32_t filter, shading, reuse, store, jitter, seed;
+    float sample_distance, step;
+    int max_steps;
+    double view[16], proj[16], model[16];
+    float inv_mvp[16], mv[16], normal[9];
+    const float *tf;            /* tf_size*4 straight RGBA, clamped to [0,1] */
+    uint32_t tf_size;
+    float window_offset, window_scale, opacity_scale;
+    float material[4];
+    int light_count;
+    float light_pos[VXL_MAX_LIGHTS][4], light_color[VXL_MAX_LIGHTS][3];
+    float early_termination, depth_threshold;
+    const float *scene_depth;
+    float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
+    float *tf_copy;             /* owned when the caller gave a table */
+} vxl_frame;
+
+/* p may be NULL (all defaults). On success free with vxl_frame_free. */
+int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e);
+void vxl_frame_free(vxl_frame *f);
+
+/* The default camera: frames the volume's bounding sphere, orbiting about
+ * world +Z by azimuth and elevation (degrees). */
+void vxl_frame_default_camera(const vxl_volume_geom *g, uint32_t w, uint32_t h, double az_deg, double el_deg,
+                              double view[16], double proj[16]);
+
+#endif

@@ -1,0 +1,29 @@
+/* gl_thread.h - one worker thread per renderer that owns its GL context.
+ * Making an OSMesa/EGL context current on a host thread (Blender's main
+ * thread) breaks the host's own GL, so all GL work is handed to this thread
+ * and the caller waits. Calls from several threads are serialised. */
+#ifndef VXL_GL_THREAD_H
+#define VXL_GL_THREAD_H
+
+#include <pthread.h>
+
+typedef int (*vxl_job_fn)(void *arg);
+
+typedef struct vxl_gl_thread {
+    pthread_t thread;
+    pthread_mutex_t call_lock; /* one caller at a time */
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
+    vxl_job_fn job;
+    void *arg;
+    int result;
+    int pending, done, quit, started;
+} vxl_gl_thread;
+
+int vxl_gl_thread_start(vxl_gl_thread *t);
+/* Runs fn(arg) on the GL thread and returns its result. */
+int vxl_gl_thread_call(vxl_gl_thread *t, vxl_job_fn fn, void *arg);
+/* Runs fn(arg) (may be NULL) as the last job, then joins the thread. */
+void vxl_gl_thread_stop(vxl_gl_thread *t, vxl_job_fn fn, void *arg);
+
+#endif

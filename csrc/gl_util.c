@@ -1,0 +1,160 @@
+/* gl_util.c - shader program cache and small GL helpers (GL thread only). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "renderer_internal.h"
+#include "shader_source.h"
+
+static const char *const filter_defines[VXL_FILTER_COUNT] = {
+    "#define FILTER_CENTRAL 1\n", "#define FILTER_FORWARD3 1\n", "#define FILTER_SOBEL8 1\n",
+    "#define FILTER_SOBEL14 1\n", "#define FILTER_SOBEL26 1\n", "#define FILTER_PRECOMPUTED 1\n"};
+
+/* flags bits: 1 shading, 2 reuse gradients; for GRAD_STORE: the store format */
+static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
+
+static int compile(vxl_renderer *r, GLenum type, const char *file, const char *defines, GLuint *out)
+{
+    vxl_gl *gl = &r->gl;
+    char *src = NULL;
+    int rc = vxl_shader_source(r->shader_dir, file, defines, &src, &r->err);
+    if (rc) return rc;
+    GLuint s = gl->CreateShader(type);
+    const GLchar *srcs[1] = {src};
+    gl->ShaderSource(s, 1, srcs, NULL);
+    gl->CompileShader(s);
+    free(src);
+    GLint ok = 0;
+    gl->GetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[400];
+        log[0] = '\0';
+        gl->GetShaderInfoLog(s, sizeof log, NULL, log);
+        gl->DeleteShader(s);
+        return vxl_fail(&r->err, VXL_ERR_SHADER, "shader %s failed to compile: %s", file, log);
+    }
+    *out = s;
+    return VXL_OK;
+}
+
+static int link(vxl_renderer *r, GLuint a, GLuint b, GLuint *out)
+{
+    vxl_gl *gl = &r->gl;
+    GLuint p = gl->CreateProgram();
+    gl->AttachShader(p, a);
+    if (b) gl->AttachShader(p, b);
+    gl->LinkProgram(p);
+    gl->DeleteShader(a);
+    if (b) gl->DeleteShader(b);
+    GLint ok = 0;
+    gl->GetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[400];
+        log[0] = '\0';
+        gl->GetProgramInfoLog(p, sizeof log, NULL, log);
+        gl->DeleteProgram(p);
+        return vxl_fail(&r->err, VXL_ERR_SHADER, "shader program failed to link: %s", log);
+    }
+    *out = p;
+    return VXL_OK;
+}
+
+static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
+{
+    char defines[256] = "";
+    const char *fdef = filter < VXL_FILTER_COUNT ? filter_defines[filter] : filter_defines[0];
+    GLuint a = 0, b = 0;
+    int rc;
+    switch (kind) {
+    case VXL_PROG_RAYCAST:
+        snprintf(defines, sizeof defines, "%s%s%s", fdef, (flags & 1) ? "#define SHADING 1\n" : "",
+                 (flags & 2) ? "#define REUSE_GRADIENTS 1\n" : "");
+        rc = compile(r, GL_VERTEX_SHADER, "raycast.vert", NULL, &a);
+        if (rc) return rc;
+        rc = compile(r, GL_FRAGMENT_SHADER, "raycast.frag", defines, &b);
+        if (rc) {
+            r->gl.DeleteShader(a);
+            return rc;
+        }
+        return link(r, a, b, out);
+    case VXL_PROG_PROBE:
+        rc = compile(r, GL_COMPUTE_SHADER, "probe.comp", fdef, &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_GRAD_BLUR:
+        rc = compile(r, GL_COMPUTE_SHADER, "gradient_blur.comp", NULL, &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_GRAD_MAX:
+        rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_GRAD_STORE:
+        snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
+        rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", defines, &a);
+        return rc ? rc : link(r, a, 0, out);
+    default:
+        return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown program kind %u", kind);
+    }
+}
+
+int vxl_program_get(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
+{
+    uint32_t key = kind | (filter << 4) | (flags << 12);
+    for (int i = 0; i < r->n_programs; i++)
+        if (r->programs[i].key == key) {
+            *out = r->programs[i].program;
+            return VXL_OK;
+        }
+    GLuint p = 0;
+    int rc = build(r, kind, filter, flags, &p);
+    if (rc) return rc;
+    if (r->n_programs == VXL_MAX_PROGRAMS) { /* cannot happen with the current key space */
+        r->gl.DeleteProgram(p);
+        return vxl_fail(&r->err, VXL_ERR_STATE, "program cache full");
+    }
+    r->programs[r->n_programs].key = key;
+    r->programs[r->n_programs++].program = p;
+    *out = p;
+    return VXL_OK;
+}
+
+void vxl_programs_delete(vxl_renderer *r)
+{
+    for (int i = 0; i < r->n_programs; i++) r->gl.DeleteProgram(r->programs[i].program);
+    r->n_programs = 0;
+}
+
+void vxl_uniform_i(vxl_renderer *r, GLuint prog, const char *name, int v)
+{
+    GLint loc = r->gl.GetUniformLocation(prog, name);
+    if (loc >= 0) r->gl.Uniform1i(loc, v);
+}
+
+void vxl_uniform_f(vxl_renderer *r, GLuint prog, const char *name, float v)
+{
+    GLint loc = r->gl.GetUniformLocation(prog, name);
+    if (loc >= 0) r->gl.Uniform1f(loc, v);
+}
+
+GLuint vxl_texture_new(vxl_renderer *r, GLenum target, GLint filter)
+{
+    GLuint t = 0;
+    r->gl.GenTextures(1, &t);
+    r->gl.BindTexture(target, t);
+    r->gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);
+    r->gl.TexParameteri(target, GL_TEXTURE_MAG_FILTER, filter);
+    r->gl.TexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    r->gl.TexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    r->gl.TexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    r->gl.TexParameteri(target, GL_TEXTURE_BASE_LEVEL, 0);
+    r->gl.TexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
+    return t;
+}
+
+int vxl_gl_check(vxl_renderer *r, const char *what)
+{
+    GLenum e = r->gl.GetError(), first = e;
+    while (e != GL_NO_ERROR) e = r->gl.GetError(); /* drain */
+    if (first == GL_NO_ERROR) return VXL_OK;
+    if (first == GL_OUT_OF_MEMORY)
+        return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "%s: the OpenGL implementation ran out of memory", what);
+    return vxl_fail(&r->err, VXL_ERR_GL, "%s: OpenGL error 0x%04x", what, first);
+}

@@ -1,0 +1,257 @@
+/*
+ * voxlight.h - the one public header of libvoxlight.
+ *
+ * Conventions (chosen so ctypes can bind everything from this file alone):
+ *  - Opaque handles; destroy(NULL) is a no-op.
+ *  - Parameter structs are plain data with fixed-width fields only (no enums,
+ *    no bitfields). Their all-zero value means "default" for every field.
+ *    Each starts with `struct_size`, which the caller sets to sizeof(struct);
+ *    0 is accepted and means "the size of this ABI version".
+ *  - Every call returns an int: VXL_OK (0) or a VXL_ERR_* code. The message of
+ *    the last failure is available per handle (vxl_renderer_error) and, for
+ *    every failing call including those before a handle exists, from the
+ *    calling thread's vxl_last_error().
+ *  - Output buffers are allocated by the caller.
+ *  - Matrices are 4x4, column-major, OpenGL convention.
+ *  - Images are row 0 = bottom (OpenGL and Blender Image.pixels order).
+ *  - Voxel space: voxel (i,j,k) has its centre at integer coordinates; the
+ *    volume box is [-0.5, dim-0.5] on each axis. The volume's model matrix
+ *    maps voxel space to world space (NIfTI: millimetres).
+ */
+#ifndef VOXLIGHT_H
+#define VOXLIGHT_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(__GNUC__)
+#define VXL_API __attribute__((visibility("default")))
+#else
+#define VXL_API
+#endif
+
+#define VXL_ABI_VERSION 1u
+
+/* ---- error codes ---- */
+#define VXL_OK 0
+#define VXL_ERR_INVALID_ARGUMENT 1 /* a bad parameter value */
+#define VXL_ERR_IO 2               /* cannot open / read / write a file */
+#define VXL_ERR_FORMAT 3           /* file is corrupt, truncated or unsupported */
+#define VXL_ERR_LIMIT 4            /* over the memory budget or a size limit */
+#define VXL_ERR_NO_MEMORY 5        /* an allocation failed */
+#define VXL_ERR_BACKEND 6          /* no usable OpenGL context backend */
+#define VXL_ERR_GL 7               /* an OpenGL call failed */
+#define VXL_ERR_SHADER 8           /* a shader failed to compile or link */
+#define VXL_ERR_STATE 9            /* call made in the wrong state (e.g. no volume) */
+
+/* ---- data types of voxels ---- */
+#define VXL_DTYPE_U8 1
+#define VXL_DTYPE_I8 2
+#define VXL_DTYPE_U16 3
+#define VXL_DTYPE_I16 4
+#define VXL_DTYPE_U32 5
+#define VXL_DTYPE_I32 6
+#define VXL_DTYPE_F32 7
+#define VXL_DTYPE_F64 8
+
+/* ---- backends ---- */
+#define VXL_BACKEND_AUTO 0   /* EGL on a GPU, then OSMesa, then EGL on Mesa */
+#define VXL_BACKEND_OSMESA 1
+#define VXL_BACKEND_EGL 2
+
+/* ---- gradient filters ---- */
+#define VXL_FILTER_CENTRAL 0     /* 6 taps, the default */
+#define VXL_FILTER_FORWARD3 1    /* 3 taps against the centre sample */
+#define VXL_FILTER_SOBEL8 2      /* 8 trilinear taps at (+-d,+-d,+-d) */
+#define VXL_FILTER_SOBEL14 3     /* 6 faces + 8 corners */
+#define VXL_FILTER_SOBEL26 4     /* classic weighted 26-neighbour Sobel */
+#define VXL_FILTER_PRECOMPUTED 5 /* blur + Sobel once per volume, stored */
+#define VXL_FILTER_COUNT 6
+
+/* ---- transfer-function presets ---- */
+#define VXL_PRESET_AUTO 0 /* MRI or CT default, chosen from the data range */
+#define VXL_PRESET_GRAY 1
+#define VXL_PRESET_BONE 2
+#define VXL_PRESET_HOT 3
+#define VXL_PRESET_MRI 4
+#define VXL_PRESET_CT 5
+#define VXL_PRESET_COUNT 6
+
+/* ---- precomputed gradient storage ---- */
+#define VXL_GRADIENT_STORE_8BIT 0  /* RGBA8 signed-normalised, raw gradient / global max */
+#define VXL_GRADIENT_STORE_16F 1   /* RGBA16F, same scaling */
+#define VXL_GRADIENT_STORE_32F 2   /* RGBA32F, same scaling: exact, for tests and references */
+
+#define VXL_MAX_LIGHTS 8
+
+typedef struct vxl_volume vxl_volume;
+typedef struct vxl_renderer vxl_renderer;
+
+/* ---------------------------------------------------------------- volumes */
+
+typedef struct vxl_load_options {
+    uint32_t struct_size;
+    uint32_t max_dim;             /* largest size of any axis; 0 = 65536 */
+    uint64_t memory_budget_bytes; /* largest voxel storage; 0 = 2 GiB */
+} vxl_load_options;
+
+/* A volume handed over from memory (e.g. a numpy array). Data is x fastest:
+ * index = i + dims[0]*(j + dims[1]*k), native byte order. */
+typedef struct vxl_volume_desc {
+    uint32_t struct_size;
+    uint32_t dtype;        /* VXL_DTYPE_*; 0 is invalid */
+    uint32_t dims[3];
+    uint32_t has_affine;   /* 0: affine = diag(spacing) */
+    const void *data;
+    double spacing[3];     /* voxel size in mm; 0 = 1 */
+    double affine[16];     /* voxel -> world, column-major */
+    double scl_slope;      /* value = raw*slope + inter; slope 0 = no scaling */
+    double scl_inter;
+} vxl_volume_desc;
+
+typedef struct vxl_volume_info {
+    uint32_t struct_size;
+    uint32_t dtype;             /* VXL_DTYPE_* of the source data */
+    uint32_t dims[3];
+    uint32_t nifti_version;     /* 1 or 2 for NIfTI files, 0 otherwise */
+    double spacing[3];          /* voxel size (mm) */
+    double affine[16];          /* voxel -> world (mm), column-major */
+    double value_min;           /* finite range after scl_slope/scl_inter */
+    double value_max;
+    uint64_t nan_count;         /* NaN voxels (treated as value_min) */
+    uint64_t inf_count;         /* +-Inf voxels (clamped to the finite range) */
+    uint64_t storage_bytes;     /* bytes of voxel storage (texture) */
+    uint32_t texture_bits;      /* 8, 16 (normalised) or 32 (float) */
+    uint32_t affine_source;     /* 0 none (spacing), 1 qform, 2 sform */
+} vxl_volume_info;
+
+VXL_API int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **out);
+VXL_API int vxl_volume_create(const vxl_volume_desc *desc, const vxl_load_options *opt,
+                              vxl_volume **out);
+VXL_API int vxl_volume_get_info(const vxl_volume *vol, vxl_volume_info *out);
+VXL_API void vxl_volume_destroy(vxl_volume *vol);
+
+/* -------------------------------------------------------------- renderer */
+
+typedef struct vxl_renderer_options {
+    uint32_t struct_size;
+    uint32_t backend;             /* VXL_BACKEND_*; env VOXLIGHT_BACKEND overrides AUTO */
+    uint64_t memory_budget_bytes; /* GPU storage budget; 0 = 2 GiB */
+    const char *shader_dir;       /* developer override: load shaders from disk.
+                                     NULL = embedded (env VOXLIGHT_SHADER_DIR overrides) */
+} vxl_renderer_options;
+
+typedef struct vxl_renderer_info {
+    uint32_t struct_size;
+    uint32_t backend;          /* the backend actually opened */
+    int32_t max_3d_texture_size;
+    uint32_t reserved;
+    char backend_name[32];
+    char gl_renderer[128];
+    char gl_version[128];
+} vxl_renderer_info;
+
+typedef struct vxl_light {
+    float position[4];  /* world space; w = 0: direction the light travels FROM
+                           (towards the light), w = 1: position of a point light */
+    float color[3];     /* 0,0,0 = white */
+    float intensity;    /* 0 = 1 */
+} vxl_light;
+
+typedef struct vxl_render_params {
+    uint32_t struct_size;
+    uint32_t width, height;          /* 0 = 512 */
+    uint32_t has_camera;             /* 0: default camera framing the volume */
+    float view[16];                  /* world -> view */
+    float proj[16];                  /* view -> clip */
+    float azimuth_deg;               /* default camera only: rotation about world +Z */
+    float elevation_deg;             /* default camera only */
+    uint32_t has_model;              /* 0: model = the volume's affine */
+    float model[16];                 /* voxel -> world */
+
+    /* Optional scene depth, width*height floats, row 0 = bottom: view-space
+     * planar distance (positive, along -Z of view) of opaque geometry;
+     * +inf = none. Rays stop there. */
+    const float *scene_depth;
+
+    uint32_t filter;                 /* VXL_FILTER_* */
+    float sample_distance;           /* gradient tap offset in voxels; 0 = 1.0 */
+    uint32_t reuse_gradients;        /* 1: keep previous direction when |g| drops */
+    uint32_t gradient_store;         /* VXL_GRADIENT_STORE_* (precomputed filter) */
+    float step;                      /* ray step in voxels; 0 = 0.5 */
+    uint32_t jitter_off;             /* 1: no per-pixel start jitter */
+    uint32_t jitter_seed;            /* varies the deterministic jitter pattern */
+
+    /* classification */
+    uint32_t preset;                 /* VXL_PRESET_* used when tf_rgba is NULL */
+    uint32_t tf_size;                /* entries in tf_rgba (>= 2) */
+    const float *tf_rgba;            /* straight RGBA, opacity per voxel of path */
+    uint32_t has_window;             /* 0: window = preset default / data range */
+    float window_low, window_high;   /* in data units, mapped onto the TF */
+    float opacity_scale;             /* 0 = 1 */
+    uint32_t classify;               /* 0 = post-classification (reserved for more) */
+
+    /* shading */
+    uint32_t shading_off;            /* 1: pure emission-absorption */
+    uint32_t has_material;           /* 0: defaults below */
+    float ambient, diffuse, specular, shininess; /* defaults .3 .7 .3 24 */
+    uint32_t light_count;            /* 0: headlight */
+    vxl_light lights[VXL_MAX_LIGHTS];
+
+    /* termination and output */
+    float early_termination;         /* opacity that stops a ray; 0 = 0.99 */
+    float depth_threshold;           /* opacity that defines output depth; 0 = 0.5 */
+    uint32_t no_skip;                /* 1: disable every in-frame skip (testing) */
+    uint32_t reserved[7];
+} vxl_render_params;
+
+VXL_API int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out);
+VXL_API void vxl_renderer_destroy(vxl_renderer *r);
+VXL_API const char *vxl_renderer_error(const vxl_renderer *r);
+VXL_API int vxl_renderer_get_info(vxl_renderer *r, vxl_renderer_info *out);
+
+/* Uploads the volume; the renderer keeps its own copy on the GL side, so the
+ * vxl_volume may be destroyed afterwards. */
+VXL_API int vxl_renderer_set_volume(vxl_renderer *r, const vxl_volume *vol);
+
+/* rgba: width*height*4 floats, premultiplied. depth: width*height floats
+ * (view-space planar distance where opacity passes depth_threshold, +inf
+ * where it never does) or NULL. */
+VXL_API int vxl_render(vxl_renderer *r, const vxl_render_params *p, float *rgba, float *depth);
+
+/* The camera vxl_render uses when has_camera is 0, for callers that want to
+ * start from it. */
+VXL_API int vxl_default_camera(vxl_renderer *r, const vxl_render_params *p, float view[16],
+                               float proj[16]);
+
+/* Evaluates the gradient filter selected in p (filter, sample_distance,
+ * gradient_store, reuse_gradients) at n points given in voxel space
+ * (points: n*3 floats), with the same GLSL the ray caster runs. out: n*3
+ * floats, the gradient in voxel space (units of normalised value per voxel;
+ * the precomputed filter's magnitude is relative). With reuse_gradients the
+ * points are treated as consecutive samples of one ray. */
+VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, const float *points,
+                                uint32_t n, float *out);
+
+/* ------------------------------------------------------------------ misc */
+
+VXL_API uint32_t vxl_abi_version(void);
+VXL_API const char *vxl_last_error(void);       /* thread-local; "" if none */
+VXL_API const char *vxl_error_name(int code);
+VXL_API const char *vxl_filter_name(uint32_t filter);   /* NULL if out of range */
+VXL_API int vxl_filter_from_name(const char *name, uint32_t *out);
+VXL_API const char *vxl_preset_name(uint32_t preset);
+VXL_API int vxl_preset_from_name(const char *name, uint32_t *out);
+
+/* Writes premultiplied RGBA (row 0 = bottom) to .png (straight alpha, 8 bit)
+ * or .exr (premultiplied half float, plus a Z channel when depth != NULL). */
+VXL_API int vxl_write_image(const char *path, const float *rgba, const float *depth, uint32_t width,
+                            uint32_t height);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,716 @@
+/* nifti.c - NIfTI-1 / NIfTI-2 reader (.nii, .nii.gz, .hdr/.img[.gz]).
+ *
+ * Our own reader instead of libnifti: we need only the first 3D volume, want
+ * every header field treated as hostile input, and want failures reported
+ * through vxl_fail rather than printed. zlib's gz* functions read plain and
+ * gzip files alike, so one code path serves both.
+ *
+ * Flow: find the header file -> read and parse the header into a
+ * version-neutral struct -> validate it -> read the first volume's raw bytes
+ * (from the same file at vox_offset, or from the paired .img) -> swap if the
+ * file's byte order is foreign -> hand over to vxl_volume_build, which owns
+ * scaling, NaN handling and normalisation. */
+#include "volume.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <zlib.h>
+
+#define NII1_HDR_SIZE 348
+#define NII2_HDR_SIZE 540
+/* Single-file data may not start before the header plus the 4-byte
+ * extension flag. */
+#define NII1_MIN_OFFSET 352
+#define NII2_MIN_OFFSET 544
+/* Extensions (e.g. CIFTI XML) can be megabytes, never anywhere near this;
+ * a larger vox_offset is a corrupt header, not a real file. */
+#define MAX_VOX_OFFSET (1ull << 30)
+/* gzread takes an unsigned and returns an int: stay well inside INT_MAX. */
+#define READ_CHUNK (1u << 30)
+#define GZ_BUFFER (256u * 1024u)
+
+/* The header fields we use, widened to the NIfTI-2 types so one validation
+ * and one affine path serve both versions. */
+typedef struct nii_header {
+    int version;        /* 1 or 2 */
+    int swapped;        /* file byte order differs from ours */
+    int paired;         /* "ni1"/"ni2": voxels live in a separate .img */
+    int datatype;
+    int64_t dim[8];
+    double pixdim[8];
+    double vox_offset;  /* float in NIfTI-1, so kept as double until checked */
+    double scl_slope, scl_inter;
+    int qform_code, sform_code;
+    double quatern[3];  /* b, c, d */
+    double qoffset[3];
+    double srow[3][4];
+} nii_header;
+
+/* ------------------------------------------------------------ byte access */
+
+/* Byte order is detected from sizeof_hdr, so we never need to know the
+ * host's order: "swapped" just means "reverse every multi-byte field". */
+static void swap_bytes(unsigned char *p, size_t n)
+{
+    for (size_t i = 0; i < n / 2; i++) {
+        unsigned char t = p[i];
+        p[i] = p[n - 1 - i];
+        p[n - 1 - i] = t;
+    }
+}
+
+static void get_field(void *dst, const unsigned char *buf, size_t off, size_t n, int swapped)
+{
+    memcpy(dst, buf + off, n);
+    if (swapped) swap_bytes(dst, n);
+}
+
+static int64_t get_i16(const unsigned char *b, size_t off, int sw)
+{
+    int16_t v;
+    get_field(&v, b, off, sizeof v, sw);
+    return v;
+}
+
+static int64_t get_i32(const unsigned char *b, size_t off, int sw)
+{
+    int32_t v;
+    get_field(&v, b, off, sizeof v, sw);
+    return v;
+}
+
+static int64_t get_i64(const unsigned char *b, size_t off, int sw)
+{
+    int64_t v;
+    get_field(&v, b, off, sizeof v, sw);
+    return v;
+}
+
+static double get_f32(const unsigned char *b, size_t off, int sw)
+{
+    float v;
+    get_field(&v, b, off, sizeof v, sw);
+    return v;
+}
+
+static double get_f64(const unsigned char *b, size_t off, int sw)
+{
+    double v;
+    get_field(&v, b, off, sizeof v, sw);
+    return v;
+}
+
+/* Swaps every element of a voxel buffer in place. */
+static void swap_voxels(unsigned char *p, uint64_t count, size_t elem)
+{
+    if (elem < 2) return;
+    for (uint64_t i = 0; i < count; i++) swap_bytes(p + i * elem, elem);
+}
+
+/* ----------------------------------------------------------------- paths */
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcasecmp(s + n - m, suffix) == 0;
+}
+
+/* Returns a malloc'd copy of path with its trailing `from` replaced by `to`,
+ * or NULL when path does not end in `from` or memory is short. */
+static char *replace_suffix(const char *path, const char *from, const char *to)
+{
+    if (!ends_with(path, from)) return NULL;
+    size_t stem = strlen(path) - strlen(from);
+    char *s = malloc(stem + strlen(to) + 1);
+    if (!s) return NULL;
+    memcpy(s, path, stem);
+    strcpy(s + stem, to);
+    return s;
+}
+
+static int file_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+/* Given ".img[.gz]", the header is the matching ".hdr", preferring the same
+ * compression but accepting the other (some tools gzip only the image).
+ * Returns a malloc'd path (the input itself when it is not an .img) or NULL
+ * when memory is short. */
+static char *header_path_for(const char *path)
+{
+    static const char *const pairs[][2] = {
+        {".img.gz", ".hdr.gz"}, {".img.gz", ".hdr"}, {".img", ".hdr"}, {".img", ".hdr.gz"},
+    };
+    int is_img = ends_with(path, ".img") || ends_with(path, ".img.gz");
+    for (size_t i = 0; is_img && i < sizeof pairs / sizeof pairs[0]; i++) {
+        char *cand = replace_suffix(path, pairs[i][0], pairs[i][1]);
+        if (cand && file_exists(cand)) return cand;
+        free(cand);
+    }
+    /* Not an .img, or no header found: open the path itself, whose error
+     * (or lack of a NIfTI magic) then tells the user what is wrong. When an
+     * .img has no header, name the header we looked for. */
+    if (is_img) {
+        char *want = replace_suffix(path, ends_with(path, ".gz") ? ".img.gz" : ".img",
+                                    ends_with(path, ".gz") ? ".hdr.gz" : ".hdr");
+        if (want) return want;
+    }
+    size_t n = strlen(path) + 1;
+    char *s = malloc(n);
+    if (s) memcpy(s, path, n);
+    return s;
+}
+
+/* The .img that goes with a .hdr[.gz]; same preference order as above. */
+static char *image_path_for(const char *hdr_path)
+{
+    static const char *const pairs[][2] = {
+        {".hdr.gz", ".img.gz"}, {".hdr.gz", ".img"}, {".hdr", ".img"}, {".hdr", ".img.gz"},
+    };
+    char *first = NULL;
+    for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; i++) {
+        char *cand = replace_suffix(hdr_path, pairs[i][0], pairs[i][1]);
+        if (!cand) continue;
+        if (file_exists(cand)) {
+            free(first);
+            return cand;
+        }
+        if (!first) first = cand; /* reported as missing if nothing exists */
+        else free(cand);
+    }
+    return first;
+}
+
+/* ------------------------------------------------------------------- I/O */
+
+static gzFile open_gz(const char *path, vxl_err *e)
+{
+    errno = 0;
+    gzFile f = gzopen(path, "rb");
+    if (!f) {
+        vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path,
+                 errno ? strerror(errno) : "out of memory");
+        return NULL;
+    }
+    gzbuffer(f, GZ_BUFFER); /* larger than zlib's 8 KiB default: fewer syscalls */
+    return f;
+}
+
+/* Reads up to n bytes; *got says how many arrived. Returns VXL_OK at EOF too
+ * (the caller judges a short count), or an error for a broken stream. */
+static int read_bytes(gzFile f, void *buf, uint64_t n, uint64_t *got, const char *path, vxl_err *e)
+{
+    unsigned char *p = buf;
+    *got = 0;
+    while (*got < n) {
+        uint64_t left = n - *got;
+        unsigned want = left > READ_CHUNK ? READ_CHUNK : (unsigned)left;
+        int r = gzread(f, p + *got, want);
+        if (r < 0) {
+            int zerr = Z_OK;
+            const char *msg = gzerror(f, &zerr);
+            if (zerr == Z_ERRNO)
+                return vxl_fail(e, VXL_ERR_IO, "read error in '%s': %s", path, strerror(errno));
+            return vxl_fail(e, VXL_ERR_FORMAT, "corrupt compressed data in '%s': %s", path,
+                            msg ? msg : "unknown zlib error");
+        }
+        if (r == 0) break;
+        *got += (uint64_t)r;
+    }
+    return VXL_OK;
+}
+
+/* ---------------------------------------------------------------- header */
+
+static void parse_nifti1(const unsigned char *b, int sw, nii_header *h)
+{
+    h->version = 1;
+    for (int i = 0; i < 8; i++) {
+        h->dim[i] = get_i16(b, 40 + 2 * (size_t)i, sw);
+        h->pixdim[i] = get_f32(b, 76 + 4 * (size_t)i, sw);
+    }
+    h->datatype = (int)get_i16(b, 70, sw);
+    h->vox_offset = get_f32(b, 108, sw);
+    h->scl_slope = get_f32(b, 112, sw);
+    h->scl_inter = get_f32(b, 116, sw);
+    h->qform_code = (int)get_i16(b, 252, sw);
+    h->sform_code = (int)get_i16(b, 254, sw);
+    for (int i = 0; i < 3; i++) {
+        h->quatern[i] = get_f32(b, 256 + 4 * (size_t)i, sw);
+        h->qoffset[i] = get_f32(b, 268 + 4 * (size_t)i, sw);
+        for (int j = 0; j < 4; j++) h->srow[i][j] = get_f32(b, 280 + 16 * (size_t)i + 4 * (size_t)j, sw);
+    }
+}
+
+static void parse_nifti2(const unsigned char *b, int sw, nii_header *h)
+{
+    h->version = 2;
+    for (int i = 0; i < 8; i++) {
+        h->dim[i] = get_i64(b, 16 + 8 * (size_t)i, sw);
+        h->pixdim[i] = get_f64(b, 104 + 8 * (size_t)i, sw);
+    }
+    h->datatype = (int)get_i16(b, 12, sw);
+    /* int64 in the file; any value beyond 2^53 is rejected as absurd anyway,
+     * so the conversion to double cannot hide a valid offset. */
+    h->vox_offset = (double)get_i64(b, 168, sw);
+    h->scl_slope = get_f64(b, 176, sw);
+    h->scl_inter = get_f64(b, 184, sw);
+    h->qform_code = (int)get_i32(b, 344, sw);
+    h->sform_code = (int)get_i32(b, 348, sw);
+    for (int i = 0; i < 3; i++) {
+        h->quatern[i] = get_f64(b, 352 + 8 * (size_t)i, sw);
+        h->qoffset[i] = get_f64(b, 376 + 8 * (size_t)i, sw);
+        for (int j = 0; j < 4; j++) h->srow[i][j] = get_f64(b, 400 + 32 * (size_t)i + 8 * (size_t)j, sw);
+    }
+}
+
+/* sizeof_hdr is the byte-order mark: 348/540 read natively or swapped. */
+static int detect_version(const unsigned char *b, int *version, int *swapped)
+{
+    int32_t native, foreign;
+    memcpy(&native, b, 4);
+    foreign = native;
+    swap_bytes((unsigned char *)&foreign, 4);
+    *swapped = 0;
+    if (native == NII1_HDR_SIZE || native == NII2_HDR_SIZE) {
+        *version = native == NII1_HDR_SIZE ? 1 : 2;
+        return 1;
+    }
+    if (foreign == NII1_HDR_SIZE || foreign == NII2_HDR_SIZE) {
+        *version = foreign == NII1_HDR_SIZE ? 1 : 2;
+        *swapped = 1;
+        return 1;
+    }
+    return 0;
+}
+
+/* Sets h->paired from the magic, or fails: without a valid magic a 348-byte
+ * header is Analyze 7.5, whose orientation rules we do not implement. */
+static int check_magic(const unsigned char *b, nii_header *h, const char *path, vxl_err *e)
+{
+    if (h->version == 1) {
+        const unsigned char *m = b + 344;
+        if (memcmp(m, "n+1\0", 4) == 0 || memcmp(m, "ni1\0", 4) == 0) {
+            h->paired = m[1] == 'i';
+            return VXL_OK;
+        }
+        return vxl_fail(e, VXL_ERR_FORMAT,
+                        "'%s': bad NIfTI-1 magic (expected \"n+1\" or \"ni1\"; an Analyze 7.5 "
+                        "header or a corrupt file?)", path);
+    }
+    /* The 4 bytes after "n+2\0" (\r\n\032\n) exist to detect text-mode
+     * transfer damage, so they are checked too. */
+    const unsigned char *m = b + 4;
+    if ((memcmp(m, "n+2\0", 4) == 0 || memcmp(m, "ni2\0", 4) == 0) &&
+        memcmp(m + 4, "\r\n\032\n", 4) == 0) {
+        h->paired = m[1] == 'i';
+        return VXL_OK;
+    }
+    return vxl_fail(e, VXL_ERR_FORMAT,
+                    "'%s': bad NIfTI-2 magic (expected \"n+2\" or \"ni2\" followed by \\r\\n\\032\\n; "
+                    "corrupt or damaged by a text-mode transfer?)", path);
+}
+
+/* Reads and parses the header from f (positioned at 0). */
+static int read_header(gzFile f, const char *path, nii_header *h, vxl_err *e)
+{
+    unsigned char b[NII2_HDR_SIZE];
+    uint64_t got;
+    int rc = read_bytes(f, b, NII1_HDR_SIZE, &got, path, e);
+    if (rc) return rc;
+    if (got < 4 || !detect_version(b, &h->version, &h->swapped)) {
+        if (got < 4)
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s' is not a NIfTI file: only %llu bytes long", path,
+                            (unsigned long long)got);
+        int32_t s;
+        memcpy(&s, b, 4);
+        return vxl_fail(e, VXL_ERR_FORMAT,
+                        "'%s' is not a NIfTI file: sizeof_hdr is %d, expected 348 or 540 (either "
+                        "byte order)", path, (int)s);
+    }
+    size_t want = h->version == 1 ? NII1_HDR_SIZE : NII2_HDR_SIZE;
+    if (got == NII1_HDR_SIZE && want > got) {
+        uint64_t more;
+        rc = read_bytes(f, b + got, want - got, &more, path, e);
+        if (rc) return rc;
+        got += more;
+    }
+    if (got < want)
+        return vxl_fail(e, VXL_ERR_FORMAT,
+                        "'%s': truncated header: expected %zu bytes, got %llu", path, want,
+                        (unsigned long long)got);
+    if (h->version == 1) parse_nifti1(b, h->swapped, h);
+    else parse_nifti2(b, h->swapped, h);
+    return check_magic(b, h, path, e);
+}
+
+/* ------------------------------------------------------------ validation */
+
+static const char *datatype_name(int code)
+{
+    switch (code) {
+    case 0: return "UNKNOWN";
+    case 1: return "BINARY";
+    case 2: return "UINT8";
+    case 4: return "INT16";
+    case 8: return "INT32";
+    case 16: return "FLOAT32";
+    case 32: return "COMPLEX64";
+    case 64: return "FLOAT64";
+    case 128: return "RGB24";
+    case 256: return "INT8";
+    case 512: return "UINT16";
+    case 768: return "UINT32";
+    case 1024: return "INT64";
+    case 1280: return "UINT64";
+    case 1536: return "FLOAT128";
+    case 1792: return "COMPLEX128";
+    case 2048: return "COMPLEX256";
+    case 2304: return "RGBA32";
+    default: return "not a NIfTI datatype";
+    }
+}
+
+static uint32_t vxl_dtype_from_nifti(int code)
+{
+    switch (code) {
+    case 2: return VXL_DTYPE_U8;
+    case 256: return VXL_DTYPE_I8;
+    case 4: return VXL_DTYPE_I16;
+    case 512: return VXL_DTYPE_U16;
+    case 8: return VXL_DTYPE_I32;
+    case 768: return VXL_DTYPE_U32;
+    case 16: return VXL_DTYPE_F32;
+    case 64: return VXL_DTYPE_F64;
+    default: return 0;
+    }
+}
+
+/* Checks dim[] and fills the 3D grid. Axes past dim[0] are absent (= 1);
+ * axes 4..7 must still be positive even though only volume 0 is read. */
+static int check_dims(const nii_header *h, uint32_t dims[3], const char *path, vxl_err *e)
+{
+    int64_t nd = h->dim[0];
+    if (nd < 1 || nd > 7)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': bad dimensions: dim[0] is %lld, must be 1..7", path,
+                        (long long)nd);
+    for (int a = 1; a <= nd; a++) {
+        if (h->dim[a] < 1)
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': bad dimensions: dim[%d] is %lld, must be >= 1",
+                            path, a, (long long)h->dim[a]);
+    }
+    for (int a = 0; a < 3; a++) {
+        int64_t d = a + 1 <= nd ? h->dim[a + 1] : 1;
+        if (d > (int64_t)UINT32_MAX)
+            return vxl_fail(e, VXL_ERR_LIMIT, "'%s': dim[%d] = %lld exceeds the per-axis limit", path,
+                            a + 1, (long long)d);
+        dims[a] = (uint32_t)d;
+    }
+    return VXL_OK;
+}
+
+/* vox_offset must be a whole, sane byte offset; for single files it must
+ * also clear the header and extension flag. */
+static int check_vox_offset(const nii_header *h, uint64_t *offset, const char *path, vxl_err *e)
+{
+    double v = h->vox_offset;
+    if (!isfinite(v) || v < 0 || v != floor(v))
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': bad vox_offset %g: must be a whole number >= 0", path,
+                        v);
+    if (v > (double)MAX_VOX_OFFSET)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': absurd vox_offset %.0f (more than %llu bytes of "
+                        "header)", path, v, (unsigned long long)MAX_VOX_OFFSET);
+    uint64_t min = h->paired ? 0 : h->version == 1 ? NII1_MIN_OFFSET : NII2_MIN_OFFSET;
+    if ((uint64_t)v < min)
+        return vxl_fail(e, VXL_ERR_FORMAT,
+                        "'%s': vox_offset %.0f is inside the header (must be >= %llu)", path, v,
+                        (unsigned long long)min);
+    *offset = (uint64_t)v;
+    return VXL_OK;
+}
+
+/* ---------------------------------------------------------------- geometry */
+
+/* pixdim[1..3] as voxel size: the sign carries no meaning there (qfac lives
+ * in pixdim[0]), and 0 / non-finite means "unknown", i.e. 1 mm. */
+static void spacing_from(const nii_header *h, double sp[3])
+{
+    for (int a = 0; a < 3; a++) {
+        double p = fabs(h->pixdim[a + 1]);
+        sp[a] = (isfinite(p) && p > 0) ? p : 1.0;
+    }
+}
+
+static void set_colmajor(double A[16], const double M[3][4])
+{
+    memset(A, 0, 16 * sizeof *A);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++) A[c * 4 + r] = M[r][c];
+    A[15] = 1.0;
+}
+
+/* A transform is usable when finite and invertible: writers that set a code
+ * but leave the rows zero do exist, and we would rather fall back to the
+ * next source than render a flat volume. */
+static int usable(const double M[3][4])
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++)
+            if (!isfinite(M[r][c])) return 0;
+    double det = M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
+                 M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+                 M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]);
+    return isfinite(det) && det != 0.0;
+}
+
+/* nifti1.h "METHOD 2": R from the unit quaternion (a,b,c,d), columns scaled
+ * by the voxel size, the third negated when qfac < 0, offsets appended.
+ * Mirrors quatern_to_mat44 from nifti1_io.c, except that the voxel size is
+ * our cleaned spacing (|pixdim|, 0 -> 1) instead of "<= 0 -> 1". */
+static int qform_matrix(const nii_header *h, const double sp[3], double M[3][4])
+{
+    double b = h->quatern[0], c = h->quatern[1], d = h->quatern[2];
+    double n2 = b * b + c * c + d * d;
+    if (!isfinite(n2)) return 0;
+    double a = 1.0 - n2;
+    if (a < 1e-7) { /* |(b,c,d)| ~ 1: a 180 degree rotation; renormalise */
+        double s = 1.0 / sqrt(n2);
+        b *= s; c *= s; d *= s;
+        a = 0.0;
+    } else {
+        a = sqrt(a);
+    }
+    double xd = sp[0], yd = sp[1], zd = sp[2];
+    if (h->pixdim[0] < 0) zd = -zd; /* qfac: left-handed voxel grid */
+    M[0][0] = (a * a + b * b - c * c - d * d) * xd;
+    M[0][1] = 2.0 * (b * c - a * d) * yd;
+    M[0][2] = 2.0 * (b * d + a * c) * zd;
+    M[1][0] = 2.0 * (b * c + a * d) * xd;
+    M[1][1] = (a * a + c * c - b * b - d * d) * yd;
+    M[1][2] = 2.0 * (c * d - a * b) * zd;
+    M[2][0] = 2.0 * (b * d - a * c) * xd;
+    M[2][1] = 2.0 * (c * d + a * b) * yd;
+    M[2][2] = (a * a + d * d - c * c - b * b) * zd;
+    for (int r = 0; r < 3; r++) M[r][3] = h->qoffset[r];
+    return usable(M);
+}
+
+/* Picks sform, then qform, then diag(spacing), as the standard orders them.
+ * Returns the affine_source code (2, 1, 0). */
+static uint32_t choose_affine(const nii_header *h, const double sp[3], double A[16])
+{
+    double M[3][4];
+    if (h->sform_code > 0 && usable(h->srow)) {
+        set_colmajor(A, h->srow);
+        return 2;
+    }
+    if (h->qform_code > 0 && qform_matrix(h, sp, M)) {
+        set_colmajor(A, M);
+        return 1;
+    }
+    memset(M, 0, sizeof M);
+    for (int a = 0; a < 3; a++) M[a][a] = sp[a];
+    set_colmajor(A, M);
+    return 0;
+}
+
+/* --------------------------------------------------------------- voxels */
+
+/* For an uncompressed file the size is known up front: report truncation
+ * before allocating a buffer a hostile header may have sized. */
+static int precheck_size(gzFile f, const char *path, uint64_t offset, uint64_t nbytes, vxl_err *e)
+{
+    struct stat st;
+    if (!gzdirect(f) || stat(path, &st) != 0 || st.st_size < 0) return VXL_OK;
+    uint64_t size = (uint64_t)st.st_size;
+    uint64_t have = size > offset ? size - offset : 0;
+    if (have < nbytes)
+        return vxl_fail(e, VXL_ERR_FORMAT,
+                        "'%s': truncated file: expected %llu bytes of voxel data at offset %llu, "
+                        "got %llu", path, (unsigned long long)nbytes, (unsigned long long)offset,
+                        (unsigned long long)have);
+    return VXL_OK;
+}
+
+/* Reads the first volume's nbytes at offset into a new buffer. */
+static int read_voxels(gzFile f, const char *path, uint64_t offset, uint64_t nbytes, void **out,
+                       vxl_err *e)
+{
+    *out = NULL;
+    int rc = precheck_size(f, path, offset, nbytes, e);
+    if (rc) return rc;
+    /* Forward seek only (we are at or before offset); on gzip streams zlib
+     * decompresses and discards, and a seek past the end shows up as a short
+     * read below. */
+    if (gzseek(f, (z_off_t)offset, SEEK_SET) < 0)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot seek to vox_offset %llu", path,
+                        (unsigned long long)offset);
+    void *buf = malloc((size_t)nbytes);
+    if (!buf)
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for %llu bytes of voxel data", path,
+                        (unsigned long long)nbytes);
+    uint64_t got;
+    rc = read_bytes(f, buf, nbytes, &got, path, e);
+    if (!rc && got < nbytes)
+        rc = vxl_fail(e, VXL_ERR_FORMAT,
+                      "'%s': truncated file: expected %llu bytes of voxel data, got %llu", path,
+                      (unsigned long long)nbytes, (unsigned long long)got);
+    if (rc) {
+        free(buf);
+        return rc;
+    }
+    *out = buf;
+    return VXL_OK;
+}
+
+/* Re-raises an error from a helper that does not know the file name, keeping
+ * its code, so the message says which file was at fault. */
+static int fail_with_path(vxl_err *e, const char *path, const vxl_err *inner)
+{
+    return vxl_fail(e, inner->code, "'%s': %s", path, inner->msg);
+}
+
+/* ------------------------------------------------------------------ load */
+
+typedef struct nii_load {
+    const char *path;    /* as given by the caller */
+    char *hdr_path;
+    char *img_path;      /* paired files only */
+    gzFile hdr_file, img_file;
+    void *raw;
+} nii_load;
+
+static void load_cleanup(nii_load *L)
+{
+    if (L->img_file) gzclose(L->img_file);
+    if (L->hdr_file) gzclose(L->hdr_file);
+    free(L->raw);
+    free(L->img_path);
+    free(L->hdr_path);
+}
+
+/* Opens the header, reads it, and opens the file holding the voxels.
+ * On success data and data_path name that file. */
+static int open_files(nii_load *L, nii_header *h, gzFile *data, const char **data_path, vxl_err *e)
+{
+    L->hdr_path = header_path_for(L->path);
+    if (!L->hdr_path) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory");
+    L->hdr_file = open_gz(L->hdr_path, e);
+    if (!L->hdr_file) return VXL_ERR_IO;
+    int rc = read_header(L->hdr_file, L->hdr_path, h, e);
+    if (rc) return rc;
+    if (!h->paired) {
+        *data = L->hdr_file;
+        *data_path = L->hdr_path;
+        return VXL_OK;
+    }
+    /* The caller may have named the .img itself: use it as given. */
+    if (ends_with(L->path, ".img") || ends_with(L->path, ".img.gz")) {
+        size_t n = strlen(L->path) + 1;
+        L->img_path = malloc(n);
+        if (L->img_path) memcpy(L->img_path, L->path, n);
+    } else if (ends_with(L->hdr_path, ".hdr") || ends_with(L->hdr_path, ".hdr.gz")) {
+        L->img_path = image_path_for(L->hdr_path);
+    } else {
+        return vxl_fail(e, VXL_ERR_FORMAT,
+                        "'%s': header says the voxels are in a separate .img file, but the file "
+                        "name does not end in .hdr", L->hdr_path);
+    }
+    if (!L->img_path) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory");
+    L->img_file = open_gz(L->img_path, e);
+    if (!L->img_file) return VXL_ERR_IO;
+    *data = L->img_file;
+    *data_path = L->img_path;
+    return VXL_OK;
+}
+
+/* Validates the header and works out what to read. */
+static int plan_read(const nii_header *h, const char *path, const vxl_load_options *opt,
+                     uint32_t dims[3], uint32_t *dtype, uint64_t *offset, uint64_t *nbytes, vxl_err *e)
+{
+    int rc = check_dims(h, dims, path, e);
+    if (rc) return rc;
+    *dtype = vxl_dtype_from_nifti(h->datatype);
+    if (!*dtype)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': unsupported datatype %d (%s)", path, h->datatype,
+                        datatype_name(h->datatype));
+    rc = check_vox_offset(h, offset, path, e);
+    if (rc) return rc;
+    /* Same check vxl_volume_build makes, but before we allocate the raw
+     * buffer; it also guarantees the voxel count below cannot overflow. */
+    vxl_err inner = {0};
+    if (vxl_volume_check_limits(dims, vxl_texture_bits_for(*dtype) / 8, opt, &inner))
+        return fail_with_path(e, path, &inner);
+    uint64_t n = (uint64_t)dims[0] * dims[1] * dims[2];
+    uint64_t size = vxl_dtype_size(*dtype);
+    /* The raw buffer is at most 2x the texture (f64 -> float texture), so
+     * this only trips on 32-bit hosts. */
+    if (n > (uint64_t)SIZE_MAX / size)
+        return vxl_fail(e, VXL_ERR_LIMIT, "'%s': volume too large for this address space", path);
+    *nbytes = n * size;
+    return VXL_OK;
+}
+
+/* NIfTI: slope 0 or non-finite means "no scaling"; a non-finite intercept
+ * with a usable slope is treated as 0 rather than poisoning every value. */
+static void scaling_from(const nii_header *h, double *slope, double *inter)
+{
+    *slope = h->scl_slope;
+    *inter = h->scl_inter;
+    if (!isfinite(*slope) || *slope == 0.0) {
+        *slope = 0.0; /* vxl_volume_build: 0 = unscaled, inter ignored */
+        *inter = 0.0;
+    } else if (!isfinite(*inter)) {
+        *inter = 0.0;
+    }
+}
+
+int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+{
+    if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
+    *out = NULL;
+    if (!path || !*path) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "path is empty");
+
+    nii_load L = {.path = path};
+    nii_header h;
+    memset(&h, 0, sizeof h);
+    gzFile data = NULL;
+    const char *data_path = NULL;
+    uint32_t dims[3], dtype = 0;
+    uint64_t offset = 0, nbytes = 0;
+    int rc = open_files(&L, &h, &data, &data_path, e);
+    if (!rc) rc = plan_read(&h, L.hdr_path, opt, dims, &dtype, &offset, &nbytes, e);
+    if (!rc) rc = read_voxels(data, data_path, offset, nbytes, &L.raw, e);
+    if (rc) {
+        load_cleanup(&L);
+        return rc;
+    }
+    /* The file handles are done with: close them before the texture is
+     * allocated so their buffers do not add to the peak. */
+    if (L.img_file) gzclose(L.img_file);
+    gzclose(L.hdr_file);
+    L.img_file = L.hdr_file = NULL;
+
+    if (h.swapped) swap_voxels(L.raw, nbytes / vxl_dtype_size(dtype), vxl_dtype_size(dtype));
+    double sp[3], A[16], slope, inter;
+    spacing_from(&h, sp);
+    uint32_t source = choose_affine(&h, sp, A);
+    scaling_from(&h, &slope, &inter);
+
+    vxl_err inner = {0};
+    rc = vxl_volume_build(L.raw, dtype, dims, sp, A, slope, inter, opt, out, &inner);
+    if (rc) rc = fail_with_path(e, L.hdr_path, &inner);
+    else {
+        (*out)->nifti_version = (uint32_t)h.version;
+        (*out)->affine_source = source;
+    }
+    load_cleanup(&L);
+    return rc;
+}

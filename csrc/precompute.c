@@ -1,0 +1,91 @@
+/* precompute.c - the `precomputed` gradient filter's texture: a [1,2,1]^3 blur
+ * then a 26-neighbour Sobel, computed on the GL side once per volume. It
+ * stores the raw gradient divided by the global maximum magnitude, so that
+ * interpolation happens before normalisation (see measured-facts.md). */
+#include "renderer_internal.h"
+
+static const GLenum store_internal[] = {GL_RGBA8_SNORM, GL_RGBA16F, GL_RGBA32F};
+static const uint32_t store_bytes[] = {4, 8, 16};
+
+void vxl_gradients_release(vxl_renderer *r)
+{
+    if (r->gradient_tex) r->gl.DeleteTextures(1, &r->gradient_tex);
+    r->gradient_tex = 0;
+    r->gradient_bytes = 0;
+}
+
+static GLuint groups(uint32_t n) { return (n + 3) / 4; }
+
+static void dispatch_volume(vxl_renderer *r)
+{
+    r->gl.DispatchCompute(groups(r->dims[0]), groups(r->dims[1]), groups(r->dims[2]));
+}
+
+int vxl_gradients_ensure(vxl_renderer *r, int store)
+{
+    if (store < 0 || store > VXL_GRADIENT_STORE_32F)
+        return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown gradient_store %d", store);
+    if (r->gradient_tex && r->gradient_store == store) return VXL_OK;
+    vxl_gradients_release(r);
+    vxl_gl *gl = &r->gl;
+    uint64_t n = (uint64_t)r->dims[0] * r->dims[1] * r->dims[2];
+    uint64_t need = r->volume_bytes + n * store_bytes[store] + n * 4 /* transient blur */;
+    if (need > r->budget)
+        return vxl_fail(&r->err, VXL_ERR_LIMIT,
+                        "precomputed gradients need %.1f MiB in all, over the memory budget of %.1f MiB; "
+                        "use an on-the-fly filter or the 8-bit store",
+                        need / 1048576.0, r->budget / 1048576.0);
+    GLuint blur_prog, max_prog, store_prog;
+    int rc = vxl_program_get(r, VXL_PROG_GRAD_BLUR, 0, 0, &blur_prog);
+    if (!rc) rc = vxl_program_get(r, VXL_PROG_GRAD_MAX, 0, 0, &max_prog);
+    if (!rc) rc = vxl_program_get(r, VXL_PROG_GRAD_STORE, 0, (uint32_t)store, &store_prog);
+    if (rc) return rc;
+    gl->GetError();
+
+    /* pass 1: blur into a transient float texture */
+    GLuint blur = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
+    gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R32F, (GLsizei)r->dims[0], (GLsizei)r->dims[1], (GLsizei)r->dims[2], 0,
+                   GL_RED, GL_FLOAT, NULL);
+    gl->UseProgram(blur_prog);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
+    vxl_uniform_i(r, blur_prog, "u_src", 0);
+    gl->BindImageTexture(0, blur, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    dispatch_volume(r);
+    gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+
+    /* pass 2: global maximum magnitude */
+    const GLuint zero = 0;
+    gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[0]);
+    gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zero, &zero, GL_DYNAMIC_READ);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r->ssbo[0]);
+    gl->UseProgram(max_prog);
+    gl->BindTexture(GL_TEXTURE_3D, blur);
+    vxl_uniform_i(r, max_prog, "u_src", 0);
+    dispatch_volume(r);
+    gl->MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    union { GLuint u; float f; } max_mag = {0};
+    gl->GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof max_mag.u, &max_mag.u);
+
+    /* pass 3: scaled raw gradient into the stored format */
+    r->gradient_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)store_internal[store], (GLsizei)r->dims[0], (GLsizei)r->dims[1],
+                   (GLsizei)r->dims[2], 0, GL_RGBA, GL_FLOAT, NULL);
+    gl->UseProgram(store_prog);
+    gl->BindTexture(GL_TEXTURE_3D, blur);
+    vxl_uniform_i(r, store_prog, "u_src", 0);
+    vxl_uniform_f(r, store_prog, "u_inv_max", max_mag.f > 0 ? 1.0f / max_mag.f : 0.0f);
+    gl->BindImageTexture(0, r->gradient_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, store_internal[store]);
+    dispatch_volume(r);
+    gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    gl->DeleteTextures(1, &blur);
+    gl->UseProgram(0);
+    rc = vxl_gl_check(r, "precomputing gradients");
+    if (rc) {
+        vxl_gradients_release(r);
+        return rc;
+    }
+    r->gradient_store = store;
+    r->gradient_bytes = n * store_bytes[store];
+    return VXL_OK;
+}

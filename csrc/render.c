@@ -1,0 +1,216 @@
+/* render.c - one frame of the ray caster: resolve parameters, bind state,
+ * draw a full-screen triangle into a float framebuffer, read it back. */
+#include <math.h>
+#include <string.h>
+
+#include "frame.h"
+#include "renderer_internal.h"
+
+static void geom_of(const vxl_renderer *r, vxl_volume_geom *g)
+{
+    memcpy(g->dims, r->dims, sizeof g->dims);
+    memcpy(g->affine, r->affine, sizeof g->affine);
+    g->tex_lo = r->tex_lo;
+    g->tex_hi = r->tex_hi;
+    g->value_min = r->value_min;
+    g->value_max = r->value_max;
+}
+
+/* (Re)allocates the colour + depth-out attachments when the size changes. */
+static int ensure_framebuffer(vxl_renderer *r, uint32_t w, uint32_t h)
+{
+    vxl_gl *gl = &r->gl;
+    if (r->color_tex && r->fb_w == w && r->fb_h == h) return VXL_OK;
+    if (r->color_tex) gl->DeleteTextures(1, &r->color_tex);
+    if (r->depth_tex) gl->DeleteTextures(1, &r->depth_tex);
+    r->color_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_NEAREST);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, (GLsizei)w, (GLsizei)h, 0, GL_RGBA, GL_FLOAT, NULL);
+    r->depth_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_NEAREST);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, (GLsizei)w, (GLsizei)h, 0, GL_RED, GL_FLOAT, NULL);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, r->color_tex, 0);
+    gl->FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, r->depth_tex, 0);
+    int rc = vxl_gl_check(r, "allocating the framebuffer");
+    if (!rc && gl->CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        rc = vxl_fail(&r->err, VXL_ERR_GL, "the %ux%u float framebuffer is incomplete", w, h);
+    if (rc) {
+        gl->DeleteTextures(1, &r->color_tex);
+        gl->DeleteTextures(1, &r->depth_tex);
+        r->color_tex = r->depth_tex = 0;
+        r->fb_w = r->fb_h = 0;
+        return rc;
+    }
+    r->fb_w = w;
+    r->fb_h = h;
+    return VXL_OK;
+}
+
+int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store)
+{
+    vxl_gl *gl = &r->gl;
+    if (filter == VXL_FILTER_PRECOMPUTED) {
+        int rc = vxl_gradients_ensure(r, store);
+        if (rc) return rc;
+        gl->ActiveTexture(GL_TEXTURE1);
+        gl->BindTexture(GL_TEXTURE_3D, r->gradient_tex);
+    }
+    gl->UseProgram(prog);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
+    vxl_uniform_i(r, prog, "u_volume", 0);
+    vxl_uniform_i(r, prog, "u_gradient", 1);
+    GLint loc = gl->GetUniformLocation(prog, "u_dims");
+    float dims[3] = {(float)r->dims[0], (float)r->dims[1], (float)r->dims[2]};
+    if (loc >= 0) gl->Uniform3fv(loc, 1, dims);
+    return VXL_OK;
+}
+
+static void upload_tf(vxl_renderer *r, const vxl_frame *f)
+{
+    vxl_gl *gl = &r->gl;
+    if (!r->tf_tex) r->tf_tex = vxl_texture_new(r, GL_TEXTURE_1D, GL_LINEAR);
+    gl->ActiveTexture(GL_TEXTURE2);
+    gl->BindTexture(GL_TEXTURE_1D, r->tf_tex);
+    gl->TexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, (GLsizei)f->tf_size, 0, GL_RGBA, GL_FLOAT, f->tf);
+}
+
+static void upload_scene_depth(vxl_renderer *r, const vxl_frame *f)
+{
+    vxl_gl *gl = &r->gl;
+    if (!r->scene_depth_tex) r->scene_depth_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_NEAREST);
+    gl->ActiveTexture(GL_TEXTURE3);
+    gl->BindTexture(GL_TEXTURE_2D, r->scene_depth_tex);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, (GLsizei)f->width, (GLsizei)f->height, 0, GL_RED, GL_FLOAT,
+                   f->scene_depth);
+}
+
+static void set_frame_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame *f)
+{
+    vxl_gl *gl = &r->gl;
+#define LOC(name) gl->GetUniformLocation(prog, name)
+    gl->UniformMatrix4fv(LOC("u_inv_mvp"), 1, GL_FALSE, f->inv_mvp);
+    gl->UniformMatrix4fv(LOC("u_mv"), 1, GL_FALSE, f->mv);
+    gl->UniformMatrix3fv(LOC("u_normal_matrix"), 1, GL_FALSE, f->normal);
+    gl->Uniform2f(LOC("u_viewport"), (float)f->width, (float)f->height);
+    gl->Uniform1f(LOC("u_step"), f->step);
+    gl->Uniform1i(LOC("u_max_steps"), f->max_steps);
+    gl->Uniform1ui(LOC("u_jitter_seed"), f->seed);
+    gl->Uniform1i(LOC("u_jitter"), (int)f->jitter);
+    gl->Uniform1f(LOC("u_early_termination"), f->early_termination);
+    gl->Uniform1f(LOC("u_depth_threshold"), f->depth_threshold);
+    gl->Uniform1i(LOC("u_has_scene_depth"), f->scene_depth != NULL);
+    gl->Uniform1i(LOC("u_scene_depth"), 3);
+    gl->Uniform1i(LOC("u_tf"), 2);
+    gl->Uniform1f(LOC("u_tf_size"), (float)f->tf_size);
+    gl->Uniform2f(LOC("u_window"), f->window_offset, f->window_scale);
+    gl->Uniform1f(LOC("u_opacity_scale"), f->opacity_scale);
+    gl->Uniform1f(LOC("u_sample_distance"), f->sample_distance);
+    gl->Uniform4fv(LOC("u_material"), 1, f->material);
+    gl->Uniform1i(LOC("u_light_count"), f->light_count);
+    gl->Uniform4fv(LOC("u_light_pos"), VXL_MAX_LIGHTS, &f->light_pos[0][0]);
+    gl->Uniform3fv(LOC("u_light_color"), VXL_MAX_LIGHTS, &f->light_color[0][0]);
+#undef LOC
+}
+
+typedef struct render_job {
+    vxl_renderer *r;
+    const vxl_render_params *p;
+    float *rgba, *depth;
+} render_job;
+
+static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
+{
+    vxl_gl *gl = &r->gl;
+    GLuint prog;
+    uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u);
+    /* unshaded rays never evaluate gradients: one program serves every filter */
+    uint32_t filter = f->shading ? f->filter : VXL_FILTER_CENTRAL;
+    int rc = vxl_program_get(r, VXL_PROG_RAYCAST, filter, flags, &prog);
+    if (!rc) rc = ensure_framebuffer(r, f->width, f->height);
+    if (rc) return rc;
+    gl->GetError();
+    upload_tf(r, f);
+    if (f->scene_depth) upload_scene_depth(r, f);
+    rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
+    if (rc) return rc;
+    set_frame_uniforms(r, prog, f);
+    gl->BindFramebuffer(GL_FRAMEBUFFER, r->fbo);
+    const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    gl->DrawBuffers(2, bufs);
+    gl->Viewport(0, 0, (GLsizei)f->width, (GLsizei)f->height);
+    gl->Disable(GL_DEPTH_TEST);
+    gl->Disable(GL_BLEND);
+    gl->BindVertexArray(r->vao);
+    gl->DrawArrays(GL_TRIANGLES, 0, 3);
+    gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
+    gl->ReadPixels(0, 0, (GLsizei)f->width, (GLsizei)f->height, GL_RGBA, GL_FLOAT, rgba);
+    if (depth) {
+        gl->ReadBuffer(GL_COLOR_ATTACHMENT1);
+        gl->ReadPixels(0, 0, (GLsizei)f->width, (GLsizei)f->height, GL_RED, GL_FLOAT, depth);
+    }
+    gl->BindVertexArray(0);
+    gl->UseProgram(0);
+    return vxl_gl_check(r, "rendering");
+}
+
+static int job_render(void *p)
+{
+    render_job *j = p;
+    vxl_renderer *r = j->r;
+    if (!r->has_volume) return vxl_fail(&r->err, VXL_ERR_STATE, "no volume: call vxl_renderer_set_volume first");
+    vxl_volume_geom g;
+    geom_of(r, &g);
+    vxl_frame f;
+    int rc = vxl_frame_resolve(&f, j->p, &g, &r->err);
+    if (rc) return rc;
+    rc = draw(r, &f, j->rgba, j->depth);
+    vxl_frame_free(&f);
+    return rc;
+}
+
+int vxl_render(vxl_renderer *r, const vxl_render_params *p, float *rgba, float *depth)
+{
+    if (!r) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "renderer is NULL");
+    if (!rgba) return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "rgba output buffer is NULL");
+    render_job j = {r, p, rgba, depth};
+    int rc = vxl_gl_thread_call(&r->thread, job_render, &j);
+    if (rc) vxl_publish_error(&r->err);
+    return rc;
+}
+
+typedef struct camera_job {
+    vxl_renderer *r;
+    const vxl_render_params *p;
+    float *view, *proj;
+} camera_job;
+
+static int job_camera(void *p)
+{
+    camera_job *j = p;
+    vxl_renderer *r = j->r;
+    if (!r->has_volume) return vxl_fail(&r->err, VXL_ERR_STATE, "no volume: call vxl_renderer_set_volume first");
+    vxl_volume_geom g;
+    geom_of(r, &g);
+    vxl_render_params q;
+    memset(&q, 0, sizeof q);
+    if (j->p) q = *j->p;
+    q.has_camera = 0;
+    vxl_frame f;
+    int rc = vxl_frame_resolve(&f, &q, &g, &r->err);
+    if (rc) return rc;
+    for (int i = 0; i < 16; i++) {
+        j->view[i] = (float)f.view[i];
+        j->proj[i] = (float)f.proj[i];
+    }
+    vxl_frame_free(&f);
+    return VXL_OK;
+}
+
+int vxl_default_camera(vxl_renderer *r, const vxl_render_params *p, float view[16], float proj[16])
+{
+    if (!r || !view || !proj) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "renderer or matrix is NULL");
+    camera_job j = {r, p, view, proj};
+    int rc = vxl_gl_thread_call(&r->thread, job_camera, &j);
+    if (rc) vxl_publish_error(&r->err);
+    return rc;
+}

@@ -1,0 +1,179 @@
+/* renderer.c - renderer lifecycle and volume upload. Every GL call runs on
+ * the renderer's thread through vxl_gl_thread_call. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "renderer_internal.h"
+#include "volume.h"
+
+typedef struct open_job {
+    vxl_renderer *r;
+    uint32_t backend;
+} open_job;
+
+static vxl_gl_proc get_proc(void *user, const char *name)
+{
+    vxl_context *c = user;
+    return (vxl_gl_proc)c->get_proc(c, name);
+}
+
+static void copy_gl_string(vxl_renderer *r, GLenum what, char *dst, size_t n)
+{
+    const GLubyte *s = r->gl.GetString(what);
+    strncpy(dst, s ? (const char *)s : "", n - 1);
+    dst[n - 1] = '\0';
+}
+
+static int job_open(void *p)
+{
+    open_job *j = p;
+    vxl_renderer *r = j->r;
+    int rc = vxl_context_open(&r->ctx, j->backend, &r->err);
+    if (rc) return rc;
+    const char *missing = vxl_gl_load(&r->gl, get_proc, &r->ctx);
+    if (missing) {
+        vxl_context_close(&r->ctx);
+        return vxl_fail(&r->err, VXL_ERR_BACKEND, "%s: OpenGL entry point %s is missing", r->ctx.name, missing);
+    }
+    r->info.struct_size = sizeof r->info;
+    r->info.backend = r->ctx.backend;
+    snprintf(r->info.backend_name, sizeof r->info.backend_name, "%s", r->ctx.name);
+    copy_gl_string(r, GL_RENDERER, r->info.gl_renderer, sizeof r->info.gl_renderer);
+    copy_gl_string(r, GL_VERSION, r->info.gl_version, sizeof r->info.gl_version);
+    r->gl.GetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &r->info.max_3d_texture_size);
+    r->gl.GenVertexArrays(1, &r->vao);
+    r->gl.GenFramebuffers(1, &r->fbo);
+    r->gl.GenBuffers(2, r->ssbo);
+    r->gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    r->gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    return vxl_gl_check(r, "creating the renderer");
+}
+
+static void delete_texture(vxl_renderer *r, GLuint *t)
+{
+    if (*t) r->gl.DeleteTextures(1, t);
+    *t = 0;
+}
+
+static int job_close(void *p)
+{
+    vxl_renderer *r = p;
+    if (r->ctx.close) {
+        vxl_gradients_release(r);
+        delete_texture(r, &r->volume_tex);
+        delete_texture(r, &r->color_tex);
+        delete_texture(r, &r->depth_tex);
+        delete_texture(r, &r->scene_depth_tex);
+        delete_texture(r, &r->tf_tex);
+        vxl_programs_delete(r);
+        r->gl.DeleteFramebuffers(1, &r->fbo);
+        r->gl.DeleteVertexArrays(1, &r->vao);
+        r->gl.DeleteBuffers(2, r->ssbo);
+        r->gl.Finish();
+    }
+    vxl_context_close(&r->ctx);
+    return VXL_OK;
+}
+
+int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
+{
+    if (!out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
+    *out = NULL;
+    vxl_renderer *r = calloc(1, sizeof *r);
+    if (!r) return vxl_fail(NULL, VXL_ERR_NO_MEMORY, "out of memory for the renderer");
+    r->budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
+    const char *dir = (opt && opt->shader_dir) ? opt->shader_dir : getenv("VOXLIGHT_SHADER_DIR");
+    if (dir && *dir && !(r->shader_dir = strdup(dir))) {
+        free(r);
+        return vxl_fail(NULL, VXL_ERR_NO_MEMORY, "out of memory");
+    }
+    if (vxl_gl_thread_start(&r->thread)) {
+        free(r->shader_dir);
+        free(r);
+        return vxl_fail(NULL, VXL_ERR_NO_MEMORY, "cannot start the renderer's GL thread");
+    }
+    open_job j = {r, opt ? opt->backend : VXL_BACKEND_AUTO};
+    int rc = vxl_gl_thread_call(&r->thread, job_open, &j);
+    if (rc) {
+        vxl_err copy = r->err;
+        vxl_gl_thread_stop(&r->thread, job_close, r);
+        free(r->shader_dir);
+        free(r);
+        return vxl_fail(NULL, rc, "%s", copy.msg);
+    }
+    *out = r;
+    return VXL_OK;
+}
+
+void vxl_renderer_destroy(vxl_renderer *r)
+{
+    if (!r) return;
+    vxl_gl_thread_stop(&r->thread, job_close, r);
+    free(r->shader_dir);
+    free(r);
+}
+
+const char *vxl_renderer_error(const vxl_renderer *r) { return r ? r->err.msg : ""; }
+
+int vxl_renderer_get_info(vxl_renderer *r, vxl_renderer_info *out)
+{
+    if (!r || !out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "renderer or info is NULL");
+    *out = r->info; /* written once by job_open, read-only afterwards */
+    return VXL_OK;
+}
+
+typedef struct volume_job {
+    vxl_renderer *r;
+    const vxl_volume *v;
+} volume_job;
+
+static const GLenum internal_formats[] = {GL_R8, GL_R16, GL_R32F};
+static const GLenum texel_types[] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_SHORT, GL_FLOAT};
+
+static int job_set_volume(void *p)
+{
+    volume_job *j = p;
+    vxl_renderer *r = j->r;
+    const vxl_volume *v = j->v;
+    for (int a = 0; a < 3; a++)
+        if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size)
+            return vxl_fail(&r->err, VXL_ERR_LIMIT,
+                            "volume %ux%ux%u exceeds this backend's 3D texture limit of %d per axis",
+                            v->dims[0], v->dims[1], v->dims[2], r->info.max_3d_texture_size);
+    if (v->storage_bytes > r->budget)
+        return vxl_fail(&r->err, VXL_ERR_LIMIT, "volume needs %.1f MiB, over the renderer's memory budget of %.1f MiB",
+                        v->storage_bytes / 1048576.0, r->budget / 1048576.0);
+    /* Everything derived from the old volume goes: the data changed. */
+    vxl_gradients_release(r);
+    delete_texture(r, &r->volume_tex);
+    r->has_volume = 0;
+    int fi = v->texture_bits == 8 ? 0 : v->texture_bits == 16 ? 1 : 2;
+    r->gl.GetError();
+    r->volume_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+    r->gl.TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)v->dims[0], (GLsizei)v->dims[1],
+                     (GLsizei)v->dims[2], 0, GL_RED, texel_types[fi], v->texels);
+    int rc = vxl_gl_check(r, "uploading the volume");
+    if (rc) {
+        delete_texture(r, &r->volume_tex);
+        return rc;
+    }
+    memcpy(r->dims, v->dims, sizeof r->dims);
+    r->tex_lo = v->tex_lo;
+    r->tex_hi = v->tex_hi;
+    r->value_min = v->value_min;
+    r->value_max = v->value_max;
+    memcpy(r->affine, v->affine, sizeof r->affine);
+    r->volume_bytes = v->storage_bytes;
+    r->has_volume = 1;
+    return VXL_OK;
+}
+
+int vxl_renderer_set_volume(vxl_renderer *r, const vxl_volume *v)
+{
+    if (!r || !v) return vxl_fail(r ? &r->err : NULL, VXL_ERR_INVALID_ARGUMENT, "renderer or volume is NULL");
+    volume_job j = {r, v};
+    int rc = vxl_gl_thread_call(&r->thread, job_set_volume, &j);
+    if (rc) vxl_publish_error(&r->err);
+    return rc;
+}

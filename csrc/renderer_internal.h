@@ -1,0 +1,74 @@
+/* renderer_internal.h - the renderer's state. Everything GL lives on the
+ * renderer's own thread; API functions package their arguments into a job. */
+#ifndef VXL_RENDERER_INTERNAL_H
+#define VXL_RENDERER_INTERNAL_H
+
+#include <stdint.h>
+
+#include "context.h"
+#include "error.h"
+#include "gl_funcs.h"
+#include "gl_thread.h"
+#include "voxlight.h"
+
+#define VXL_MAX_PROGRAMS 96
+#define VXL_MAX_SAMPLES_PER_RAY 16384 /* bounds every ray, whatever the step */
+#define VXL_MAX_IMAGE_SIDE 16384
+
+/* Program kinds in the cache key. */
+#define VXL_PROG_RAYCAST 0
+#define VXL_PROG_PROBE 1
+#define VXL_PROG_GRAD_BLUR 2
+#define VXL_PROG_GRAD_MAX 3
+#define VXL_PROG_GRAD_STORE 4
+
+typedef struct vxl_program_entry {
+    uint32_t key;
+    GLuint program;
+} vxl_program_entry;
+
+struct vxl_renderer {
+    vxl_gl_thread thread;
+    vxl_context ctx;
+    vxl_gl gl;
+    vxl_err err;               /* last failure on this handle */
+    uint64_t budget;           /* GPU storage budget, bytes */
+    char *shader_dir;          /* NULL = embedded shaders */
+    vxl_renderer_info info;
+
+    /* the volume on the GL side; see set_volume for what depends on it */
+    int has_volume;
+    uint32_t dims[3];
+    double tex_lo, tex_hi, value_min, value_max;
+    double affine[16];
+    GLuint volume_tex;
+    uint64_t volume_bytes;
+
+    /* Precomputed gradients depend only on the volume data and the storage
+     * format: rebuilt on set_volume or a format change, never per frame. */
+    GLuint gradient_tex;
+    int gradient_store;        /* VXL_GRADIENT_STORE_* of gradient_tex */
+    uint64_t gradient_bytes;
+
+    vxl_program_entry programs[VXL_MAX_PROGRAMS];
+    int n_programs;
+    GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex, ssbo[2];
+    uint32_t fb_w, fb_h;
+};
+
+/* gl_util.c */
+int vxl_program_get(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out);
+void vxl_uniform_i(vxl_renderer *r, GLuint prog, const char *name, int v);
+void vxl_uniform_f(vxl_renderer *r, GLuint prog, const char *name, float v);
+GLuint vxl_texture_new(vxl_renderer *r, GLenum target, GLint filter);
+int vxl_gl_check(vxl_renderer *r, const char *what);
+void vxl_programs_delete(vxl_renderer *r);
+
+/* precompute.c */
+int vxl_gradients_ensure(vxl_renderer *r, int store);
+void vxl_gradients_release(vxl_renderer *r);
+
+/* render.c helpers shared with probe.c */
+int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store);
+
+#endif

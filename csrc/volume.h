@@ -1,0 +1,49 @@
+/* volume.h - the CPU-side volume: voxels already converted to the texture
+ * format they will be uploaded in, plus geometry and value range. */
+#ifndef VXL_VOLUME_H
+#define VXL_VOLUME_H
+
+#include <stdint.h>
+
+#include "error.h"
+#include "voxlight.h"
+
+#define VXL_DEFAULT_BUDGET (2ull << 30) /* 2 GiB */
+#define VXL_DEFAULT_MAX_DIM 65536u
+
+struct vxl_volume {
+    uint32_t dims[3];
+    uint32_t src_dtype;     /* VXL_DTYPE_* of the source */
+    uint32_t texture_bits;  /* 8, 16: unsigned normalised; 32: float in [0,1] */
+    uint32_t nifti_version;
+    uint32_t affine_source;
+    void *texels;           /* dims product * texture_bits/8 bytes */
+    uint64_t storage_bytes;
+    /* data value = tex_lo + t * (tex_hi - tex_lo) for stored t in [0,1] */
+    double tex_lo, tex_hi;
+    double value_min, value_max; /* finite data range */
+    uint64_t nan_count, inf_count;
+    double spacing[3];
+    double affine[16];      /* column-major voxel -> world */
+};
+
+/* Checks dims against max_dim and the budget before anything is allocated.
+ * bytes_per_voxel is what the texture will cost. */
+int vxl_volume_check_limits(const uint32_t dims[3], uint32_t bytes_per_voxel,
+                            const vxl_load_options *opt, vxl_err *e);
+
+/* Texture bits used for a source dtype. */
+uint32_t vxl_texture_bits_for(uint32_t dtype);
+uint32_t vxl_dtype_size(uint32_t dtype);
+
+/* Builds a volume from raw native-endian typed data (x fastest). Applies
+ * slope/inter (slope 0 = none), counts and neutralises NaN/Inf, normalises
+ * into the texture format. affine may be NULL (diag(spacing)). */
+int vxl_volume_build(const void *raw, uint32_t dtype, const uint32_t dims[3], const double spacing[3],
+                     const double *affine_colmajor, double slope, double inter,
+                     const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+
+/* NIfTI-1/2 reader (.nii, .nii.gz, .hdr/.img[.gz]); in nifti.c. */
+int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+
+#endif

@@ -1,0 +1,84 @@
+// gradients.glsl - the gradient filters, one chosen per program by a define:
+// FILTER_CENTRAL, FILTER_FORWARD3, FILTER_SOBEL8, FILTER_SOBEL14,
+// FILTER_SOBEL26, FILTER_PRECOMPUTED. Every filter returns the gradient in
+// voxel space (normalised value per voxel) and is exact on a linear ramp.
+#include "common.glsl"
+
+uniform float u_sample_distance; // tap offset d, in voxels
+
+#ifdef FILTER_PRECOMPUTED
+uniform sampler3D u_gradient; // raw gradient / global max, interpolated then used
+#endif
+
+#define TAP(o) sample_value(p + (o))
+
+// centre: the value at p, which the ray caster has already fetched.
+vec3 gradient_at(vec3 p, float centre)
+{
+    float d = u_sample_distance;
+#if defined(FILTER_CENTRAL)
+    return vec3(TAP(vec3(d, 0, 0)) - TAP(vec3(-d, 0, 0)),
+                TAP(vec3(0, d, 0)) - TAP(vec3(0, -d, 0)),
+                TAP(vec3(0, 0, d)) - TAP(vec3(0, 0, -d))) / (2.0 * d);
+#elif defined(FILTER_FORWARD3)
+    // 3 taps against the centre sample: cheapest, biased by d/2 along each axis.
+    return (vec3(TAP(vec3(d, 0, 0)), TAP(vec3(0, d, 0)), TAP(vec3(0, 0, d))) - centre) / d;
+#elif defined(FILTER_SOBEL8)
+    // Trilinear fetches at the 8 corners (+-d,+-d,+-d); at d = 0.5 this is
+    // exactly the [-1,0,1]x[1,2,1]x[1,2,1] Sobel kernel at grid points.
+    vec3 g = vec3(0.0);
+    for (int i = 0; i < 8; i++) {
+        vec3 s = vec3((i & 1) != 0 ? 1.0 : -1.0, (i & 2) != 0 ? 1.0 : -1.0, (i & 4) != 0 ? 1.0 : -1.0);
+        g += s * TAP(d * s);
+    }
+    return g / (8.0 * d);
+#elif defined(FILTER_SOBEL14)
+    // Faces and corners together (MRIcroGL's Sobel14); each face tap sums to
+    // 2d*grad and the corners to 8d*grad on a ramp.
+    vec3 g = vec3(TAP(vec3(d, 0, 0)) - TAP(vec3(-d, 0, 0)),
+                  TAP(vec3(0, d, 0)) - TAP(vec3(0, -d, 0)),
+                  TAP(vec3(0, 0, d)) - TAP(vec3(0, 0, -d)));
+    for (int i = 0; i < 8; i++) {
+        vec3 s = vec3((i & 1) != 0 ? 1.0 : -1.0, (i & 2) != 0 ? 1.0 : -1.0, (i & 4) != 0 ? 1.0 : -1.0);
+        g += s * TAP(d * s);
+    }
+    return g / (10.0 * d);
+#elif defined(FILTER_SOBEL26)
+    // Classic weighted 26-neighbour Sobel: weight o.x*h(o.y)*h(o.z) for the x
+    // component with h(0) = 2, h(+-1) = 1; the weights sum to 32d on a ramp.
+    vec3 g = vec3(0.0);
+    for (int z = -1; z <= 1; z++)
+        for (int y = -1; y <= 1; y++)
+            for (int x = -1; x <= 1; x++) {
+                if (x == 0 && y == 0 && z == 0) continue;
+                vec3 o = vec3(x, y, z);
+                vec3 h = 2.0 - abs(o);
+                g += o * vec3(h.y * h.z, h.x * h.z, h.x * h.y) * TAP(d * o);
+            }
+    return g / (32.0 * d);
+#elif defined(FILTER_PRECOMPUTED)
+    return textureLod(u_gradient, voxel_to_tex(p), 0.0).xyz;
+#else
+#error "no FILTER_* define"
+#endif
+}
+
+// reuseGradients (MRIcroGL): when the gradient magnitude drops below the
+// previous sample's, keep the previous direction. The magnitude always
+// follows the current sample, as in MRIcroGL, so a long decline keeps one
+// direction while a rise takes the new one.
+struct GradientState {
+    vec3 dir;
+    float mag; // < 0: no previous sample
+};
+
+GradientState gradient_state_init() { return GradientState(vec3(0.0), -1.0); }
+
+vec3 reuse_gradient(inout GradientState s, vec3 g)
+{
+    float m = length(g);
+    vec3 d = (m < s.mag) ? s.dir : g;
+    s.dir = d;
+    s.mag = m;
+    return d;
+}

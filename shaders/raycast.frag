@@ -1,0 +1,101 @@
+// raycast.frag - front-to-back ray casting with premultiplied compositing.
+// Variants by define: FILTER_* (gradients.glsl), SHADING, REUSE_GRADIENTS.
+#include "gradients.glsl"
+#include "classify.glsl"
+#include "shading.glsl"
+
+uniform mat4 u_inv_mvp;      // clip -> voxel space
+uniform mat4 u_mv;           // voxel -> view space
+uniform vec2 u_viewport;     // pixels
+uniform float u_step;        // voxels
+uniform int u_max_steps;     // hard bound on samples per ray
+uniform uint u_jitter_seed;
+uniform int u_jitter;
+uniform float u_early_termination;
+uniform float u_depth_threshold;
+uniform int u_has_scene_depth;
+uniform sampler2D u_scene_depth; // view-space planar distance, +inf = none
+
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out float o_depth;
+
+// Integer hash (PCG-style): deterministic per pixel and seed, no texture.
+float jitter_hash(uvec2 px, uint seed)
+{
+    uint v = px.x * 1973u + px.y * 9277u + seed * 26699u + 1u;
+    v = v * 747796405u + 2891336453u;
+    v = ((v >> ((v >> 28u) + 4u)) ^ v) * 277803737u;
+    v = (v >> 22u) ^ v;
+    return float(v) * (1.0 / 4294967296.0);
+}
+
+void emit_nothing()
+{
+    o_color = vec4(0.0);
+    o_depth = uintBitsToFloat(0x7f800000u); // +inf
+}
+
+void main()
+{
+    vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
+    vec4 hn = u_inv_mvp * vec4(ndc, -1.0, 1.0);
+    vec4 hf = u_inv_mvp * vec4(ndc, 1.0, 1.0);
+    vec3 o = hn.xyz / hn.w;
+    vec3 dir = hf.xyz / hf.w - o;
+    float t_far = length(dir);
+    if (!(t_far > 0.0) || isinf(t_far) || any(isnan(o)) || any(isinf(o))) { emit_nothing(); return; }
+    dir /= t_far;
+
+    // Slab test with a guarded reciprocal: an axis-parallel ray whose origin
+    // lies on a slab plane would otherwise give 0 * inf = NaN.
+    vec3 lo = vec3(-0.5), hi = u_dims - 0.5;
+    float t0 = 0.0, t1 = t_far;
+    for (int a = 0; a < 3; a++) {
+        if (abs(dir[a]) < 1e-12) {
+            if (o[a] < lo[a] || o[a] > hi[a]) { emit_nothing(); return; }
+        } else {
+            float inv = 1.0 / dir[a];
+            float ta = (lo[a] - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
+            t0 = max(t0, min(ta, tb));
+            t1 = min(t1, max(ta, tb));
+        }
+    }
+    // View-space planar distance along the ray is affine in t.
+    vec4 row2 = vec4(u_mv[0][2], u_mv[1][2], u_mv[2][2], u_mv[3][2]);
+    float z0 = dot(row2, vec4(o, 1.0)), dz = dot(row2.xyz, dir);
+    if (u_has_scene_depth != 0 && dz < 0.0) {
+        float d = texelFetch(u_scene_depth, ivec2(gl_FragCoord.xy), 0).r;
+        if (!isnan(d)) t1 = min(t1, (-d - z0) / dz);
+    }
+    if (!(t0 < t1)) { emit_nothing(); return; }
+
+    vec3 view_dir = -normalize(mat3(u_mv) * dir);
+    float jitter = u_jitter != 0 ? jitter_hash(uvec2(gl_FragCoord.xy), u_jitter_seed) : 0.0;
+    float t = t0 + jitter * u_step;
+    vec4 acc = vec4(0.0);
+    float depth = uintBitsToFloat(0x7f800000u);
+#ifdef REUSE_GRADIENTS
+    GradientState gs = gradient_state_init();
+#endif
+    for (int i = 0; i < u_max_steps && t < t1; i++, t += u_step) {
+        vec3 p = o + t * dir;
+        float v = sample_value(p);
+        vec4 c = classify(v);
+        if (c.a <= 0.0) continue;
+        float a = correct_opacity(c.a, u_step);
+        vec3 rgb = c.rgb;
+#ifdef SHADING
+        vec3 g = gradient_at(p, v);
+#ifdef REUSE_GRADIENTS
+        g = reuse_gradient(gs, g);
+#endif
+        vec3 pos = (u_mv * vec4(p, 1.0)).xyz;
+        rgb = shade(rgb, g, pos, view_dir);
+#endif
+        acc += (1.0 - acc.a) * a * vec4(rgb, 1.0);
+        if (isinf(depth) && acc.a >= u_depth_threshold) depth = -(z0 + dz * t);
+        if (acc.a >= u_early_termination) break;
+    }
+    o_color = clamp(acc, 0.0, 1.0);
+    o_depth = depth;
+}

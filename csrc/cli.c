@@ -68,7 +68,7 @@ static const char *dtype_name(uint32_t t)
 
 static int cmd_info(int argc, char **argv)
 {
-    if (argc != 1) return die("info takes one INPUT file\n%s", usage);
+    if (argc != 1) return die("info takes one INPUT file (see voxlight --help)");
     vxl_volume *v = NULL;
     if (vxl_volume_load(argv[0], NULL, &v)) return die("%s", vxl_last_error());
     vxl_volume_info in = {.struct_size = sizeof in};
@@ -155,12 +155,12 @@ static int parse_render(int argc, char **argv, render_args *a)
             NEED_VALUE();
             if (!parse_size(val, &a->ro.memory_budget_bytes)) return die("bad --memory-budget '%s': e.g. 2G or 512M", val);
             a->lo.memory_budget_bytes = a->ro.memory_budget_bytes;
-        } else if (o[0] == '-' && o[1]) return die("unknown option '%s'\n%s", o, usage);
+        } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);
 #undef NEED_VALUE
     }
-    if (!a->input) return die("render needs an INPUT file\n%s", usage);
+    if (!a->input) return die("render needs an INPUT file (see voxlight --help)");
     if (!a->output) return die("render needs -o OUT.png or OUT.exr");
     return 0;
 }
@@ -209,5 +209,5 @@ int main(int argc, char **argv)
     if (vxl_abi_version() != VXL_ABI_VERSION) return die("libvoxlight ABI %u, expected %u", vxl_abi_version(), VXL_ABI_VERSION);
     if (!strcmp(argv[1], "render")) return cmd_render(argc - 2, argv + 2);
     if (!strcmp(argv[1], "info")) return cmd_info(argc - 2, argv + 2);
-    return die("unknown command '%s'\n%s", argv[1], usage);
+    return die("unknown command '%s' (see voxlight --help)", argv[1]);
 }

@@ -34,6 +34,12 @@
 #define READ_CHUNK (1u << 30)
 #define GZ_BUFFER (256u * 1024u)
 
+/* A 3x4 affine, row-major as NIfTI writes srow_x/y/z. A struct so it can be
+ * passed as const without C11's array-qualifier pitfalls. */
+typedef struct mat34 {
+    double m[3][4];
+} mat34;
+
 /* The header fields we use, widened to the NIfTI-2 types so one validation
  * and one affine path serve both versions. */
 typedef struct nii_header {
@@ -48,7 +54,7 @@ typedef struct nii_header {
     int qform_code, sform_code;
     double quatern[3];  /* b, c, d */
     double qoffset[3];
-    double srow[3][4];
+    mat34 srow;
 } nii_header;
 
 /* ------------------------------------------------------------ byte access */
@@ -245,7 +251,7 @@ static void parse_nifti1(const unsigned char *b, int sw, nii_header *h)
     for (int i = 0; i < 3; i++) {
         h->quatern[i] = get_f32(b, 256 + 4 * (size_t)i, sw);
         h->qoffset[i] = get_f32(b, 268 + 4 * (size_t)i, sw);
-        for (int j = 0; j < 4; j++) h->srow[i][j] = get_f32(b, 280 + 16 * (size_t)i + 4 * (size_t)j, sw);
+        for (int j = 0; j < 4; j++) h->srow.m[i][j] = get_f32(b, 280 + 16 * (size_t)i + 4 * (size_t)j, sw);
     }
 }
 
@@ -267,7 +273,7 @@ static void parse_nifti2(const unsigned char *b, int sw, nii_header *h)
     for (int i = 0; i < 3; i++) {
         h->quatern[i] = get_f64(b, 352 + 8 * (size_t)i, sw);
         h->qoffset[i] = get_f64(b, 376 + 8 * (size_t)i, sw);
-        for (int j = 0; j < 4; j++) h->srow[i][j] = get_f64(b, 400 + 32 * (size_t)i + 8 * (size_t)j, sw);
+        for (int j = 0; j < 4; j++) h->srow.m[i][j] = get_f64(b, 400 + 32 * (size_t)i + 8 * (size_t)j, sw);
     }
 }
 
@@ -448,19 +454,20 @@ static void spacing_from(const nii_header *h, double sp[3])
     }
 }
 
-static void set_colmajor(double A[16], const double M[3][4])
+static void set_colmajor(double A[16], const mat34 *M)
 {
     memset(A, 0, 16 * sizeof *A);
     for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 4; c++) A[c * 4 + r] = M[r][c];
+        for (int c = 0; c < 4; c++) A[c * 4 + r] = M->m[r][c];
     A[15] = 1.0;
 }
 
 /* A transform is usable when finite and invertible: writers that set a code
  * but leave the rows zero do exist, and we would rather fall back to the
  * next source than render a flat volume. */
-static int usable(const double M[3][4])
+static int usable(const mat34 *T)
 {
+    const double (*M)[4] = T->m;
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 4; c++)
             if (!isfinite(M[r][c])) return 0;
@@ -474,8 +481,9 @@ static int usable(const double M[3][4])
  * by the voxel size, the third negated when qfac < 0, offsets appended.
  * Mirrors quatern_to_mat44 from nifti1_io.c, except that the voxel size is
  * our cleaned spacing (|pixdim|, 0 -> 1) instead of "<= 0 -> 1". */
-static int qform_matrix(const nii_header *h, const double sp[3], double M[3][4])
+static int qform_matrix(const nii_header *h, const double sp[3], mat34 *Q)
 {
+    double (*M)[4] = Q->m;
     double b = h->quatern[0], c = h->quatern[1], d = h->quatern[2];
     double n2 = b * b + c * c + d * d;
     if (!isfinite(n2)) return 0;
@@ -499,25 +507,25 @@ static int qform_matrix(const nii_header *h, const double sp[3], double M[3][4])
     M[2][1] = 2.0 * (c * d + a * b) * yd;
     M[2][2] = (a * a + d * d - c * c - b * b) * zd;
     for (int r = 0; r < 3; r++) M[r][3] = h->qoffset[r];
-    return usable(M);
+    return usable(Q);
 }
 
 /* Picks sform, then qform, then diag(spacing), as the standard orders them.
  * Returns the affine_source code (2, 1, 0). */
 static uint32_t choose_affine(const nii_header *h, const double sp[3], double A[16])
 {
-    double M[3][4];
-    if (h->sform_code > 0 && usable(h->srow)) {
-        set_colmajor(A, h->srow);
+    mat34 M;
+    if (h->sform_code > 0 && usable(&h->srow)) {
+        set_colmajor(A, &h->srow);
         return 2;
     }
-    if (h->qform_code > 0 && qform_matrix(h, sp, M)) {
-        set_colmajor(A, M);
+    if (h->qform_code > 0 && qform_matrix(h, sp, &M)) {
+        set_colmajor(A, &M);
         return 1;
     }
-    memset(M, 0, sizeof M);
-    for (int a = 0; a < 3; a++) M[a][a] = sp[a];
-    set_colmajor(A, M);
+    memset(&M, 0, sizeof M);
+    for (int a = 0; a < 3; a++) M.m[a][a] = sp[a];
+    set_colmajor(A, &M);
     return 0;
 }
 
@@ -601,7 +609,7 @@ static void load_cleanup(nii_load *L)
 static int open_files(nii_load *L, nii_header *h, gzFile *data, const char **data_path, vxl_err *e)
 {
     L->hdr_path = header_path_for(L->path);
-    if (!L->hdr_path) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory");
+    if (!L->hdr_path) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", L->path);
     L->hdr_file = open_gz(L->hdr_path, e);
     if (!L->hdr_file) return VXL_ERR_IO;
     int rc = read_header(L->hdr_file, L->hdr_path, h, e);
@@ -623,7 +631,7 @@ static int open_files(nii_load *L, nii_header *h, gzFile *data, const char **dat
                         "'%s': header says the voxels are in a separate .img file, but the file "
                         "name does not end in .hdr", L->hdr_path);
     }
-    if (!L->img_path) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory");
+    if (!L->img_path) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", L->path);
     L->img_file = open_gz(L->img_path, e);
     if (!L->img_file) return VXL_ERR_IO;
     *data = L->img_file;

@@ -34,24 +34,23 @@ int vxl_volume_check_limits(const uint32_t dims[3], uint32_t bytes_per_voxel,
 {
     uint32_t max_dim = (opt && opt->max_dim) ? opt->max_dim : VXL_DEFAULT_MAX_DIM;
     uint64_t budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
-    for (int a = 0; a < 3; a++) {
+    for (int a = 0; a < 3; a++)
         if (dims[a] == 0)
             return vxl_fail(e, VXL_ERR_FORMAT, "bad dimensions %ux%ux%u: every axis needs at least 1 voxel",
                             dims[0], dims[1], dims[2]);
+    /* The budget comes first so an absurd header is refused naming it. Each
+     * dim is < 2^32, so the product of three needs overflow care. */
+    uint64_t n = (uint64_t)dims[0] * dims[1];
+    uint64_t bpv = bytes_per_voxel ? bytes_per_voxel : 1;
+    if (n > UINT64_MAX / dims[2] / bpv || n * dims[2] * bpv > budget)
+        return vxl_fail(e, VXL_ERR_LIMIT, "volume %ux%ux%u needs %.1f MiB, over the memory budget of %.1f MiB",
+                        dims[0], dims[1], dims[2], (double)dims[0] * dims[1] * dims[2] * bpv / 1048576.0,
+                        budget / 1048576.0);
+    uint64_t bytes = n * dims[2] * bpv;
+    for (int a = 0; a < 3; a++)
         if (dims[a] > max_dim)
             return vxl_fail(e, VXL_ERR_LIMIT, "dimensions %ux%ux%u exceed the per-axis limit of %u",
                             dims[0], dims[1], dims[2], max_dim);
-    }
-    /* dims <= 2^32 each, so the product of three needs overflow care. */
-    uint64_t n = (uint64_t)dims[0] * dims[1];
-    if (dims[2] && n > UINT64_MAX / dims[2] / (bytes_per_voxel ? bytes_per_voxel : 1))
-        return vxl_fail(e, VXL_ERR_LIMIT, "dimensions %ux%ux%u overflow the voxel count", dims[0],
-                        dims[1], dims[2]);
-    uint64_t bytes = n * dims[2] * bytes_per_voxel;
-    if (bytes > budget)
-        return vxl_fail(e, VXL_ERR_LIMIT,
-                        "volume %ux%ux%u needs %.1f MiB, over the memory budget of %.1f MiB",
-                        dims[0], dims[1], dims[2], bytes / 1048576.0, budget / 1048576.0);
     if (bytes > (uint64_t)SIZE_MAX)
         return vxl_fail(e, VXL_ERR_LIMIT, "volume too large for this address space");
     return VXL_OK;

@@ -1,0 +1,116 @@
+/* test_util.h - shared helpers for the C tests: analytic volumes, a renderer
+ * on the requested backend, image checks. */
+#ifndef VXL_TEST_UTIL_H
+#define VXL_TEST_UTIL_H
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "voxlight.h"
+
+typedef double (*field_fn)(double x, double y, double z, const double *prm);
+
+/* A float32 volume sampled from f at voxel centres (voxel-space coords). */
+static inline vxl_volume *make_volume_f32(uint32_t nx, uint32_t ny, uint32_t nz, field_fn f, const double *prm)
+{
+    float *d = malloc(sizeof(float) * nx * ny * nz);
+    if (!d) return NULL;
+    for (uint32_t k = 0; k < nz; k++)
+        for (uint32_t j = 0; j < ny; j++)
+            for (uint32_t i = 0; i < nx; i++) d[i + nx * (j + ny * k)] = (float)f(i, j, k, prm);
+    vxl_volume_desc desc;
+    memset(&desc, 0, sizeof desc);
+    desc.struct_size = sizeof desc;
+    desc.dtype = VXL_DTYPE_F32;
+    desc.dims[0] = nx;
+    desc.dims[1] = ny;
+    desc.dims[2] = nz;
+    desc.data = d;
+    vxl_volume *v = NULL;
+    vxl_volume_create(&desc, NULL, &v);
+    free(d);
+    return v;
+}
+
+/* prm: a, b, c, d of f = a x + b y + c z + d */
+static inline double field_ramp(double x, double y, double z, const double *p)
+{
+    return p[0] * x + p[1] * y + p[2] * z + p[3];
+}
+
+/* prm: cx, cy, cz, sigma: a smooth Gaussian blob, value in (0,1] */
+static inline double field_blob(double x, double y, double z, const double *p)
+{
+    double dx = x - p[0], dy = y - p[1], dz = z - p[2];
+    return exp(-(dx * dx + dy * dy + dz * dz) / (2 * p[3] * p[3]));
+}
+
+/* prm: cx, cy, cz, radius: 1 inside a ball, 0 outside, smoothed over ~1 voxel */
+static inline double field_ball(double x, double y, double z, const double *p)
+{
+    double r = sqrt((x - p[0]) * (x - p[0]) + (y - p[1]) * (y - p[1]) + (z - p[2]) * (z - p[2]));
+    return 1.0 / (1.0 + exp(2.0 * (r - p[3])));
+}
+
+static inline double angle_deg(const float *a, const double *b)
+{
+    double la = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+    double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    if (!(la > 0) || !(lb > 0)) return 180.0;
+    double c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
+    c = c > 1 ? 1 : c < -1 ? -1 : c;
+    return acos(c) * 180.0 / M_PI;
+}
+
+static inline vxl_renderer *make_renderer(uint32_t backend)
+{
+    vxl_renderer_options o;
+    memset(&o, 0, sizeof o);
+    o.struct_size = sizeof o;
+    o.backend = backend;
+    vxl_renderer *r = NULL;
+    return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
+}
+
+static inline vxl_render_params default_params(uint32_t w, uint32_t h)
+{
+    vxl_render_params p;
+    memset(&p, 0, sizeof p);
+    p.struct_size = sizeof p;
+    p.width = w;
+    p.height = h;
+    return p;
+}
+
+/* 1 if every pixel is finite, colour in [0,1], alpha >= each colour channel
+ * (premultiplied), depth finite or +inf and positive. */
+static inline int image_is_sane(const float *rgba, const float *depth, size_t npix)
+{
+    for (size_t i = 0; i < npix; i++) {
+        const float *p = rgba + 4 * i;
+        for (int c = 0; c < 4; c++)
+            if (!isfinite(p[c]) || p[c] < 0 || p[c] > 1) return 0;
+        for (int c = 0; c < 3; c++)
+            if (p[c] > p[3] + 1e-6f) return 0;
+        if (depth && (isnan(depth[i]) || depth[i] < 0 || (isinf(depth[i]) && depth[i] < 0))) return 0;
+    }
+    return 1;
+}
+
+static inline double image_rmse(const float *a, const float *b, size_t n)
+{
+    double s = 0;
+    for (size_t i = 0; i < n; i++) s += ((double)a[i] - b[i]) * ((double)a[i] - b[i]);
+    return sqrt(s / (double)n);
+}
+
+static inline double alpha_sum(const float *rgba, size_t npix)
+{
+    double s = 0;
+    for (size_t i = 0; i < npix; i++) s += rgba[4 * i + 3];
+    return s;
+}
+
+#endif

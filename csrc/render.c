@@ -134,6 +134,10 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
     if (rc) return rc;
     set_frame_uniforms(r, prog, f);
+    const GLuint zeros[4] = {0, 0, 0, 0};
+    gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[2]);
+    gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zeros, zeros, GL_DYNAMIC_READ);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, r->ssbo[2]);
     gl->BindFramebuffer(GL_FRAMEBUFFER, r->fbo);
     const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     gl->DrawBuffers(2, bufs);
@@ -150,7 +154,19 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     }
     gl->BindVertexArray(0);
     gl->UseProgram(0);
-    return vxl_gl_check(r, "rendering");
+    GLuint counts[4];
+    gl->MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    gl->GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof counts, counts);
+    int rc2 = vxl_gl_check(r, "rendering");
+    if (rc2) return rc2;
+    memset(&r->stats, 0, sizeof r->stats);
+    r->stats.struct_size = sizeof r->stats;
+    r->stats.sample_bound = (uint32_t)f->max_steps;
+    r->stats.samples = (uint64_t)counts[1] << 32 | counts[0];
+    r->stats.max_ray_samples = counts[2];
+    r->stats.rays = counts[3];
+    r->stats.effective_step = f->step;
+    return VXL_OK;
 }
 
 static int job_render(void *p)

@@ -44,7 +44,7 @@ static int job_open(void *p)
     r->gl.GetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &r->info.max_3d_texture_size);
     r->gl.GenVertexArrays(1, &r->vao);
     r->gl.GenFramebuffers(1, &r->fbo);
-    r->gl.GenBuffers(2, r->ssbo);
+    r->gl.GenBuffers(3, r->ssbo);
     r->gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
     r->gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
     return vxl_gl_check(r, "creating the renderer");
@@ -69,7 +69,7 @@ static int job_close(void *p)
         vxl_programs_delete(r);
         r->gl.DeleteFramebuffers(1, &r->fbo);
         r->gl.DeleteVertexArrays(1, &r->vao);
-        r->gl.DeleteBuffers(2, r->ssbo);
+        r->gl.DeleteBuffers(3, r->ssbo);
         r->gl.Finish();
     }
     vxl_context_close(&r->ctx);
@@ -112,6 +112,25 @@ void vxl_renderer_destroy(vxl_renderer *r)
     vxl_gl_thread_stop(&r->thread, job_close, r);
     free(r->shader_dir);
     free(r);
+}
+
+typedef struct stats_job {
+    vxl_renderer *r;
+    vxl_render_stats *out;
+} stats_job;
+
+static int job_stats(void *p)
+{
+    stats_job *j = p;
+    *j->out = j->r->stats;
+    return VXL_OK;
+}
+
+int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out)
+{
+    if (!r || !out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "renderer or stats is NULL");
+    stats_job j = {r, out};
+    return vxl_gl_thread_call(&r->thread, job_stats, &j);
 }
 
 const char *vxl_renderer_error(const vxl_renderer *r) { return r ? r->err.msg : ""; }

@@ -52,8 +52,9 @@ struct vxl_renderer {
 
     vxl_program_entry programs[VXL_MAX_PROGRAMS];
     int n_programs;
-    GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex, ssbo[2];
+    GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex, ssbo[3]; /* probe in/out, stats */
     uint32_t fb_w, fb_h;
+    vxl_render_stats stats;    /* of the last successful frame */
 };
 
 /* gl_util.c */

@@ -16,6 +16,9 @@ uniform float u_depth_threshold;
 uniform int u_has_scene_depth;
 uniform sampler2D u_scene_depth; // view-space planar distance, +inf = none
 
+// Work counters for vxl_renderer_get_stats: one atomic per ray, not per sample.
+layout(std430, binding = 2) buffer Stats { uint st_samples_lo; uint st_samples_hi; uint st_max_ray; uint st_rays; };
+
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;
 
@@ -77,7 +80,9 @@ void main()
 #ifdef REUSE_GRADIENTS
     GradientState gs = gradient_state_init();
 #endif
+    uint taken = 0u;
     for (int i = 0; i < u_max_steps && t < t1; i++, t += u_step) {
+        taken++;
         vec3 p = o + t * dir;
         float v = sample_value(p);
         vec4 c = classify(v);
@@ -96,6 +101,10 @@ void main()
         if (isinf(depth) && acc.a >= u_depth_threshold) depth = -(z0 + dz * t);
         if (acc.a >= u_early_termination) break;
     }
+    uint old = atomicAdd(st_samples_lo, taken);
+    if (old + taken < old) atomicAdd(st_samples_hi, 1u); // carry into the high word
+    atomicMax(st_max_ray, taken);
+    atomicAdd(st_rays, 1u);
     o_color = clamp(acc, 0.0, 1.0);
     o_depth = depth;
 }

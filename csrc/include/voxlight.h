@@ -222,6 +222,19 @@ VXL_API int vxl_renderer_set_volume(vxl_renderer *r, const vxl_volume *vol);
  * where it never does) or NULL. */
 VXL_API int vxl_render(vxl_renderer *r, const vxl_render_params *p, float *rgba, float *depth);
 
+/* What the last vxl_render did, counted on the GL side. */
+typedef struct vxl_render_stats {
+    uint32_t struct_size;
+    uint32_t sample_bound;      /* the hard bound on samples per ray in that frame */
+    uint64_t samples;           /* samples taken by all rays */
+    uint32_t max_ray_samples;   /* samples of the longest ray (<= sample_bound) */
+    uint32_t rays;              /* rays that entered the volume */
+    float effective_step;       /* step after clamping, voxels */
+    uint32_t reserved[3];
+} vxl_render_stats;
+
+VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);
+
 /* The camera vxl_render uses when has_camera is 0, for callers that want to
  * start from it. */
 VXL_API int vxl_default_camera(vxl_renderer *r, const vxl_render_params *p, float view[16],

@@ -201,8 +201,8 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown filter %u", p->filter);
     if (p->gradient_store > VXL_GRADIENT_STORE_32F)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown gradient_store %u", p->gradient_store);
-    if (p->classify != 0)
-        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "classify %u is not supported (0 = post)", p->classify);
+    if (p->classify >= VXL_CLASSIFY_COUNT)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown classify mode %u", p->classify);
     f->filter = p->filter;
     f->store = p->gradient_store;
     f->shading = !p->shading_off;

@@ -71,6 +71,10 @@ extern "C" {
 #define VXL_FILTER_PRECOMPUTED 5 /* blur + Sobel once per volume, stored */
 #define VXL_FILTER_COUNT 6
 
+/* ---- classification modes ---- */
+#define VXL_CLASSIFY_POST 0 /* interpolate the value, then look it up (default) */
+#define VXL_CLASSIFY_COUNT 1
+
 /* ---- transfer-function presets ---- */
 #define VXL_PRESET_AUTO 0 /* MRI or CT default, chosen from the data range */
 #define VXL_PRESET_GRAY 1
@@ -192,7 +196,7 @@ typedef struct vxl_render_params {
     uint32_t has_window;             /* 0: window = preset default / data range */
     float window_low, window_high;   /* in data units, mapped onto the TF */
     float opacity_scale;             /* 0 = 1 */
-    uint32_t classify;               /* 0 = post-classification (reserved for more) */
+    uint32_t classify;               /* VXL_CLASSIFY_* */
 
     /* shading */
     uint32_t shading_off;            /* 1: pure emission-absorption */

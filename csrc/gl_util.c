@@ -8,7 +8,8 @@
 
 static const char *const filter_defines[VXL_FILTER_COUNT] = {
     "#define FILTER_CENTRAL 1\n", "#define FILTER_FORWARD3 1\n", "#define FILTER_SOBEL8 1\n",
-    "#define FILTER_SOBEL14 1\n", "#define FILTER_SOBEL26 1\n", "#define FILTER_PRECOMPUTED 1\n"};
+    "#define FILTER_SOBEL14 1\n", "#define FILTER_SOBEL26 1\n", "#define FILTER_PRECOMPUTED 1\n",
+    "#define FILTER_CUBIC 1\n"};
 
 /* flags bits: 1 shading, 2 reuse gradients; for GRAD_STORE: the store format */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
@@ -89,6 +90,12 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     case VXL_PROG_GRAD_STORE:
         snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
         rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", defines, &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_BSPLINE_COPY:
+        rc = compile(r, GL_COMPUTE_SHADER, "bspline_prefilter.comp", "#define COPY_PASS 1\n", &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_BSPLINE_AXIS:
+        rc = compile(r, GL_COMPUTE_SHADER, "bspline_prefilter.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
     default:
         return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown program kind %u", kind);

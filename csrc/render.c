@@ -53,12 +53,18 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
         if (rc) return rc;
         gl->ActiveTexture(GL_TEXTURE1);
         gl->BindTexture(GL_TEXTURE_3D, r->gradient_tex);
+    } else if (filter == VXL_FILTER_CUBIC) {
+        int rc = vxl_bspline_ensure(r);
+        if (rc) return rc;
+        gl->ActiveTexture(GL_TEXTURE1);
+        gl->BindTexture(GL_TEXTURE_3D, r->bspline_tex);
     }
     gl->UseProgram(prog);
     gl->ActiveTexture(GL_TEXTURE0);
     gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
     vxl_uniform_i(r, prog, "u_volume", 0);
     vxl_uniform_i(r, prog, "u_gradient", 1);
+    vxl_uniform_i(r, prog, "u_bspline", 1);
     GLint loc = gl->GetUniformLocation(prog, "u_dims");
     float dims[3] = {(float)r->dims[0], (float)r->dims[1], (float)r->dims[2]};
     if (loc >= 0) gl->Uniform3fv(loc, 1, dims);

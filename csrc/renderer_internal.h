@@ -21,6 +21,8 @@
 #define VXL_PROG_GRAD_BLUR 2
 #define VXL_PROG_GRAD_MAX 3
 #define VXL_PROG_GRAD_STORE 4
+#define VXL_PROG_BSPLINE_COPY 5
+#define VXL_PROG_BSPLINE_AXIS 6
 
 typedef struct vxl_program_entry {
     uint32_t key;
@@ -50,6 +52,10 @@ struct vxl_renderer {
     int gradient_store;        /* VXL_GRADIENT_STORE_* of gradient_tex */
     uint64_t gradient_bytes;
 
+    /* Cubic B-spline coefficients: depend only on the volume data. */
+    GLuint bspline_tex;
+    uint64_t bspline_bytes;
+
     vxl_program_entry programs[VXL_MAX_PROGRAMS];
     int n_programs;
     GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex, ssbo[3]; /* probe in/out, stats */
@@ -68,6 +74,8 @@ void vxl_programs_delete(vxl_renderer *r);
 /* precompute.c */
 int vxl_gradients_ensure(vxl_renderer *r, int store);
 void vxl_gradients_release(vxl_renderer *r);
+int vxl_bspline_ensure(vxl_renderer *r);
+void vxl_bspline_release(vxl_renderer *r);
 
 /* render.c helpers shared with probe.c */
 int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store);

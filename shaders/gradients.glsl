@@ -1,6 +1,6 @@
 // gradients.glsl - the gradient filters, one chosen per program by a define:
 // FILTER_CENTRAL, FILTER_FORWARD3, FILTER_SOBEL8, FILTER_SOBEL14,
-// FILTER_SOBEL26, FILTER_PRECOMPUTED. Every filter returns the gradient in
+// FILTER_SOBEL26, FILTER_PRECOMPUTED, FILTER_CUBIC. Every filter returns the gradient in
 // voxel space (normalised value per voxel) and is exact on a linear ramp.
 #include "common.glsl"
 
@@ -8,6 +8,47 @@ uniform float u_sample_distance; // tap offset d, in voxels
 
 #ifdef FILTER_PRECOMPUTED
 uniform sampler3D u_gradient; // raw gradient / global max, interpolated then used
+#endif
+
+#ifdef FILTER_CUBIC
+uniform sampler3D u_bspline; // interpolating cubic B-spline coefficients, trilinear
+
+// Sigg & Hadwiger (GPU Gems 2, ch. 20): a cubic B-spline over 4 samples is
+// two linear fetches. For voxel coordinate x, the pair offsets (relative to
+// floor(x)) and weights of the B-spline (w) and of its derivative (dw).
+void bspline_pairs(float x, out vec2 h, out vec2 g, out vec2 dh, out vec2 dg)
+{
+    float a = x - floor(x), a2 = a * a, a3 = a2 * a, b = 1.0 - a;
+    float w0 = b * b * b / 6.0, w1 = (3.0 * a3 - 6.0 * a2 + 4.0) / 6.0;
+    float w2 = (-3.0 * a3 + 3.0 * a2 + 3.0 * a + 1.0) / 6.0, w3 = a3 / 6.0;
+    g = vec2(w0 + w1, w2 + w3);
+    h = vec2(-1.0 + w1 / g.x, 1.0 + w3 / g.y);
+    // derivative weights: w0', w1' <= 0 and w2', w3' >= 0 on [0,1), so each
+    // pair is a convex blend and one linear fetch still serves it
+    float d0 = -0.5 * b * b, d1 = 0.5 * (3.0 * a2 - 4.0 * a);
+    float d2 = 0.5 * (-3.0 * a2 + 2.0 * a + 1.0), d3 = 0.5 * a2;
+    dg = vec2(d0 + d1, d2 + d3);
+    dh = vec2(-1.0 + d1 / dg.x, 1.0 + d3 / dg.y);
+}
+
+float coeff(vec3 q) { return textureLod(u_bspline, voxel_to_tex(q), 0.0).r; }
+
+// One gradient component: derivative pairs along axis `a`, value pairs on
+// the other two; 8 trilinear fetches.
+float bspline_partial(vec3 base, vec2 h[3], vec2 g[3], vec2 dh[3], vec2 dg[3], int a)
+{
+    float s = 0.0;
+    for (int i = 0; i < 8; i++) {
+        ivec3 k = ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+        vec3 q, w;
+        for (int c = 0; c < 3; c++) {
+            q[c] = base[c] + (c == a ? dh[c][k[c]] : h[c][k[c]]);
+            w[c] = c == a ? dg[c][k[c]] : g[c][k[c]];
+        }
+        s += w.x * w.y * w.z * coeff(q);
+    }
+    return s;
+}
 #endif
 
 #define TAP(o) sample_value(p + (o))
@@ -58,6 +99,13 @@ vec3 gradient_at(vec3 p, float centre)
     return g / (32.0 * d);
 #elif defined(FILTER_PRECOMPUTED)
     return textureLod(u_gradient, voxel_to_tex(p), 0.0).xyz;
+#elif defined(FILTER_CUBIC)
+    // Analytic derivative of the interpolating cubic B-spline: 24 fetches.
+    vec3 base = floor(p);
+    vec2 h[3], g[3], dh[3], dg[3];
+    for (int c = 0; c < 3; c++) bspline_pairs(p[c], h[c], g[c], dh[c], dg[c]);
+    return vec3(bspline_partial(base, h, g, dh, dg, 0), bspline_partial(base, h, g, dh, dg, 1),
+                bspline_partial(base, h, g, dh, dg, 2));
 #else
 #error "no FILTER_* define"
 #endif

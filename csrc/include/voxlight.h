@@ -254,6 +254,40 @@ VXL_API int vxl_default_camera(vxl_renderer *r, const vxl_render_params *p, floa
 VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, const float *points,
                                 uint32_t n, float *out);
 
+/* ------------------------------------------------- ground truth (issue 4) */
+
+/* Analytic phantoms, generated at any resolution, each with an analytic
+ * gradient. The volume covers [-1,1]^3 in world units (affine maps voxel
+ * centres 0..n-1 onto -1..1), stored as float32. */
+#define VXL_PHANTOM_MARSCHNER_LOBB 1 /* fM = 6, alpha = 0.25; iso-surface at 0.5 */
+#define VXL_PHANTOM_SPHERE 2         /* ellipsoid distance field: 0.5 - signed distance */
+#define VXL_PHANTOM_RAMP 3           /* linear ramp along (1, 2, 3)/|.| */
+#define VXL_PHANTOM_NOISY_BLOB 4     /* smooth Gaussian blob plus Gaussian noise */
+#define VXL_PHANTOM_COUNT 5
+
+typedef struct vxl_phantom_desc {
+    uint32_t struct_size;
+    uint32_t kind;         /* VXL_PHANTOM_* */
+    uint32_t dims[3];      /* 0 = 64 */
+    uint32_t seed;         /* noise seed (NOISY_BLOB) */
+    double noise_sigma;    /* NOISY_BLOB: standard deviation; 0 = 0.05 */
+} vxl_phantom_desc;
+
+VXL_API int vxl_phantom_create(const vxl_phantom_desc *d, vxl_volume **out);
+/* The noise-free analytic field and its gradient at a voxel-space point
+ * (gradient per voxel of the given grid). For NOISY_BLOB this is the blob
+ * without noise: the signal a filter should recover. */
+VXL_API int vxl_phantom_eval(const vxl_phantom_desc *d, const double p[3], double *value, double grad[3]);
+VXL_API const char *vxl_phantom_name(uint32_t kind);
+
+/* The ground-truth image of a phantom: a CPU renderer in double precision
+ * with the shaders' camera, transfer function, shading and compositing
+ * equations, sampling the analytic field and gradient at a step of at most
+ * 1/16 voxel, with no jitter. vol must be vxl_phantom_create(d)'s volume (it
+ * fixes the value normalisation). Slow: meant for small images. */
+VXL_API int vxl_reference_render(const vxl_phantom_desc *d, const vxl_volume *vol, const vxl_render_params *p,
+                                 float *rgba, float *depth);
+
 /* ------------------------------------------------------------------ misc */
 
 VXL_API uint32_t vxl_abi_version(void);

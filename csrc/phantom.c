@@ -121,3 +121,26 @@ int vxl_phantom_create(const vxl_phantom_desc *d, vxl_volume **out)
     free(data);
     return rc;
 }
+
+int vxl_phantom_iso_points(const vxl_phantom_desc *d, double iso, double tol, uint32_t seed, float *pts, uint32_t max,
+                           uint32_t *n)
+{
+    uint32_t dims[3];
+    int rc = resolve(d, dims, NULL);
+    if (rc) return rc;
+    if (!pts || !n || !(tol > 0)) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "points, count or tol is invalid");
+    uint64_t s = seed * 6364136223846793005ull + 1;
+    *n = 0;
+    /* bounded rejection sampling: 1000 tries per point wanted */
+    for (uint64_t tries = 0; tries < (uint64_t)max * 1000 && *n < max; tries++) {
+        double u[3], g[3];
+        for (int k = 0; k < 3; k++) {
+            s = s * 6364136223846793005ull + 1442695040888963407ull;
+            u[k] = -0.9 + 1.8 * ((s >> 11) / 9007199254740992.0);
+        }
+        if (fabs(field(d->kind, u, g) - iso) > tol) continue;
+        for (int k = 0; k < 3; k++) pts[3 * *n + k] = (float)((u[k] + 1) * (dims[k] - 1) / 2);
+        (*n)++;
+    }
+    return VXL_OK;
+}

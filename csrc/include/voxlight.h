@@ -279,6 +279,11 @@ VXL_API int vxl_phantom_create(const vxl_phantom_desc *d, vxl_volume **out);
  * without noise: the signal a filter should recover. */
 VXL_API int vxl_phantom_eval(const vxl_phantom_desc *d, const double p[3], double *value, double grad[3]);
 VXL_API const char *vxl_phantom_name(uint32_t kind);
+/* Up to max voxel-space points (max*3 floats) where the noise-free field is
+ * within tol of iso, drawn uniformly from the central 90% of the box with a
+ * fixed seed; *n receives the count found. */
+VXL_API int vxl_phantom_iso_points(const vxl_phantom_desc *d, double iso, double tol, uint32_t seed, float *pts,
+                                   uint32_t max, uint32_t *n);
 
 /* The ground-truth image of a phantom: a CPU renderer in double precision
  * with the shaders' camera, transfer function, shading and compositing

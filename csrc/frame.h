@@ -31,6 +31,7 @@ typedef struct vxl_frame {
     int light_count;
     float light_pos[VXL_MAX_LIGHTS][4], light_color[VXL_MAX_LIGHTS][3];
     float early_termination, depth_threshold;
+    int skip;                   /* empty-space skipping and the screen-space bound */
     const float *scene_depth;
     float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
     float *tf_copy;             /* owned when the caller gave a table */

@@ -18,6 +18,8 @@
     X(PFNGLCLEARBUFFERFVPROC, ClearBufferfv)                                  \
     X(PFNGLPIXELSTOREIPROC, PixelStorei)                                      \
     X(PFNGLREADPIXELSPROC, ReadPixels)                                        \
+    X(PFNGLGETTEXIMAGEPROC, GetTexImage)                                      \
+    X(PFNGLSCISSORPROC, Scissor)                                              \
     X(PFNGLREADBUFFERPROC, ReadBuffer)                                        \
     X(PFNGLDRAWBUFFERSPROC, DrawBuffers)                                      \
     X(PFNGLDRAWARRAYSPROC, DrawArrays)                                        \

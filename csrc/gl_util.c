@@ -97,6 +97,9 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     case VXL_PROG_BSPLINE_AXIS:
         rc = compile(r, GL_COMPUTE_SHADER, "bspline_prefilter.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_BRICK_MINMAX:
+        rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", NULL, &a);
+        return rc ? rc : link(r, a, 0, out);
     default:
         return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown program kind %u", kind);
     }
@@ -141,9 +144,12 @@ void vxl_uniform_f(vxl_renderer *r, GLuint prog, const char *name, float v)
     if (loc >= 0) r->gl.Uniform1f(loc, v);
 }
 
+/* Created on a scratch unit, so making a texture never disturbs what a
+ * program has bound on its sampler units (0-4). Leaves unit 7 active. */
 GLuint vxl_texture_new(vxl_renderer *r, GLenum target, GLint filter)
 {
     GLuint t = 0;
+    r->gl.ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
     r->gl.GenTextures(1, &t);
     r->gl.BindTexture(target, t);
     r->gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);

@@ -10,7 +10,43 @@
 #define ML_FM 6.0
 #define ML_ALPHA 0.25
 
-static const char *const names[VXL_PHANTOM_COUNT] = {NULL, "marschner-lobb", "sphere", "ramp", "noisy-blob"};
+static const char *const names[VXL_PHANTOM_COUNT] = {NULL,         "marschner-lobb", "sphere",      "ramp",
+                                                     "noisy-blob", "sparse-balls",   "dense-balls"};
+
+#define LATTICE 8
+#define BALL_SIGMA 0.06
+
+/* Whether lattice site (i,j,k) holds a ball: every site for the dense twin,
+ * a fixed hash-chosen 5% for the sparse one. */
+static int site_active(uint32_t kind, int i, int j, int k)
+{
+    if (kind == VXL_PHANTOM_DENSE_BALLS) return 1;
+    uint32_t h = (uint32_t)(i * 73856093) ^ (uint32_t)(j * 19349663) ^ (uint32_t)(k * 83492791);
+    h = (h ^ (h >> 13)) * 0x5bd1e995u;
+    return (h ^ (h >> 15)) % 100 < 5;
+}
+
+/* Sum of the Gaussian balls near u (each reaches ~4 sigma < 1 site). */
+static double balls(uint32_t kind, const double u[3], double g[3])
+{
+    double cell = 2.0 / LATTICE, v = 0;
+    int c[3];
+    g[0] = g[1] = g[2] = 0;
+    for (int a = 0; a < 3; a++) c[a] = (int)floor((u[a] + 1) / cell);
+    for (int k = c[2] - 1; k <= c[2] + 1; k++)
+        for (int j = c[1] - 1; j <= c[1] + 1; j++)
+            for (int i = c[0] - 1; i <= c[0] + 1; i++) {
+                if (i < 0 || j < 0 || k < 0 || i >= LATTICE || j >= LATTICE || k >= LATTICE) continue;
+                if (!site_active(kind, i, j, k)) continue;
+                double d[3] = {u[0] - (-1 + (i + 0.5) * cell), u[1] - (-1 + (j + 0.5) * cell), u[2] - (-1 + (k + 0.5) * cell)};
+                double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                if (r2 > 16 * BALL_SIGMA * BALL_SIGMA) continue;
+                double e = exp(-r2 / (2 * BALL_SIGMA * BALL_SIGMA));
+                v += e;
+                for (int a = 0; a < 3; a++) g[a] -= d[a] / (BALL_SIGMA * BALL_SIGMA) * e;
+            }
+    return v;
+}
 
 const char *vxl_phantom_name(uint32_t kind) { return kind < VXL_PHANTOM_COUNT ? names[kind] : NULL; }
 
@@ -55,6 +91,9 @@ static double field(uint32_t kind, const double u[3], double g[3])
         for (int a = 0; a < 3; a++) g[a] = 0.25 * dir[a];
         return 0.5 + 0.25 * (dir[0] * x + dir[1] * y + dir[2] * z);
     }
+    case VXL_PHANTOM_SPARSE_BALLS:
+    case VXL_PHANTOM_DENSE_BALLS:
+        return balls(kind, u, g);
     default: { /* NOISY_BLOB: Gaussian blob, sigma 0.4 */
         double r2 = x * x + y * y + z * z, s2 = 0.16, v = exp(-r2 / (2 * s2));
         g[0] = -x / s2 * v;

@@ -72,6 +72,7 @@ int vxl_gradients_ensure(vxl_renderer *r, int store)
     gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)store_internal[store], (GLsizei)r->dims[0], (GLsizei)r->dims[1],
                    (GLsizei)r->dims[2], 0, GL_RGBA, GL_FLOAT, NULL);
     gl->UseProgram(store_prog);
+    gl->ActiveTexture(GL_TEXTURE0);
     gl->BindTexture(GL_TEXTURE_3D, blur);
     vxl_uniform_i(r, store_prog, "u_src", 0);
     vxl_uniform_f(r, store_prog, "u_inv_max", max_mag.f > 0 ? 1.0f / max_mag.f : 0.0f);

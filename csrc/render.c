@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "frame.h"
+#include "mat4.h"
 #include "renderer_internal.h"
 
 static void geom_of(const vxl_renderer *r, vxl_volume_geom *g)
@@ -118,6 +119,38 @@ static void set_frame_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame *f)
 #undef LOC
 }
 
+/* The pixel rectangle covering the projected volume box, so rays that miss
+ * it are never started. Whole viewport when a corner is behind the eye. */
+static void screen_bounds(const vxl_renderer *r, const vxl_frame *f, GLint rect[4])
+{
+    double mv[16], mvp[16];
+    vxl_mat4_mul(mv, f->view, f->model);
+    vxl_mat4_mul(mvp, f->proj, mv);
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    rect[0] = rect[1] = 0;
+    rect[2] = (GLint)f->width;
+    rect[3] = (GLint)f->height;
+    for (int c = 0; c < 8; c++) {
+        double v[4] = {(c & 1) ? r->dims[0] - 0.5 : -0.5, (c & 2) ? r->dims[1] - 0.5 : -0.5,
+                       (c & 4) ? r->dims[2] - 0.5 : -0.5, 1}, clip[4];
+        vxl_mat4_transform(mvp, v, clip);
+        if (!(clip[3] > 1e-12)) return;
+        for (int a = 0; a < 2; a++) {
+            double ndc = clip[a] / clip[3];
+            lo[a] = ndc < lo[a] ? ndc : lo[a];
+            hi[a] = ndc > hi[a] ? ndc : hi[a];
+        }
+    }
+    const double size[2] = {f->width, f->height};
+    for (int a = 0; a < 2; a++) {
+        double p0 = floor((lo[a] * 0.5 + 0.5) * size[a]) - 1, p1 = ceil((hi[a] * 0.5 + 0.5) * size[a]) + 1;
+        p0 = p0 < 0 ? 0 : p0 > size[a] ? size[a] : p0;
+        p1 = p1 < 0 ? 0 : p1 > size[a] ? size[a] : p1;
+        rect[a] = (GLint)p0;
+        rect[2 + a] = (GLint)(p1 - p0);
+    }
+}
+
 typedef struct render_job {
     vxl_renderer *r;
     const vxl_render_params *p;
@@ -137,9 +170,13 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     gl->GetError();
     upload_tf(r, f);
     if (f->scene_depth) upload_scene_depth(r, f);
+    if (f->skip && (rc = vxl_skipping_prepare(r, f))) return rc;
     rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
     if (rc) return rc;
     set_frame_uniforms(r, prog, f);
+    vxl_uniform_i(r, prog, "u_skip", f->skip);
+    vxl_uniform_i(r, prog, "u_brick_size", (int)(r->bricks.size ? r->bricks.size : VXL_DEFAULT_BRICK));
+    vxl_uniform_i(r, prog, "u_brick_distance", 4);
     const GLuint zeros[4] = {0, 0, 0, 0};
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[2]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zeros, zeros, GL_DYNAMIC_READ);
@@ -150,8 +187,17 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     gl->Viewport(0, 0, (GLsizei)f->width, (GLsizei)f->height);
     gl->Disable(GL_DEPTH_TEST);
     gl->Disable(GL_BLEND);
+    gl->Disable(GL_SCISSOR_TEST);
+    const float clear_color[4] = {0, 0, 0, 0}, clear_depth[4] = {INFINITY, 0, 0, 0};
+    gl->ClearBufferfv(GL_COLOR, 0, clear_color);
+    gl->ClearBufferfv(GL_COLOR, 1, clear_depth);
+    GLint rect[4] = {0, 0, (GLint)f->width, (GLint)f->height};
+    if (f->skip) screen_bounds(r, f, rect);
+    gl->Enable(GL_SCISSOR_TEST);
+    gl->Scissor(rect[0], rect[1], rect[2], rect[3]);
     gl->BindVertexArray(r->vao);
     gl->DrawArrays(GL_TRIANGLES, 0, 3);
+    gl->Disable(GL_SCISSOR_TEST);
     gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl->ReadPixels(0, 0, (GLsizei)f->width, (GLsizei)f->height, GL_RGBA, GL_FLOAT, rgba);
     if (depth) {
@@ -172,6 +218,11 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     r->stats.max_ray_samples = counts[2];
     r->stats.rays = counts[3];
     r->stats.effective_step = f->step;
+    if (f->skip) {
+        r->stats.bricks_total = r->bricks.dims[0] * r->bricks.dims[1] * r->bricks.dims[2];
+        r->stats.bricks_occupied = r->bricks.occupied;
+        r->stats.brick_size = r->bricks.size;
+    }
     return VXL_OK;
 }
 

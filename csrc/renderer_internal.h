@@ -5,15 +5,18 @@
 
 #include <stdint.h>
 
+#include "bricks.h"
 #include "context.h"
 #include "error.h"
 #include "gl_funcs.h"
 #include "gl_thread.h"
+#include "frame.h"
 #include "voxlight.h"
 
 #define VXL_MAX_PROGRAMS 96
 #define VXL_MAX_SAMPLES_PER_RAY 16384 /* bounds every ray, whatever the step */
 #define VXL_MAX_IMAGE_SIDE 16384
+#define VXL_SCRATCH_UNIT 7 /* texture unit used only to create and fill textures */
 
 /* Program kinds in the cache key. */
 #define VXL_PROG_RAYCAST 0
@@ -23,6 +26,7 @@
 #define VXL_PROG_GRAD_STORE 4
 #define VXL_PROG_BSPLINE_COPY 5
 #define VXL_PROG_BSPLINE_AXIS 6
+#define VXL_PROG_BRICK_MINMAX 7
 
 typedef struct vxl_program_entry {
     uint32_t key;
@@ -56,6 +60,11 @@ struct vxl_renderer {
     GLuint bspline_tex;
     uint64_t bspline_bytes;
 
+    /* Empty-space skipping: min-max per brick (data only) and the distance
+     * map texture (re-derived when the classification changes). */
+    vxl_bricks bricks;
+    GLuint brick_tex;
+
     vxl_program_entry programs[VXL_MAX_PROGRAMS];
     int n_programs;
     GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex, ssbo[3]; /* probe in/out, stats */
@@ -76,6 +85,10 @@ int vxl_gradients_ensure(vxl_renderer *r, int store);
 void vxl_gradients_release(vxl_renderer *r);
 int vxl_bspline_ensure(vxl_renderer *r);
 void vxl_bspline_release(vxl_renderer *r);
+
+/* skipping.c */
+int vxl_skipping_prepare(vxl_renderer *r, const vxl_frame *f);
+void vxl_skipping_release(vxl_renderer *r);
 
 /* render.c helpers shared with probe.c */
 int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store);

@@ -15,6 +15,9 @@ uniform float u_early_termination;
 uniform float u_depth_threshold;
 uniform int u_has_scene_depth;
 uniform sampler2D u_scene_depth; // view-space planar distance, +inf = none
+uniform int u_skip;               // empty-space skipping on
+uniform int u_brick_size;         // voxels per brick edge
+uniform usampler3D u_brick_distance; // 0 occupied; k: bricks within k-1 are empty
 
 // Work counters for vxl_renderer_get_stats: one atomic per ray, not per sample.
 layout(std430, binding = 2) buffer Stats { uint st_samples_lo; uint st_samples_hi; uint st_max_ray; uint st_rays; };
@@ -74,16 +77,38 @@ void main()
 
     vec3 view_dir = -normalize(mat3(u_mv) * dir);
     float jitter = u_jitter != 0 ? jitter_hash(uvec2(gl_FragCoord.xy), u_jitter_seed) : 0.0;
-    float t = t0 + jitter * u_step;
+    // Sample positions are t_start + i * step for integer i, whether or not
+    // empty space is skipped, so skipping changes no sample that counts.
+    float t_start = t0 + jitter * u_step;
     vec4 acc = vec4(0.0);
     float depth = uintBitsToFloat(0x7f800000u);
 #ifdef REUSE_GRADIENTS
     GradientState gs = gradient_state_init();
 #endif
     uint taken = 0u;
-    for (int i = 0; i < u_max_steps && t < t1; i++, t += u_step) {
-        taken++;
+    for (int i = 0; i < u_max_steps; i++) {
+        float t = t_start + float(i) * u_step;
+        if (t >= t1) break;
         vec3 p = o + t * dir;
+        if (u_skip != 0) {
+            ivec3 b = ivec3(floor((p + 0.5) / float(u_brick_size)));
+            uint k = texelFetch(u_brick_distance, clamp(b, ivec3(0), textureSize(u_brick_distance, 0) - 1), 0).r;
+            if (k > 0u) {
+                // Leap to where the ray leaves the cube of 2k-1 empty bricks
+                // around this one (Chebyshev distance map).
+                vec3 lo = vec3(b - ivec3(k - 1u)) * float(u_brick_size) - 0.5;
+                vec3 hi = vec3(b + ivec3(k)) * float(u_brick_size) - 0.5;
+                vec3 tb = vec3(1e30);
+                for (int a = 0; a < 3; a++)
+                    if (abs(dir[a]) >= 1e-12) tb[a] = ((dir[a] > 0.0 ? hi[a] : lo[a]) - o[a]) / dir[a];
+                float t_exit = min(tb.x, min(tb.y, tb.z));
+                // the sample at the exit is evaluated (minus a hair for rounding)
+                int next = int(min(ceil((t_exit - t_start) / u_step - 1e-3), float(u_max_steps)));
+                i = max(i, next - 1); // the loop's i++ lands on `next`
+                continue;
+            }
+        }
+        taken++;
         float v = sample_value(p);
         vec4 c = classify(v);
         if (c.a <= 0.0) continue;

@@ -235,7 +235,9 @@ typedef struct vxl_render_stats {
     uint32_t max_ray_samples;   /* samples of the longest ray (<= sample_bound) */
     uint32_t rays;              /* rays that entered the volume */
     float effective_step;       /* step after clamping, voxels */
-    uint32_t reserved[3];
+    uint32_t bricks_total;      /* bricks of the skipping grid (0 when skipping is off) */
+    uint32_t bricks_occupied;   /* bricks that can be visible under the classification */
+    uint32_t brick_size;        /* voxels per brick edge */
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);
@@ -263,7 +265,9 @@ VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, con
 #define VXL_PHANTOM_SPHERE 2         /* ellipsoid distance field: 0.5 - signed distance */
 #define VXL_PHANTOM_RAMP 3           /* linear ramp along (1, 2, 3)/|.| */
 #define VXL_PHANTOM_NOISY_BLOB 4     /* smooth Gaussian blob plus Gaussian noise */
-#define VXL_PHANTOM_COUNT 5
+#define VXL_PHANTOM_SPARSE_BALLS 5   /* Gaussian balls on 5% of an 8^3 lattice (empty-space skipping) */
+#define VXL_PHANTOM_DENSE_BALLS 6    /* its dense twin: a ball on every lattice site */
+#define VXL_PHANTOM_COUNT 7
 
 typedef struct vxl_phantom_desc {
     uint32_t struct_size;

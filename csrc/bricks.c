@@ -1,0 +1,108 @@
+/* bricks.c - occupancy of bricks under a classification, and the Chebyshev
+ * distance map that lets rays leap over runs of empty bricks. CPU-side: the
+ * grid is small (ch2better at 8^3 bricks: 38x47x40 = 71k entries). */
+#include "bricks.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *c = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ c[i]) * 1099511628211ull;
+    return h;
+}
+
+static uint64_t classification_key(const vxl_frame *f)
+{
+    uint64_t h = 1469598103934665603ull;
+    h = fnv(h, f->tf, (size_t)f->tf_size * 4 * sizeof(float));
+    h = fnv(h, &f->tf_size, sizeof f->tf_size);
+    h = fnv(h, &f->window_offset, sizeof f->window_offset);
+    h = fnv(h, &f->window_scale, sizeof f->window_scale);
+    h = fnv(h, &f->opacity_scale, sizeof f->opacity_scale);
+    return h;
+}
+
+/* Table index a normalised value maps to (as classify.glsl computes it). */
+static double table_pos(const vxl_frame *f, double v)
+{
+    double x = (v - f->window_offset) * f->window_scale;
+    x = x < 0 ? 0 : x > 1 ? 1 : x;
+    return x * (f->tf_size - 1);
+}
+
+/* 1-D exact L-infinity distance along one axis of a grid (in place on d):
+ * d[i] = min_j max(|i - j|, d[j]), computed by brute force per line, which
+ * at these grid sizes (<= 2048 / brick) is cheap and obviously right. */
+static void chebyshev_axis(uint8_t *d, const uint32_t dims[3], int axis, uint8_t *line, uint8_t *out)
+{
+    uint32_t n = dims[axis];
+    uint32_t stride = axis == 0 ? 1 : axis == 1 ? dims[0] : dims[0] * dims[1];
+    uint32_t ou = axis == 0 ? dims[1] : dims[0], ov = axis == 2 ? dims[1] : dims[2];
+    for (uint32_t v = 0; v < ov; v++)
+        for (uint32_t u = 0; u < ou; u++) {
+            size_t base = axis == 0 ? (size_t)dims[0] * (u + (size_t)dims[1] * v)
+                        : axis == 1 ? u + (size_t)dims[0] * dims[1] * v
+                                    : u + (size_t)dims[0] * v;
+            for (uint32_t i = 0; i < n; i++) line[i] = d[base + (size_t)i * stride];
+            for (uint32_t i = 0; i < n; i++) {
+                uint32_t best = line[i];
+                for (uint32_t j = 0; j < n && best > 0; j++) {
+                    uint32_t dist = i > j ? i - j : j - i;
+                    if (dist >= best) { if (j > i) break; else continue; }
+                    uint32_t c = dist > line[j] ? dist : line[j];
+                    if (c < best) best = c;
+                }
+                out[i] = (uint8_t)best;
+            }
+            for (uint32_t i = 0; i < n; i++) d[base + (size_t)i * stride] = out[i];
+        }
+}
+
+int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
+{
+    uint64_t key = classification_key(f);
+    if (b->distance && b->tf_key == key) return 0;
+    size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
+    if (!b->distance && !(b->distance = malloc(n))) return -1;
+    /* prefix count of table entries with non-zero opacity */
+    uint32_t *nonzero = malloc(((size_t)f->tf_size + 1) * sizeof *nonzero);
+    uint32_t maxdim = b->dims[0] > b->dims[1] ? b->dims[0] : b->dims[1];
+    maxdim = maxdim > b->dims[2] ? maxdim : b->dims[2];
+    uint8_t *scratch = malloc(2 * (size_t)maxdim);
+    if (!nonzero || !scratch) {
+        free(nonzero);
+        free(scratch);
+        return -1;
+    }
+    nonzero[0] = 0;
+    for (uint32_t i = 0; i < f->tf_size; i++) nonzero[i + 1] = nonzero[i] + (f->tf[4 * i + 3] * f->opacity_scale > 0);
+    uint32_t occupied = 0;
+    for (size_t i = 0; i < n; i++) {
+        double u0 = table_pos(f, b->minmax[2 * i]), u1 = table_pos(f, b->minmax[2 * i + 1]);
+        if (u0 > u1) { double t = u0; u0 = u1; u1 = t; }
+        /* linear filtering reads floor(u)..floor(u)+1; widen by one entry
+         * each way so float rounding in the shader can never escape */
+        long lo = (long)floor(u0) - 1, hi = (long)floor(u1) + 2;
+        if (lo < 0) lo = 0;
+        if (hi > (long)f->tf_size - 1) hi = (long)f->tf_size - 1;
+        int occ = nonzero[hi + 1] - nonzero[lo] > 0;
+        b->distance[i] = occ ? 0 : 255;
+        occupied += (uint32_t)occ;
+    }
+    for (int axis = 0; axis < 3; axis++) chebyshev_axis(b->distance, b->dims, axis, scratch, scratch + maxdim);
+    free(nonzero);
+    free(scratch);
+    b->tf_key = key;
+    b->occupied = occupied;
+    return 1;
+}
+
+void vxl_bricks_free(vxl_bricks *b)
+{
+    free(b->minmax);
+    free(b->distance);
+    memset(b, 0, sizeof *b);
+}

@@ -1,0 +1,77 @@
+/* skipping.c - the GL side of empty-space skipping: builds the brick min-max
+ * grid once per volume, uploads the distance map when the classification
+ * changes. VOXLIGHT_BRICK_SIZE (4..64) overrides the brick edge for
+ * measurements; the default is justified in docs/skipping.md. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "renderer_internal.h"
+
+static uint32_t brick_size(void)
+{
+    const char *env = getenv("VOXLIGHT_BRICK_SIZE");
+    long v = env ? strtol(env, NULL, 10) : 0;
+    return v >= 4 && v <= 64 ? (uint32_t)v : VXL_DEFAULT_BRICK;
+}
+
+void vxl_skipping_release(vxl_renderer *r)
+{
+    if (r->brick_tex) r->gl.DeleteTextures(1, &r->brick_tex);
+    r->brick_tex = 0;
+    vxl_bricks_free(&r->bricks);
+}
+
+static int build_minmax(vxl_renderer *r)
+{
+    vxl_gl *gl = &r->gl;
+    vxl_bricks *b = &r->bricks;
+    b->size = brick_size();
+    for (int a = 0; a < 3; a++) b->dims[a] = (r->dims[a] + b->size - 1) / b->size;
+    size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
+    b->minmax = malloc(n * 2 * sizeof(float));
+    if (!b->minmax) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the brick grid");
+    GLuint prog;
+    int rc = vxl_program_get(r, VXL_PROG_BRICK_MINMAX, 0, 0, &prog);
+    if (rc) return rc;
+    gl->GetError();
+    GLuint tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
+    gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RG32F, (GLsizei)b->dims[0], (GLsizei)b->dims[1], (GLsizei)b->dims[2], 0, GL_RG,
+                   GL_FLOAT, NULL);
+    gl->UseProgram(prog);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
+    vxl_uniform_i(r, prog, "u_volume", 0);
+    vxl_uniform_i(r, prog, "u_brick", (int)b->size);
+    gl->BindImageTexture(0, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RG32F);
+    gl->DispatchCompute((b->dims[0] + 3) / 4, (b->dims[1] + 3) / 4, (b->dims[2] + 3) / 4);
+    gl->MemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    gl->BindTexture(GL_TEXTURE_3D, tex);
+    gl->GetTexImage(GL_TEXTURE_3D, 0, GL_RG, GL_FLOAT, b->minmax);
+    gl->DeleteTextures(1, &tex);
+    gl->UseProgram(0);
+    return vxl_gl_check(r, "building the brick min-max grid");
+}
+
+int vxl_skipping_prepare(vxl_renderer *r, const vxl_frame *f)
+{
+    vxl_gl *gl = &r->gl;
+    if (!r->bricks.minmax) {
+        int rc = build_minmax(r);
+        if (rc) {
+            vxl_skipping_release(r);
+            return rc;
+        }
+    }
+    int changed = vxl_bricks_classify(&r->bricks, f);
+    if (changed < 0) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the brick occupancy");
+    if (!r->brick_tex) {
+        r->brick_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
+        changed = 1;
+    }
+    gl->ActiveTexture(GL_TEXTURE4);
+    gl->BindTexture(GL_TEXTURE_3D, r->brick_tex);
+    if (changed)
+        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, (GLsizei)r->bricks.dims[0], (GLsizei)r->bricks.dims[1],
+                       (GLsizei)r->bricks.dims[2], 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, r->bricks.distance);
+    return VXL_OK;
+}

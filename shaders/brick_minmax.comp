@@ -1,0 +1,24 @@
+// brick_minmax.comp - min and max of the normalised value per brick of
+// BRICK^3 voxels, over the brick plus a one-voxel apron: every voxel that a
+// trilinear sample inside the brick's box can touch. Computed once per volume.
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+uniform sampler3D u_volume;
+uniform int u_brick;
+layout(rg32f, binding = 0) writeonly uniform image3D u_minmax;
+
+void main()
+{
+    ivec3 b = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(b, imageSize(u_minmax)))) return;
+    ivec3 size = textureSize(u_volume, 0);
+    ivec3 lo = max(b * u_brick - 1, ivec3(0)), hi = min(b * u_brick + u_brick, size - 1);
+    float mn = 1e30, mx = -1e30;
+    for (int z = lo.z; z <= hi.z; z++)
+        for (int y = lo.y; y <= hi.y; y++)
+            for (int x = lo.x; x <= hi.x; x++) {
+                float v = texelFetch(u_volume, ivec3(x, y, z), 0).r;
+                mn = min(mn, v);
+                mx = max(mx, v);
+            }
+    imageStore(u_minmax, b, vec4(mn, mx, 0.0, 0.0));
+}

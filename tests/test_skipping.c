@@ -1,0 +1,76 @@
+/* test_skipping.c - skipping what a scene doesn't need must not change the
+ * image: every phantom and filter rendered with all in-frame skips on
+ * (bricks, screen bound, early termination) against all of them off.
+ * Brick leaping and the screen bound are exact by construction; early
+ * termination drops at most 1 - threshold of each pixel, so the test runs it
+ * at 0.999 (<= 1e-3 per channel, >= 60 dB) and checks the default 0.99
+ * against its own bound. */
+#include <stdio.h>
+
+#include "harness.h"
+#include "test_util.h"
+
+static vxl_renderer *R;
+
+#define W 64
+#define H 64
+
+static double psnr(const float *a, const float *b, size_t n)
+{
+    double r = image_rmse(a, b, n);
+    return r > 0 ? 20 * log10(1.0 / r) : 200;
+}
+
+TEST(skipping_never_changes_the_image)
+{
+    static float on[W * H * 4], off[W * H * 4];
+    const uint32_t kinds[5] = {VXL_PHANTOM_MARSCHNER_LOBB, VXL_PHANTOM_SPHERE, VXL_PHANTOM_NOISY_BLOB,
+                               VXL_PHANTOM_SPARSE_BALLS, VXL_PHANTOM_DENSE_BALLS};
+    for (int k = 0; k < 5; k++) {
+        vxl_phantom_desc pd = {.struct_size = sizeof pd, .kind = kinds[k], .dims = {48, 48, 48}, .seed = 3};
+        vxl_volume *v = NULL;
+        REQUIRE(vxl_phantom_create(&pd, &v) == VXL_OK);
+        REQUIRE(vxl_renderer_set_volume(R, v) == VXL_OK);
+        vxl_volume_destroy(v);
+        for (uint32_t f = 0; f < VXL_FILTER_COUNT; f++) {
+            vxl_render_params p = default_params(W, H);
+            p.preset = VXL_PRESET_BONE;
+            p.has_window = 1;
+            p.window_low = 0.35f;
+            p.window_high = 0.75f;
+            p.azimuth_deg = 20;
+            p.elevation_deg = 25;
+            p.filter = f;
+            static float dflt[W * H * 4];
+            REQUIRE(vxl_render(R, &p, dflt, NULL) == VXL_OK); /* default threshold 0.99 */
+            p.early_termination = 0.999f;
+            REQUIRE(vxl_render(R, &p, on, NULL) == VXL_OK);
+            vxl_render_stats s_on = {.struct_size = sizeof s_on}, s_off = s_on;
+            vxl_renderer_get_stats(R, &s_on);
+            p.no_skip = 1;
+            REQUIRE(vxl_render(R, &p, off, NULL) == VXL_OK);
+            vxl_renderer_get_stats(R, &s_off);
+            double q = psnr(on, off, W * H * 4), worst = 0;
+            for (int i = 0; i < W * H * 4; i++) worst = fmax(worst, fabs(dflt[i] - off[i]));
+            CHECKF(worst <= 0.01 + 1e-5, "%s/%s: default termination off by %.4f", vxl_phantom_name(kinds[k]),
+                   vxl_filter_name(f), worst);
+            fprintf(stderr, "    %-15s %-11s PSNR %6.1f dB, samples %8llu vs %8llu (%.0f%%)\n", vxl_phantom_name(kinds[k]),
+                    vxl_filter_name(f), q, (unsigned long long)s_on.samples, (unsigned long long)s_off.samples,
+                    100.0 * s_on.samples / (s_off.samples ? s_off.samples : 1));
+            CHECKF(q >= 60, "%s/%s: %.1f dB", vxl_phantom_name(kinds[k]), vxl_filter_name(f), q);
+            CHECK(s_on.samples < s_off.samples);
+        }
+    }
+}
+
+int main(void)
+{
+    R = make_renderer(VXL_BACKEND_OSMESA);
+    if (!R) {
+        printf("0 passed, 1 failed\n");
+        return 1;
+    }
+    RUN(skipping_never_changes_the_image);
+    vxl_renderer_destroy(R);
+    return TEST_SUMMARY();
+}

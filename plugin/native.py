@@ -1,0 +1,608 @@
+"""ctypes binding of libvoxlight (csrc/include/voxlight.h).
+
+No `import bpy` here on purpose: this module is tested with plain Python
+(tests/python) and is the only place that knows the C ABI. Everything that
+crosses the boundary is a numpy array or a plain Python value.
+
+Conventions kept from the header:
+  * matrices are passed in as 4x4 "math" matrices (m[row][col], the way
+    numpy and mathutils index them) and transposed here into the
+    column-major floats the library wants;
+  * images are (height, width, ...) arrays with row 0 = bottom, the same
+    order as Blender's Image.pixels;
+  * volumes from numpy are indexed array[i, j, k] like NIfTI/nibabel, so
+    the memory handed to the library is x-fastest (Fortran order).
+"""
+
+import ctypes
+import os
+
+import numpy as np
+
+ABI_VERSION = 1
+LIBRARY_NAME = "libvoxlight.so"
+
+FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed")
+PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
+BACKENDS = ("auto", "osmesa", "egl")
+MAX_LIGHTS = 8
+
+_DTYPES = {
+    np.dtype(np.uint8): 1, np.dtype(np.int8): 2,
+    np.dtype(np.uint16): 3, np.dtype(np.int16): 4,
+    np.dtype(np.uint32): 5, np.dtype(np.int32): 6,
+    np.dtype(np.float32): 7, np.dtype(np.float64): 8,
+}
+DTYPE_NAMES = {1: "uint8", 2: "int8", 3: "uint16", 4: "int16",
+               5: "uint32", 6: "int32", 7: "float32", 8: "float64"}
+
+c_float4x4 = ctypes.c_float * 16
+c_double4x4 = ctypes.c_double * 16
+
+
+# --------------------------------------------------------------- structs
+# Field order and types copied from voxlight.h; only fixed-width types.
+
+class LoadOptions(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("max_dim", ctypes.c_uint32),
+                ("memory_budget_bytes", ctypes.c_uint64)]
+
+
+class VolumeDesc(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("dtype", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("has_affine", ctypes.c_uint32),
+                ("data", ctypes.c_void_p),
+                ("spacing", ctypes.c_double * 3),
+                ("affine", c_double4x4),
+                ("scl_slope", ctypes.c_double),
+                ("scl_inter", ctypes.c_double)]
+
+
+class VolumeInfo(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("dtype", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("nifti_version", ctypes.c_uint32),
+                ("spacing", ctypes.c_double * 3),
+                ("affine", c_double4x4),
+                ("value_min", ctypes.c_double),
+                ("value_max", ctypes.c_double),
+                ("nan_count", ctypes.c_uint64),
+                ("inf_count", ctypes.c_uint64),
+                ("storage_bytes", ctypes.c_uint64),
+                ("texture_bits", ctypes.c_uint32),
+                ("affine_source", ctypes.c_uint32)]
+
+
+class RendererOptions(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("backend", ctypes.c_uint32),
+                ("memory_budget_bytes", ctypes.c_uint64),
+                ("shader_dir", ctypes.c_char_p)]
+
+
+class RendererInfo(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("backend", ctypes.c_uint32),
+                ("max_3d_texture_size", ctypes.c_int32),
+                ("reserved", ctypes.c_uint32),
+                ("backend_name", ctypes.c_char * 32),
+                ("gl_renderer", ctypes.c_char * 128),
+                ("gl_version", ctypes.c_char * 128)]
+
+
+class Light(ctypes.Structure):
+    _fields_ = [("position", ctypes.c_float * 4),
+                ("color", ctypes.c_float * 3),
+                ("intensity", ctypes.c_float)]
+
+
+class RenderParams(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("width", ctypes.c_uint32),
+                ("height", ctypes.c_uint32),
+                ("has_camera", ctypes.c_uint32),
+                ("view", c_float4x4),
+                ("proj", c_float4x4),
+                ("azimuth_deg", ctypes.c_float),
+                ("elevation_deg", ctypes.c_float),
+                ("has_model", ctypes.c_uint32),
+                ("model", c_float4x4),
+                ("scene_depth", ctypes.POINTER(ctypes.c_float)),
+                ("filter", ctypes.c_uint32),
+                ("sample_distance", ctypes.c_float),
+                ("reuse_gradients", ctypes.c_uint32),
+                ("gradient_store", ctypes.c_uint32),
+                ("step", ctypes.c_float),
+                ("jitter_off", ctypes.c_uint32),
+                ("jitter_seed", ctypes.c_uint32),
+                ("preset", ctypes.c_uint32),
+                ("tf_size", ctypes.c_uint32),
+                ("tf_rgba", ctypes.POINTER(ctypes.c_float)),
+                ("has_window", ctypes.c_uint32),
+                ("window_low", ctypes.c_float),
+                ("window_high", ctypes.c_float),
+                ("opacity_scale", ctypes.c_float),
+                ("classify", ctypes.c_uint32),
+                ("shading_off", ctypes.c_uint32),
+                ("has_material", ctypes.c_uint32),
+                ("ambient", ctypes.c_float),
+                ("diffuse", ctypes.c_float),
+                ("specular", ctypes.c_float),
+                ("shininess", ctypes.c_float),
+                ("light_count", ctypes.c_uint32),
+                ("lights", Light * MAX_LIGHTS),
+                ("early_termination", ctypes.c_float),
+                ("depth_threshold", ctypes.c_float),
+                ("no_skip", ctypes.c_uint32),
+                ("reserved", ctypes.c_uint32 * 7)]
+
+
+def _sized(struct_type):
+    s = struct_type()
+    s.struct_size = ctypes.sizeof(struct_type)
+    return s
+
+
+# ---------------------------------------------------------------- errors
+
+class VoxlightError(RuntimeError):
+    """A library call failed; .code is the VXL_ERR_* value, str() the message."""
+
+    def __init__(self, message, code=0, name=""):
+        super().__init__(message)
+        self.code = code
+        self.name = name
+
+
+class LibraryUnavailable(VoxlightError):
+    """libvoxlight.so is missing, fails to load or has another ABI."""
+
+
+# --------------------------------------------------------------- loading
+
+def candidate_paths(explicit=None):
+    """Where the library is looked for, in order. The add-on ships the .so
+    next to this file; the source-tree fallback (../build) serves developers
+    running from a checkout."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    paths = []
+    if explicit:
+        paths.append(explicit)
+    env = os.environ.get("VOXLIGHT_LIB")
+    if env:
+        paths.append(env)
+    paths.append(os.path.join(here, LIBRARY_NAME))
+    paths.append(os.path.join(os.path.dirname(here), "build", LIBRARY_NAME))
+    return paths
+
+
+def _declare(lib):
+    """Argument and result types for every entry point we call; without them
+    ctypes would truncate pointers to int."""
+    P = ctypes.POINTER
+    vp = ctypes.c_void_p
+    sig = {
+        "vxl_abi_version": (ctypes.c_uint32, []),
+        "vxl_last_error": (ctypes.c_char_p, []),
+        "vxl_error_name": (ctypes.c_char_p, [ctypes.c_int]),
+        "vxl_filter_name": (ctypes.c_char_p, [ctypes.c_uint32]),
+        "vxl_filter_from_name": (ctypes.c_int, [ctypes.c_char_p, P(ctypes.c_uint32)]),
+        "vxl_preset_name": (ctypes.c_char_p, [ctypes.c_uint32]),
+        "vxl_preset_from_name": (ctypes.c_int, [ctypes.c_char_p, P(ctypes.c_uint32)]),
+        "vxl_volume_load": (ctypes.c_int, [ctypes.c_char_p, P(LoadOptions), P(vp)]),
+        "vxl_volume_create": (ctypes.c_int, [P(VolumeDesc), P(LoadOptions), P(vp)]),
+        "vxl_volume_get_info": (ctypes.c_int, [vp, P(VolumeInfo)]),
+        "vxl_volume_destroy": (None, [vp]),
+        "vxl_renderer_create": (ctypes.c_int, [P(RendererOptions), P(vp)]),
+        "vxl_renderer_destroy": (None, [vp]),
+        "vxl_renderer_error": (ctypes.c_char_p, [vp]),
+        "vxl_renderer_get_info": (ctypes.c_int, [vp, P(RendererInfo)]),
+        "vxl_renderer_set_volume": (ctypes.c_int, [vp, vp]),
+        "vxl_render": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
+                                      P(ctypes.c_float)]),
+        "vxl_default_camera": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
+                                              P(ctypes.c_float)]),
+        "vxl_probe_gradients": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
+                                               ctypes.c_uint32, P(ctypes.c_float)]),
+        "vxl_write_image": (ctypes.c_int, [ctypes.c_char_p, P(ctypes.c_float),
+                                           P(ctypes.c_float), ctypes.c_uint32,
+                                           ctypes.c_uint32]),
+    }
+    for name, (res, args) in sig.items():
+        fn = getattr(lib, name)  # AttributeError -> reported as incompatible
+        fn.restype = res
+        fn.argtypes = args
+
+
+class Library:
+    """A loaded, ABI-checked libvoxlight."""
+
+    def __init__(self, path):
+        self.path = path
+        # Plain dlopen (RTLD_LOCAL). RTLD_DEEPBIND would crash Blender
+        # (jemalloc), and the library fetches GL through get-proc-address,
+        # so Blender's global libGL cannot capture its GL calls.
+        try:
+            self.cdll = ctypes.CDLL(path)
+        except OSError as e:
+            raise LibraryUnavailable("cannot load %s: %s" % (path, e)) from None
+        try:
+            self.cdll.vxl_abi_version.restype = ctypes.c_uint32
+            self.cdll.vxl_abi_version.argtypes = []
+            version = self.cdll.vxl_abi_version()
+        except AttributeError:
+            raise LibraryUnavailable("%s is not libvoxlight (no vxl_abi_version)" % path) from None
+        if version != ABI_VERSION:
+            raise LibraryUnavailable(
+                "%s has ABI version %d, this add-on needs %d; install matching "
+                "versions of the add-on and the library" % (path, version, ABI_VERSION))
+        try:
+            _declare(self.cdll)
+        except AttributeError as e:
+            raise LibraryUnavailable("%s lacks an entry point: %s" % (path, e)) from None
+        self.abi_version = version
+
+    # error helpers --------------------------------------------------
+    def last_error(self):
+        msg = self.cdll.vxl_last_error()
+        return msg.decode("utf-8", "replace") if msg else ""
+
+    def error_name(self, code):
+        n = self.cdll.vxl_error_name(code)
+        return n.decode() if n else "VXL_ERR_%d" % code
+
+    def check(self, code, renderer_handle=None, what=""):
+        """Raise VoxlightError carrying the library's own message."""
+        if code == 0:
+            return
+        msg = ""
+        if renderer_handle:
+            m = self.cdll.vxl_renderer_error(renderer_handle)
+            msg = m.decode("utf-8", "replace") if m else ""
+        if not msg:
+            msg = self.last_error()
+        name = self.error_name(code)
+        text = msg or name
+        if what:
+            text = "%s: %s" % (what, text)
+        raise VoxlightError(text, code, name)
+
+    def filter_index(self, name):
+        out = ctypes.c_uint32()
+        self.check(self.cdll.vxl_filter_from_name(name.encode(), ctypes.byref(out)))
+        return out.value
+
+    def preset_index(self, name):
+        out = ctypes.c_uint32()
+        self.check(self.cdll.vxl_preset_from_name(name.encode(), ctypes.byref(out)))
+        return out.value
+
+    def write_image(self, path, rgba, depth=None):
+        rgba = np.ascontiguousarray(rgba, dtype=np.float32)
+        h, w = rgba.shape[:2]
+        if rgba.shape != (h, w, 4):
+            raise ValueError("rgba must be (height, width, 4)")
+        dptr = None
+        if depth is not None:
+            depth = np.ascontiguousarray(depth, dtype=np.float32).reshape(h, w)
+            dptr = _fptr(depth)
+        self.check(self.cdll.vxl_write_image(os.fsencode(path), _fptr(rgba), dptr, w, h),
+                   what="write %s" % path)
+
+
+_library = None
+_library_error = None
+
+
+def load_library(path=None, reload=False):
+    """Return the Library, loading it on first use. Raises LibraryUnavailable
+    with a message that names every place that was tried."""
+    global _library, _library_error
+    if _library is not None and not reload and path is None:
+        return _library
+    errors = []
+    for p in candidate_paths(path):
+        if not os.path.isfile(p):
+            errors.append("%s: not found" % p)
+            continue
+        try:
+            lib = Library(p)
+        except LibraryUnavailable as e:
+            errors.append(str(e))
+            # An explicitly named library that is broken is an error by itself;
+            # falling back would hide it.
+            if p == path:
+                break
+            continue
+        _library, _library_error = lib, None
+        return lib
+    _library_error = "libvoxlight not usable: " + "; ".join(errors)
+    raise LibraryUnavailable(_library_error)
+
+
+def library_status():
+    """(ok, message) without raising, for UI code."""
+    try:
+        lib = load_library()
+    except LibraryUnavailable as e:
+        return False, str(e)
+    return True, "libvoxlight ABI %d at %s" % (lib.abi_version, lib.path)
+
+
+# --------------------------------------------------------------- helpers
+
+def _fptr(arr):
+    return arr.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+
+
+def _matrix_cm(m, ctype=ctypes.c_float):
+    """4x4 math matrix (m[row][col]) -> 16 column-major values."""
+    a = np.asarray(m, dtype=np.float64).reshape(4, 4)
+    return (ctype * 16)(*a.T.ravel().tolist())
+
+
+def matrix_from_cm(values):
+    """16 column-major values -> numpy 4x4 math matrix."""
+    return np.array(list(values), dtype=np.float64).reshape(4, 4).T
+
+
+# ---------------------------------------------------------------- volume
+
+class Volume:
+    """A volume held by the library (loaded from a file or from numpy)."""
+
+    def __init__(self, lib, handle, keepalive=None):
+        self.lib = lib
+        self._handle = handle
+        self._keepalive = keepalive  # numpy data the library may point at
+        self.info = self._read_info()
+
+    @classmethod
+    def load(cls, path, max_dim=0, memory_budget=0, lib=None):
+        lib = lib or load_library()
+        opt = _sized(LoadOptions)
+        opt.max_dim = max_dim
+        opt.memory_budget_bytes = memory_budget
+        h = ctypes.c_void_p()
+        # The library's message already names the file.
+        lib.check(lib.cdll.vxl_volume_load(os.fsencode(path), ctypes.byref(opt), ctypes.byref(h)))
+        return cls(lib, h)
+
+    @classmethod
+    def from_array(cls, array, spacing=None, affine=None, scl_slope=0.0, scl_inter=0.0,
+                   max_dim=0, memory_budget=0, lib=None):
+        """array[i, j, k] (NIfTI/nibabel index order), any numeric dtype."""
+        lib = lib or load_library()
+        a = np.asarray(array)
+        if a.ndim != 3:
+            raise ValueError("volume array must be 3-D, got shape %s" % (a.shape,))
+        if a.dtype == np.bool_:
+            a = a.astype(np.uint8)
+        elif a.dtype not in _DTYPES:
+            a = a.astype(np.float32 if a.dtype.kind == "f" else np.float64)
+        a = np.asfortranarray(a)  # x fastest, as the library expects
+        desc = _sized(VolumeDesc)
+        desc.dtype = _DTYPES[a.dtype]
+        desc.dims[:] = [int(n) for n in a.shape]
+        desc.data = a.ctypes.data
+        if spacing is not None:
+            desc.spacing[:] = [float(s) for s in spacing]
+        if affine is not None:
+            desc.has_affine = 1
+            desc.affine[:] = np.asarray(affine, np.float64).reshape(4, 4).T.ravel().tolist()
+        desc.scl_slope = scl_slope
+        desc.scl_inter = scl_inter
+        opt = _sized(LoadOptions)
+        opt.max_dim = max_dim
+        opt.memory_budget_bytes = memory_budget
+        h = ctypes.c_void_p()
+        lib.check(lib.cdll.vxl_volume_create(ctypes.byref(desc), ctypes.byref(opt),
+                                             ctypes.byref(h)), what="volume from array")
+        return cls(lib, h, keepalive=a)
+
+    def _read_info(self):
+        info = _sized(VolumeInfo)
+        self.lib.check(self.lib.cdll.vxl_volume_get_info(self._handle, ctypes.byref(info)))
+        return {
+            "dtype": DTYPE_NAMES.get(info.dtype, str(info.dtype)),
+            "dims": tuple(int(d) for d in info.dims),
+            "nifti_version": info.nifti_version,
+            "spacing": tuple(info.spacing),
+            "affine": matrix_from_cm(info.affine),
+            "value_min": info.value_min,
+            "value_max": info.value_max,
+            "nan_count": info.nan_count,
+            "inf_count": info.inf_count,
+            "storage_bytes": info.storage_bytes,
+            "texture_bits": info.texture_bits,
+            "affine_source": ("none", "qform", "sform")[info.affine_source]
+            if info.affine_source < 3 else str(info.affine_source),
+        }
+
+    @property
+    def handle(self):
+        if not self._handle:
+            raise VoxlightError("volume is closed")
+        return self._handle
+
+    def close(self):
+        if self._handle:
+            self.lib.cdll.vxl_volume_destroy(self._handle)
+            self._handle = None
+            self._keepalive = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def voxel_box_corners(dims):
+    """The 8 corners of the volume box in voxel space ([-0.5, dim-0.5])."""
+    lo = np.full(3, -0.5)
+    hi = np.asarray(dims, np.float64) - 0.5
+    return np.array([[(hi if (c >> a) & 1 else lo)[a] for a in range(3)] for c in range(8)])
+
+
+# ----------------------------------------------------------- render params
+
+def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth=None,
+                filter="central", sample_distance=1.0, reuse_gradients=False,
+                gradient_16f=False, step=0.5, jitter=True, jitter_seed=0,
+                preset="auto", window=None, opacity_scale=1.0, shading=True,
+                material=None, lights=(), azimuth=0.0, elevation=0.0,
+                early_termination=0.0, depth_threshold=0.0, no_skip=False, lib=None):
+    """Build a RenderParams. Keyword names are the Blender panel's. `lights`
+    is a sequence of (position4, color3, intensity); `material` is
+    (ambient, diffuse, specular, shininess) or None for the defaults;
+    `window` is (low, high) or None for the preset's default."""
+    lib = lib or load_library()
+    p = _sized(RenderParams)
+    p.width, p.height = int(width), int(height)
+    if view is not None or proj is not None:
+        if view is None or proj is None:
+            raise ValueError("view and proj must be given together")
+        p.has_camera = 1
+        p.view = _matrix_cm(view)
+        p.proj = _matrix_cm(proj)
+    p.azimuth_deg, p.elevation_deg = azimuth, elevation
+    if model is not None:
+        p.has_model = 1
+        p.model = _matrix_cm(model)
+    p._keep = []
+    if scene_depth is not None:
+        w, h = p.width or 512, p.height or 512
+        d = np.ascontiguousarray(scene_depth, dtype=np.float32)
+        if d.size != w * h:
+            raise ValueError("scene_depth has %d values, image has %dx%d" % (d.size, w, h))
+        p._keep.append(d)
+        p.scene_depth = _fptr(d)
+    p.filter = filter if isinstance(filter, int) else lib.filter_index(filter)
+    p.sample_distance = sample_distance
+    p.reuse_gradients = 1 if reuse_gradients else 0
+    p.gradient_store = 1 if gradient_16f else 0
+    p.step = step
+    p.jitter_off = 0 if jitter else 1
+    p.jitter_seed = jitter_seed
+    p.preset = preset if isinstance(preset, int) else lib.preset_index(preset)
+    if window is not None:
+        p.has_window = 1
+        p.window_low, p.window_high = float(window[0]), float(window[1])
+    p.opacity_scale = opacity_scale
+    p.shading_off = 0 if shading else 1
+    if material is not None:
+        p.has_material = 1
+        p.ambient, p.diffuse, p.specular, p.shininess = [float(v) for v in material]
+    lights = list(lights)
+    if len(lights) > MAX_LIGHTS:
+        raise ValueError("at most %d lights" % MAX_LIGHTS)
+    p.light_count = len(lights)
+    for i, (pos, col, inten) in enumerate(lights):
+        p.lights[i].position[:] = [float(v) for v in pos]
+        p.lights[i].color[:] = [float(v) for v in col]
+        p.lights[i].intensity = float(inten)
+    p.early_termination = early_termination
+    p.depth_threshold = depth_threshold
+    p.no_skip = 1 if no_skip else 0
+    return p
+
+
+# -------------------------------------------------------------- renderer
+
+class Renderer:
+    """One library renderer: its own GL context on its own thread, holding
+    one volume. Safe to call from any Python thread."""
+
+    def __init__(self, backend="auto", memory_budget=0, shader_dir=None, lib=None):
+        self.lib = lib or load_library()
+        opt = _sized(RendererOptions)
+        opt.backend = BACKENDS.index(backend) if isinstance(backend, str) else int(backend)
+        opt.memory_budget_bytes = memory_budget
+        opt.shader_dir = os.fsencode(shader_dir) if shader_dir else None
+        h = ctypes.c_void_p()
+        self.lib.check(self.lib.cdll.vxl_renderer_create(ctypes.byref(opt), ctypes.byref(h)),
+                       what="renderer")
+        self._handle = h
+        self.volume_info = None
+
+    @property
+    def handle(self):
+        if not self._handle:
+            raise VoxlightError("renderer is closed")
+        return self._handle
+
+    def _check(self, code, what=""):
+        self.lib.check(code, self._handle, what)
+
+    def info(self):
+        i = _sized(RendererInfo)
+        self._check(self.lib.cdll.vxl_renderer_get_info(self.handle, ctypes.byref(i)))
+        return {"backend": i.backend, "backend_name": i.backend_name.decode(),
+                "gl_renderer": i.gl_renderer.decode(), "gl_version": i.gl_version.decode(),
+                "max_3d_texture_size": i.max_3d_texture_size}
+
+    def set_volume(self, volume):
+        self._check(self.lib.cdll.vxl_renderer_set_volume(self.handle, volume.handle),
+                    "set volume")
+        self.volume_info = dict(volume.info)
+
+    def render(self, params=None, want_depth=True, **kwargs):
+        """Render; returns (rgba[h, w, 4], depth[h, w] or None), float32,
+        row 0 = bottom, premultiplied RGBA."""
+        if params is None:
+            params = make_params(lib=self.lib, **kwargs)
+        w, h = params.width or 512, params.height or 512
+        rgba = np.empty((h, w, 4), np.float32)
+        depth = np.empty((h, w), np.float32) if want_depth else None
+        self._check(self.lib.cdll.vxl_render(self.handle, ctypes.byref(params), _fptr(rgba),
+                                             _fptr(depth) if want_depth else None), "render")
+        return rgba, depth
+
+    def default_camera(self, params=None, **kwargs):
+        """(view, proj) as numpy 4x4 math matrices."""
+        if params is None:
+            params = make_params(lib=self.lib, **kwargs)
+        view = (ctypes.c_float * 16)()
+        proj = (ctypes.c_float * 16)()
+        self._check(self.lib.cdll.vxl_default_camera(self.handle, ctypes.byref(params),
+                                                     view, proj), "default camera")
+        return matrix_from_cm(view), matrix_from_cm(proj)
+
+    def probe_gradients(self, points, params=None, **kwargs):
+        """Gradient of the selected filter at voxel-space points (n, 3)."""
+        if params is None:
+            params = make_params(lib=self.lib, **kwargs)
+        pts = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+        out = np.empty_like(pts)
+        self._check(self.lib.cdll.vxl_probe_gradients(self.handle, ctypes.byref(params),
+                                                      _fptr(pts), len(pts), _fptr(out)),
+                    "probe gradients")
+        return out
+
+    def close(self):
+        if self._handle:
+            self.lib.cdll.vxl_renderer_destroy(self._handle)
+            self._handle = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

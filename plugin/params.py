@@ -1,0 +1,57 @@
+"""Builds library render parameters from a volume object's properties, a
+camera and the scene's lights. Shared by the viewport, F12 and the
+scripting API so all three render the same thing."""
+
+import numpy as np
+
+from . import lights as _lights
+from . import native
+
+
+def model_matrix(obj):
+    """voxel -> world for the object as it is now (follows the object)."""
+    v2l = np.array(obj.voxlight.voxel_to_local, np.float64).reshape(4, 4).T
+    return np.array(obj.matrix_world, np.float64) @ v2l
+
+
+def look_kwargs(props, fast=False):
+    """The properties that decide how the volume looks, as make_params
+    keyword arguments. `fast` doubles the step for interactive frames."""
+    window = None
+    if props.use_window:
+        lo, hi = sorted((props.window_low, props.window_high))
+        if hi <= lo:
+            hi = lo + max(abs(lo), 1.0) * 1e-6
+        window = (lo, hi)
+    step = props.step * (2.0 if fast else 1.0)
+    return dict(
+        filter=props.filter,
+        sample_distance=props.sample_distance,
+        reuse_gradients=props.reuse_gradients,
+        gradient_16f=props.gradient_16f,
+        step=step,
+        jitter=props.jitter,
+        preset=props.preset,
+        window=window,
+        opacity_scale=props.opacity_scale,
+        shading=props.shading,
+        material=(props.ambient, props.diffuse, props.specular, props.shininess),
+    )
+
+
+def look_key(props, fast=False):
+    """Hashable summary of look_kwargs, for the viewport's change test."""
+    return tuple(sorted((k, repr(v)) for k, v in look_kwargs(props, fast).items()))
+
+
+def scene_lights(scene, depsgraph, for_render=False):
+    if not scene.voxlight.use_scene_lights:
+        return []
+    return _lights.collect(depsgraph, for_render)
+
+
+def build(obj, width, height, view, proj, scene_depth=None, lights=(), fast=False, lib=None):
+    kw = look_kwargs(obj.voxlight, fast)
+    return native.make_params(width=width, height=height, view=view, proj=proj,
+                              model=model_matrix(obj), scene_depth=scene_depth,
+                              lights=lights, lib=lib, **kw)

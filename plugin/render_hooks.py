@@ -1,0 +1,118 @@
+"""F12, animation and `blender -b` renders: the handlers below render the
+scene's volumes with the scene camera at the render resolution (render_pre
+arms, the pipeline's own frame_change_post renders), write them into a
+float Image, and the compositor (compositor.py) lays that image over the
+engine's output. Works in background mode, where gpu drawing and draw
+handlers are unavailable, because the library renders on its own context.
+"""
+
+import bpy
+import numpy as np
+from bpy.app.handlers import persistent
+
+from . import compositor, native, offline
+
+last_error = ""
+
+
+def _volumes_present(scene):
+    return any(o.voxlight.is_volume and not o.hide_render for o in scene.objects)
+
+
+def display_to_linear(rgba):
+    """The library's colours are display-referred (sRGB), as in its PNG
+    output and in the viewport. The compositor works in scene-linear, so
+    decode them (on straight colour, then premultiply again): with the
+    Standard view transform F12 then shows what the CLI and viewport show."""
+    rgba = np.asarray(rgba, np.float32)
+    a = rgba[..., 3:4]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = np.where(a > 0, rgba[..., :3] / a, 0.0)
+    c = np.clip(c, 0.0, 1.0)
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return np.ascontiguousarray(np.concatenate([lin * a, a], axis=-1), np.float32)
+
+
+_pending = False  # a render job is between render_pre and its compositing
+
+
+@persistent
+def on_render_init(scene, *args):
+    """Nodes must exist before the pipeline decides whether to composite."""
+    if scene.voxlight.render_enabled and _volumes_present(scene) and scene.camera:
+        w, h = offline.render_size(scene)
+        compositor.ensure_nodes(scene, compositor.ensure_image(w, h))
+
+
+@persistent
+def on_render_pre(scene, *args):
+    global _pending
+    s = scene.voxlight
+    if not s.render_enabled or not _volumes_present(scene) or scene.camera is None:
+        compositor.mute(scene)
+        _pending = False
+        return
+    w, h = offline.render_size(scene)
+    compositor.ensure_nodes(scene, compositor.ensure_image(w, h))
+    _pending = True
+
+
+@persistent
+def on_frame_change_post(scene, depsgraph=None, *args):
+    """The volume is rendered here, not in render_pre: right after
+    render_pre the pipeline evaluates its own depsgraph for the frame being
+    rendered (render visibility, animation at that frame) and announces it
+    through frame_change_post. The view-layer depsgraph that render_pre
+    could use lags one frame behind in animation renders."""
+    global _pending, last_error
+    if not _pending or depsgraph is None or depsgraph.mode != "RENDER":
+        return
+    _pending = False
+    s = scene.voxlight
+    w, h = offline.render_size(scene)
+    camera = scene.camera
+    try:
+        result = offline.render(scene, depsgraph, camera, w, h,
+                                occlusion=s.render_occlusion, backend=s.backend)
+    except native.VoxlightError as e:
+        last_error = str(e)
+        print("Voxlight: render failed: %s" % e)
+        compositor.mute(scene)
+        return
+    last_error = ""
+    if result is None:
+        compositor.mute(scene)
+        return
+    rgba, _depth = result
+    img = compositor.ensure_image(w, h)
+    img.pixels.foreach_set(display_to_linear(rgba).ravel())
+    img.update()
+    compositor.ensure_nodes(scene, img)
+
+
+@persistent
+def on_render_end(scene, *args):
+    global _pending
+    _pending = False
+
+
+_handlers = ((bpy.app.handlers.render_init, on_render_init),
+             (bpy.app.handlers.render_pre, on_render_pre),
+             (bpy.app.handlers.frame_change_post, on_frame_change_post),
+             (bpy.app.handlers.render_post, on_render_end),
+             (bpy.app.handlers.render_cancel, on_render_end))
+
+
+def register():
+    for lst, fn in _handlers:
+        if fn not in lst:
+            lst.append(fn)
+
+
+def unregister():
+    for lst, fn in _handlers:
+        # Match by name too: a reloaded module has new function objects.
+        for h in list(lst):
+            if h is fn or getattr(h, "__name__", "") == fn.__name__ and \
+                    getattr(h, "__module__", "") == fn.__module__:
+                lst.remove(h)

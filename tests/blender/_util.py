@@ -1,0 +1,147 @@
+"""Shared helpers of the Blender test scripts (run inside Blender).
+
+Each script calls install_addon(), registers tests with @test and ends with
+run(), which prints one `RESULT name: N passed, M failed` line (parsed by
+tools/run_blender_tests.sh) and exits non-zero on failure. Scripts run with
+--python-exit-code 1 so an unexpected exception also fails them.
+"""
+
+import os
+import sys
+import tempfile
+import time
+import traceback
+
+import bpy
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "tests", "python"))
+
+from nifti_write import phantom, write_nifti  # noqa: E402,F401
+
+CH2 = "/usr/share/mricron/templates/ch2better.nii.gz"
+TMP = tempfile.mkdtemp(prefix="voxlight-blender-test-")
+_tests = []
+
+
+def zip_path():
+    build = os.environ.get("BUILD", "build")
+    if not os.path.isabs(build):
+        build = os.path.join(ROOT, build)
+    return os.environ.get("VOXLIGHT_ZIP", os.path.join(build, "voxlight-blender.zip"))
+
+
+def install_addon():
+    """Install the built zip the way a user does, then enable it."""
+    z = zip_path()
+    assert os.path.isfile(z), "%s missing: run tools/package_addon.sh" % z
+    bpy.ops.preferences.addon_install(filepath=z, overwrite=True)
+    bpy.ops.preferences.addon_enable(module="voxlight")
+    import voxlight
+    ok, msg = voxlight.library_status()
+    assert ok, msg
+    # The library must be the one shipped inside the installed add-on.
+    lib_dir = os.path.dirname(voxlight.native.load_library().path)
+    assert lib_dir == os.path.dirname(voxlight.__file__), (lib_dir, voxlight.__file__)
+    return voxlight
+
+
+def ball_file(name="ball.nii.gz", n=32, spacing=(2.0, 2.0, 2.0)):
+    """The test phantom as a NIfTI with its centre at the scanner origin."""
+    aff = np.diag(list(spacing) + [1.0])
+    aff[:3, 3] = [-(n - 1) / 2.0 * s for s in spacing]
+    return write_nifti(os.path.join(TMP, name), phantom(n), aff)
+
+
+def test(fn):
+    _tests.append(fn)
+    return fn
+
+
+def run(name):
+    passed = failed = 0
+    for fn in _tests:
+        t = time.time()
+        try:
+            fn()
+        except Exception:
+            failed += 1
+            traceback.print_exc()
+            print("FAIL %s (%.1fs)" % (fn.__name__, time.time() - t), flush=True)
+        else:
+            passed += 1
+            print("PASS %s (%.1fs)" % (fn.__name__, time.time() - t), flush=True)
+    print("RESULT %s: %d passed, %d failed" % (name, passed, failed), flush=True)
+    if failed:
+        sys.exit(1)
+
+
+def reset_scene():
+    """Empty the scene (factory startup has a cube, camera and light)."""
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob)
+    scene = bpy.context.scene
+    scene.frame_set(1)
+    # Settings a previous test may have changed go back to their defaults.
+    for prop in scene.voxlight.bl_rna.properties:
+        if prop.identifier != "rna_type":
+            scene.voxlight.property_unset(prop.identifier)
+    scene.render.pixel_aspect_x = scene.render.pixel_aspect_y = 1.0
+    scene.render.resolution_percentage = 100
+    return scene
+
+
+def add_camera(location, target=(0.0, 0.0, 0.0), lens=50.0, name="Camera"):
+    from mathutils import Vector
+    cam = bpy.data.objects.new(name, bpy.data.cameras.new(name))
+    cam.data.lens = lens
+    cam.location = location
+    direction = Vector(target) - Vector(location)
+    cam.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+    bpy.context.scene.collection.objects.link(cam)
+    bpy.context.scene.camera = cam
+    return cam
+
+
+def add_plane(size, location, rotation=(0.0, 0.0, 0.0), name="Plane", color=(0.1, 0.9, 0.1)):
+    """A flat opaque quad of the given size (x, y) facing +Z before rotation."""
+    me = bpy.data.meshes.new(name)
+    sx, sy = size[0] / 2.0, size[1] / 2.0
+    me.from_pydata([(-sx, -sy, 0), (sx, -sy, 0), (sx, sy, 0), (-sx, sy, 0)], [], [(0, 1, 2, 3)])
+    me.update()  # without it the viewport draws stale triangles
+    ob = bpy.data.objects.new(name, me)
+    ob.location = location
+    ob.rotation_euler = rotation
+    mat = bpy.data.materials.new(name)
+    mat.diffuse_color = (*color, 1.0)
+    mat.use_nodes = True
+    bsdf = mat.node_tree.nodes.get("Principled BSDF")
+    if bsdf is not None:
+        bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+        bsdf.inputs["Emission"].default_value = (*color, 1.0)
+    me.materials.append(mat)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def import_volume(path, **kw):
+    before = set(bpy.data.objects)
+    res = bpy.ops.voxlight.import_volume(filepath=str(path), **kw)
+    assert res == {"FINISHED"}, res
+    new = set(bpy.data.objects) - before
+    assert len(new) == 1, new
+    return new.pop()
+
+
+def load_png(path):
+    """Pixels of an image file as (h, w, 4) float, row 0 = bottom."""
+    img = bpy.data.images.load(path, check_existing=False)
+    try:
+        w, h = img.size
+        px = np.empty(w * h * 4, np.float32)
+        img.pixels.foreach_get(px)
+        return px.reshape(h, w, 4)
+    finally:
+        bpy.data.images.remove(img)

@@ -7,24 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static uint64_t fnv(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *c = p;
-    for (size_t i = 0; i < n; i++) h = (h ^ c[i]) * 1099511628211ull;
-    return h;
-}
-
-static uint64_t classification_key(const vxl_frame *f)
-{
-    uint64_t h = 1469598103934665603ull;
-    h = fnv(h, f->tf, (size_t)f->tf_size * 4 * sizeof(float));
-    h = fnv(h, &f->tf_size, sizeof f->tf_size);
-    h = fnv(h, &f->window_offset, sizeof f->window_offset);
-    h = fnv(h, &f->window_scale, sizeof f->window_scale);
-    h = fnv(h, &f->opacity_scale, sizeof f->opacity_scale);
-    return h;
-}
-
 /* Table index a normalised value maps to (as classify.glsl computes it). */
 static double table_pos(const vxl_frame *f, double v)
 {
@@ -63,7 +45,7 @@ static void chebyshev_axis(uint8_t *d, const uint32_t dims[3], int axis, uint8_t
 
 int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
 {
-    uint64_t key = classification_key(f);
+    uint64_t key = vxl_classification_key(f);
     if (b->distance && b->tf_key == key) return 0;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     if (!b->distance && !(b->distance = malloc(n))) return -1;

@@ -14,9 +14,9 @@ static const char usage[] =
     "  voxlight render INPUT -o OUT.png|OUT.exr [--size WxH] [--filter NAME] [--sample-distance D]\n"
     "                  [--reuse-gradients] [--step S] [--azimuth DEG] [--elevation DEG] [--preset NAME]\n"
     "                  [--window LO:HI] [--no-shading] [--backend auto|osmesa|egl] [--memory-budget SIZE]\n"
-    "                  [--gradient-store 8bit|16f|32f] [--no-jitter] [--no-skip]\n"
+    "                  [--gradient-store 8bit|16f|32f] [--classify post|pre|preint] [--no-jitter] [--no-skip]\n"
     "  voxlight info INPUT\n"
-    "filters: central forward3 sobel8 sobel14 sobel26 precomputed; presets: auto gray bone hot mri ct\n";
+    "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic; presets: auto gray bone hot mri ct\n";
 
 static int die(const char *fmt, ...)
 {
@@ -113,7 +113,7 @@ static int parse_render(int argc, char **argv, render_args *a)
             p->width = w; p->height = h;
         } else if (!strcmp(o, "--filter")) {
             NEED_VALUE();
-            if (vxl_filter_from_name(val, &p->filter)) return die("unknown filter '%s' (central, forward3, sobel8, sobel14, sobel26, precomputed)", val);
+            if (vxl_filter_from_name(val, &p->filter)) return die("unknown filter '%s' (central, forward3, sobel8, sobel14, sobel26, precomputed, cubic)", val);
         } else if (!strcmp(o, "--sample-distance")) {
             NEED_VALUE();
             if (!parse_float(val, &p->sample_distance) || p->sample_distance <= 0) return die("bad --sample-distance '%s'", val);
@@ -139,6 +139,13 @@ static int parse_render(int argc, char **argv, render_args *a)
         } else if (!strcmp(o, "--no-shading")) p->shading_off = 1;
         else if (!strcmp(o, "--no-jitter")) p->jitter_off = 1;
         else if (!strcmp(o, "--no-skip")) p->no_skip = 1;
+        else if (!strcmp(o, "--classify")) {
+            NEED_VALUE();
+            if (!strcasecmp(val, "post")) p->classify = VXL_CLASSIFY_POST;
+            else if (!strcasecmp(val, "pre")) p->classify = VXL_CLASSIFY_PRE;
+            else if (!strcasecmp(val, "preint")) p->classify = VXL_CLASSIFY_PREINT;
+            else return die("unknown --classify '%s' (post, pre, preint)", val);
+        }
         else if (!strcmp(o, "--gradient-store")) {
             NEED_VALUE();
             if (!strcasecmp(val, "8bit")) p->gradient_store = VXL_GRADIENT_STORE_8BIT;

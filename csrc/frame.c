@@ -204,6 +204,10 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     if (p->classify >= VXL_CLASSIFY_COUNT)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown classify mode %u", p->classify);
     f->filter = p->filter;
+    f->classify = p->classify;
+    f->preint_size = p->preint_size ? p->preint_size : 256;
+    if (f->preint_size < 16 || f->preint_size > 4096)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "preint_size %u must be in [16, 4096]", f->preint_size);
     f->store = p->gradient_store;
     f->shading = !p->shading_off;
     f->reuse = p->reuse_gradients != 0;
@@ -241,4 +245,22 @@ void vxl_frame_free(vxl_frame *f)
 {
     free(f->tf_copy);
     f->tf_copy = NULL;
+}
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *c = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ c[i]) * 1099511628211ull;
+    return h;
+}
+
+uint64_t vxl_classification_key(const vxl_frame *f)
+{
+    uint64_t h = 1469598103934665603ull;
+    h = fnv(h, f->tf, (size_t)f->tf_size * 4 * sizeof(float));
+    h = fnv(h, &f->tf_size, sizeof f->tf_size);
+    h = fnv(h, &f->window_offset, sizeof f->window_offset);
+    h = fnv(h, &f->window_scale, sizeof f->window_scale);
+    h = fnv(h, &f->opacity_scale, sizeof f->opacity_scale);
+    return h;
 }

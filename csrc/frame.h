@@ -20,6 +20,7 @@ typedef struct vxl_volume_geom {
 typedef struct vxl_frame {
     uint32_t width, height;
     uint32_t filter, shading, reuse, store, jitter, seed;
+    uint32_t classify, preint_size;
     float sample_distance, step;
     int max_steps;
     double view[16], proj[16], model[16];
@@ -36,6 +37,10 @@ typedef struct vxl_frame {
     float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
     float *tf_copy;             /* owned when the caller gave a table */
 } vxl_frame;
+
+/* A hash of everything the classification depends on (table, window,
+ * opacity scale): caches derived from it compare keys. */
+uint64_t vxl_classification_key(const vxl_frame *f);
 
 /* p may be NULL (all defaults). On success free with vxl_frame_free. */
 int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e);

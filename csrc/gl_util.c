@@ -11,7 +11,8 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
     "#define FILTER_SOBEL14 1\n", "#define FILTER_SOBEL26 1\n", "#define FILTER_PRECOMPUTED 1\n",
     "#define FILTER_CUBIC 1\n"};
 
-/* flags bits: 1 shading, 2 reuse gradients; for GRAD_STORE: the store format */
+/* flags bits for RAYCAST: 1 shading, 2 reuse gradients, 4-8 the classify
+ * mode; for GRAD_STORE: the store format */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
 
 static int compile(vxl_renderer *r, GLenum type, const char *file, const char *defines, GLuint *out)
@@ -68,8 +69,11 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     int rc;
     switch (kind) {
     case VXL_PROG_RAYCAST:
-        snprintf(defines, sizeof defines, "%s%s%s", fdef, (flags & 1) ? "#define SHADING 1\n" : "",
-                 (flags & 2) ? "#define REUSE_GRADIENTS 1\n" : "");
+        snprintf(defines, sizeof defines, "%s%s%s%s", fdef, (flags & 1) ? "#define SHADING 1\n" : "",
+                 (flags & 2) ? "#define REUSE_GRADIENTS 1\n" : "",
+                 ((flags >> 2) & 3) == VXL_CLASSIFY_PRE      ? "#define CLASSIFY_PRE 1\n"
+                 : ((flags >> 2) & 3) == VXL_CLASSIFY_PREINT ? "#define CLASSIFY_PREINT 1\n"
+                                                             : "");
         rc = compile(r, GL_VERTEX_SHADER, "raycast.vert", NULL, &a);
         if (rc) return rc;
         rc = compile(r, GL_FRAGMENT_SHADER, "raycast.frag", defines, &b);
@@ -96,6 +100,9 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BSPLINE_AXIS:
         rc = compile(r, GL_COMPUTE_SHADER, "bspline_prefilter.comp", NULL, &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_CLASSIFY_VOLUME:
+        rc = compile(r, GL_COMPUTE_SHADER, "classify_volume.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
         rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", NULL, &a);

@@ -35,6 +35,36 @@ static void classify(const ref_ctx *c, double v, double out[4])
     out[3] = a < 0 ? 0 : a > 1 ? 1 : a;
 }
 
+/* CLASSIFY_PRE: classify the analytic field at the 8 surrounding voxel
+ * centres (premultiplied), interpolate trilinearly with clamp-to-edge, as
+ * the GL path samples its pre-classified texture. */
+static void classify_pre(const ref_ctx *c, const double p[3], double out[4])
+{
+    const uint32_t *dims = c->vol->dims;
+    double span = c->vol->tex_hi - c->vol->tex_lo, acc[4] = {0, 0, 0, 0};
+    double base[3], w[3];
+    for (int a = 0; a < 3; a++) {
+        double q = p[a] < 0 ? 0 : p[a] > dims[a] - 1 ? dims[a] - 1 : p[a];
+        base[a] = floor(q);
+        w[a] = q - base[a];
+    }
+    for (int i = 0; i < 8; i++) {
+        double q[3], wt = 1, v, g[3], k[4];
+        for (int a = 0; a < 3; a++) {
+            int hi = (i >> a) & 1;
+            q[a] = base[a] + hi;
+            if (q[a] > dims[a] - 1) q[a] = dims[a] - 1;
+            wt *= hi ? w[a] : 1 - w[a];
+        }
+        vxl_phantom_eval(c->d, q, &v, g);
+        classify(c, (v - c->vol->tex_lo) / span, k);
+        for (int ch = 0; ch < 3; ch++) acc[ch] += wt * k[ch] * k[3];
+        acc[3] += wt * k[3];
+    }
+    for (int ch = 0; ch < 3; ch++) out[ch] = acc[3] > 0 ? acc[ch] / acc[3] : 0;
+    out[3] = acc[3];
+}
+
 static double correct_opacity(double a, double step)
 {
     double t = 1 - a;
@@ -117,7 +147,10 @@ static void trace(const ref_ctx *c, double px, double py, float *out_rgba, float
         double p[3] = {o[0] + t * dir[0], o[1] + t * dir[1], o[2] + t * dir[2]}, value, g[3];
         vxl_phantom_eval(c->d, p, &value, g);
         double col[4];
-        classify(c, (value - c->vol->tex_lo) / span, col);
+        /* PREINT approximates the same continuous integral as POST, so both
+         * share this reference; PRE is a different image model. */
+        if (f->classify == VXL_CLASSIFY_PRE) classify_pre(c, p, col);
+        else classify(c, (value - c->vol->tex_lo) / span, col);
         if (col[3] <= 0) continue;
         double alpha = correct_opacity(col[3], c->step);
         if (f->shading) {

@@ -161,7 +161,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
 {
     vxl_gl *gl = &r->gl;
     GLuint prog;
-    uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u);
+    uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2);
     /* unshaded rays never evaluate gradients: one program serves every filter */
     uint32_t filter = f->shading ? f->filter : VXL_FILTER_CENTRAL;
     int rc = vxl_program_get(r, VXL_PROG_RAYCAST, filter, flags, &prog);
@@ -171,12 +171,16 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     upload_tf(r, f);
     if (f->scene_depth) upload_scene_depth(r, f);
     if (f->skip && (rc = vxl_skipping_prepare(r, f))) return rc;
+    if ((rc = vxl_classification_prepare(r, f))) return rc;
     rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
     if (rc) return rc;
     set_frame_uniforms(r, prog, f);
     vxl_uniform_i(r, prog, "u_skip", f->skip);
     vxl_uniform_i(r, prog, "u_brick_size", (int)(r->bricks.size ? r->bricks.size : VXL_DEFAULT_BRICK));
     vxl_uniform_i(r, prog, "u_brick_distance", 4);
+    vxl_uniform_i(r, prog, "u_classified", 5);
+    vxl_uniform_i(r, prog, "u_preint", 6);
+    vxl_uniform_f(r, prog, "u_preint_size", (float)f->preint_size);
     const GLuint zeros[4] = {0, 0, 0, 0};
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[2]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zeros, zeros, GL_DYNAMIC_READ);

@@ -63,6 +63,7 @@ static int job_close(void *p)
         vxl_gradients_release(r);
         vxl_bspline_release(r);
         vxl_skipping_release(r);
+        vxl_classification_release(r);
         delete_texture(r, &r->volume_tex);
         delete_texture(r, &r->color_tex);
         delete_texture(r, &r->depth_tex);
@@ -169,6 +170,7 @@ static int job_set_volume(void *p)
     vxl_gradients_release(r);
     vxl_bspline_release(r);
     vxl_skipping_release(r);
+    vxl_classification_release(r);
     delete_texture(r, &r->volume_tex);
     r->has_volume = 0;
     int fi = v->texture_bits == 8 ? 0 : v->texture_bits == 16 ? 1 : 2;

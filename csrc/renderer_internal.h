@@ -27,6 +27,7 @@
 #define VXL_PROG_BSPLINE_COPY 5
 #define VXL_PROG_BSPLINE_AXIS 6
 #define VXL_PROG_BRICK_MINMAX 7
+#define VXL_PROG_CLASSIFY_VOLUME 8
 
 typedef struct vxl_program_entry {
     uint32_t key;
@@ -65,6 +66,13 @@ struct vxl_renderer {
     vxl_bricks bricks;
     GLuint brick_tex;
 
+    /* Classification caches: the pre-classified volume (RGBA8, keyed by the
+     * classification) and the pre-integration table (keyed by the
+     * classification, the step and the table size). */
+    GLuint classified_tex, preint_tex;
+    uint64_t classified_key, preint_key;
+    uint64_t classified_bytes;
+
     vxl_program_entry programs[VXL_MAX_PROGRAMS];
     int n_programs;
     GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex, ssbo[3]; /* probe in/out, stats */
@@ -85,6 +93,10 @@ int vxl_gradients_ensure(vxl_renderer *r, int store);
 void vxl_gradients_release(vxl_renderer *r);
 int vxl_bspline_ensure(vxl_renderer *r);
 void vxl_bspline_release(vxl_renderer *r);
+
+/* classification.c */
+int vxl_classification_prepare(vxl_renderer *r, const vxl_frame *f);
+void vxl_classification_release(vxl_renderer *r);
 
 /* skipping.c */
 int vxl_skipping_prepare(vxl_renderer *r, const vxl_frame *f);

@@ -1,13 +1,18 @@
-// classify.glsl - post-classification through a 1D RGBA transfer function.
-// The window maps data onto the table: x = (value - offset) * scale.
+// classify.glsl - classification through a 1D RGBA transfer function. The
+// window maps data onto the table: x = (value - offset) * scale.
+// Post-classification (default) looks up the interpolated value; CLASSIFY_PRE
+// interpolates voxels classified beforehand (classify_volume.comp);
+// CLASSIFY_PREINT looks up whole segments in the pre-integration table.
 uniform sampler1D u_tf;     // straight RGBA; alpha is opacity per voxel of path
 uniform float u_tf_size;
 uniform vec2 u_window;      // (offset, scale) in normalised value units
 uniform float u_opacity_scale;
 
+float window_pos(float v) { return clamp((v - u_window.x) * u_window.y, 0.0, 1.0); }
+
 vec4 classify(float v)
 {
-    float x = clamp((v - u_window.x) * u_window.y, 0.0, 1.0);
+    float x = window_pos(v);
     vec4 c = textureLod(u_tf, (x * (u_tf_size - 1.0) + 0.5) / u_tf_size, 0.0);
     c.a = clamp(c.a * u_opacity_scale, 0.0, 1.0);
     return c;
@@ -21,3 +26,25 @@ float correct_opacity(float a, float step)
     float t = clamp(1.0 - a, 0.0, 1.0);
     return t <= 0.0 ? 1.0 : 1.0 - pow(t, step);
 }
+
+#ifdef CLASSIFY_PRE
+uniform sampler3D u_classified; // premultiplied RGBA per voxel, opacity scale applied
+
+// Straight colour and per-voxel opacity of the interpolated classified voxels.
+vec4 pre_classified(vec3 tex)
+{
+    vec4 c = textureLod(u_classified, tex, 0.0);
+    return vec4(c.a > 0.0 ? c.rgb / c.a : vec3(0.0), c.a);
+}
+#endif
+
+#ifdef CLASSIFY_PREINT
+uniform sampler2D u_preint;   // (front, back) table positions -> premultiplied segment RGBA
+uniform float u_preint_size;
+
+vec4 preint_segment(float v_front, float v_back)
+{
+    vec2 x = vec2(window_pos(v_front), window_pos(v_back));
+    return textureLod(u_preint, (x * (u_preint_size - 1.0) + 0.5) / u_preint_size, 0.0);
+}
+#endif

@@ -1,5 +1,6 @@
 // raycast.frag - front-to-back ray casting with premultiplied compositing.
-// Variants by define: FILTER_* (gradients.glsl), SHADING, REUSE_GRADIENTS.
+// Variants by define: FILTER_* (gradients.glsl), SHADING, REUSE_GRADIENTS,
+// CLASSIFY_PRE / CLASSIFY_PREINT (classify.glsl; post-classification otherwise).
 #include "gradients.glsl"
 #include "classify.glsl"
 #include "shading.glsl"
@@ -85,11 +86,16 @@ void main()
 #ifdef REUSE_GRADIENTS
     GradientState gs = gradient_state_init();
 #endif
+#ifdef CLASSIFY_PREINT
+    // the first segment is a point: constant value over its step
+    float v_prev = sample_value(o + t_start * dir);
+#endif
     uint taken = 0u;
     for (int i = 0; i < u_max_steps; i++) {
         float t = t_start + float(i) * u_step;
         if (t >= t1) break;
         vec3 p = o + t * dir;
+        int leap = -1;
         if (u_skip != 0) {
             ivec3 b = ivec3(floor((p + 0.5) / float(u_brick_size)));
             uint k = texelFetch(u_brick_distance, clamp(b, ivec3(0), textureSize(u_brick_distance, 0) - 1), 0).r;
@@ -104,16 +110,40 @@ void main()
                 float t_exit = min(tb.x, min(tb.y, tb.z));
                 // the sample at the exit is evaluated (minus a hair for rounding)
                 int next = int(min(ceil((t_exit - t_start) / u_step - 1e-3), float(u_max_steps)));
-                i = max(i, next - 1); // the loop's i++ lands on `next`
+                leap = max(i, next - 1); // the loop's i++ lands on `next`
+#ifndef CLASSIFY_PREINT
+                i = leap;
                 continue;
+#endif
             }
         }
         taken++;
         float v = sample_value(p);
+#if defined(CLASSIFY_PREINT)
+        // A segment ending in an empty brick is still integrated: its front
+        // may lie in an occupied one. After a leap the next segment starts
+        // from the last sample inside the empty region.
+        vec4 seg = preint_segment(v_prev, v);
+        if (leap >= 0 && leap > i) {
+            i = leap;
+            v_prev = sample_value(o + (t_start + float(i) * u_step) * dir);
+        } else {
+            v_prev = v;
+        }
+        float a = seg.a;
+        if (a <= 0.0) continue;
+        vec3 rgb = seg.rgb / a;
+#elif defined(CLASSIFY_PRE)
+        vec4 c = pre_classified(voxel_to_tex(p));
+        if (c.a <= 0.0) continue;
+        float a = correct_opacity(c.a, u_step);
+        vec3 rgb = c.rgb;
+#else
         vec4 c = classify(v);
         if (c.a <= 0.0) continue;
         float a = correct_opacity(c.a, u_step);
         vec3 rgb = c.rgb;
+#endif
 #ifdef SHADING
         vec3 g = gradient_at(p, v);
 #ifdef REUSE_GRADIENTS

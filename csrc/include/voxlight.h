@@ -73,8 +73,10 @@ extern "C" {
 #define VXL_FILTER_COUNT 7
 
 /* ---- classification modes ---- */
-#define VXL_CLASSIFY_POST 0 /* interpolate the value, then look it up (default) */
-#define VXL_CLASSIFY_COUNT 1
+#define VXL_CLASSIFY_POST 0    /* interpolate the value, then look it up (default) */
+#define VXL_CLASSIFY_PRE 1     /* classify voxels first, then interpolate RGBA; shading uses the data gradient */
+#define VXL_CLASSIFY_PREINT 2  /* pre-integrated segments from a 2D (front, back) table */
+#define VXL_CLASSIFY_COUNT 3
 
 /* ---- transfer-function presets ---- */
 #define VXL_PRESET_AUTO 0 /* MRI or CT default, chosen from the data range */
@@ -210,7 +212,8 @@ typedef struct vxl_render_params {
     float early_termination;         /* opacity that stops a ray; 0 = 0.99 */
     float depth_threshold;           /* opacity that defines output depth; 0 = 0.5 */
     uint32_t no_skip;                /* 1: disable every in-frame skip (testing) */
-    uint32_t reserved[7];
+    uint32_t preint_size;            /* pre-integration table entries per axis; 0 = 256 */
+    uint32_t reserved[6];
 } vxl_render_params;
 
 VXL_API int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out);
@@ -296,6 +299,13 @@ VXL_API int vxl_phantom_iso_points(const vxl_phantom_desc *d, double iso, double
  * fixes the value normalisation). Slow: meant for small images. */
 VXL_API int vxl_reference_render(const vxl_phantom_desc *d, const vxl_volume *vol, const vxl_render_params *p,
                                  float *rgba, float *depth);
+
+/* The pre-integration table the PREINT mode uses, for inspection and tests:
+ * tf (tf_size straight RGBA entries, alpha per voxel), opacity_scale (0 = 1),
+ * segment length step (voxels), n entries per axis. out: n*n*4 floats,
+ * premultiplied RGBA, out[(back*n + front)*4 + c]. */
+VXL_API int vxl_preint_table(const float *tf, uint32_t tf_size, float opacity_scale, float step, uint32_t n,
+                             float *out);
 
 /* ------------------------------------------------------------------ misc */
 

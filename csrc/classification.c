@@ -1,0 +1,104 @@
+/* classification.c - GL resources of the pre- and pre-integrated modes,
+ * rebuilt only when what they depend on changes: the pre-classified volume
+ * on the classification (table, window, opacity scale), the pre-integration
+ * table on the classification, the step and the table size. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "preint.h"
+#include "renderer_internal.h"
+
+void vxl_classification_release(vxl_renderer *r)
+{
+    if (r->classified_tex) r->gl.DeleteTextures(1, &r->classified_tex);
+    if (r->preint_tex) r->gl.DeleteTextures(1, &r->preint_tex);
+    r->classified_tex = r->preint_tex = 0;
+    r->classified_key = r->preint_key = 0;
+    r->classified_bytes = 0;
+}
+
+/* The TF and window uniforms of classify.glsl, for the compute pass. */
+static void set_classify_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame *f)
+{
+    vxl_gl *gl = &r->gl;
+    vxl_uniform_i(r, prog, "u_tf", 2);
+    vxl_uniform_f(r, prog, "u_tf_size", (float)f->tf_size);
+    gl->Uniform2f(gl->GetUniformLocation(prog, "u_window"), f->window_offset, f->window_scale);
+    vxl_uniform_f(r, prog, "u_opacity_scale", f->opacity_scale);
+}
+
+static int prepare_pre(vxl_renderer *r, const vxl_frame *f)
+{
+    vxl_gl *gl = &r->gl;
+    uint64_t key = vxl_classification_key(f);
+    if (r->classified_tex && r->classified_key == key) goto bind;
+    uint64_t n = (uint64_t)r->dims[0] * r->dims[1] * r->dims[2];
+    if (!r->classified_tex) {
+        uint64_t need = r->volume_bytes + r->gradient_bytes + r->bspline_bytes + n * 4;
+        if (need > r->budget)
+            return vxl_fail(&r->err, VXL_ERR_LIMIT,
+                            "pre-classification needs %.1f MiB in all, over the memory budget of %.1f MiB",
+                            need / 1048576.0, r->budget / 1048576.0);
+        r->classified_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, (GLsizei)r->dims[0], (GLsizei)r->dims[1], (GLsizei)r->dims[2], 0,
+                       GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+        r->classified_bytes = n * 4;
+    }
+    GLuint prog;
+    int rc = vxl_program_get(r, VXL_PROG_CLASSIFY_VOLUME, 0, 0, &prog);
+    if (rc) return rc;
+    gl->UseProgram(prog);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
+    vxl_uniform_i(r, prog, "u_volume", 0);
+    set_classify_uniforms(r, prog, f); /* the TF is already on unit 2 */
+    gl->BindImageTexture(0, r->classified_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    gl->DispatchCompute((r->dims[0] + 3) / 4, (r->dims[1] + 3) / 4, (r->dims[2] + 3) / 4);
+    gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    gl->UseProgram(0);
+    r->classified_key = key;
+bind:
+    gl->ActiveTexture(GL_TEXTURE5);
+    gl->BindTexture(GL_TEXTURE_3D, r->classified_tex);
+    return vxl_gl_check(r, "pre-classifying the volume");
+}
+
+static int prepare_preint(vxl_renderer *r, const vxl_frame *f)
+{
+    vxl_gl *gl = &r->gl;
+    uint64_t key = vxl_classification_key(f) ^ ((uint64_t)f->preint_size << 40);
+    double step = f->step;
+    uint64_t bits;
+    memcpy(&bits, &step, sizeof bits);
+    key = (key ^ bits) * 1099511628211ull;
+    if (!(r->preint_tex && r->preint_key == key)) {
+        uint32_t n = f->preint_size;
+        float *table = malloc((size_t)n * n * 4 * sizeof *table);
+        if (!table) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for a %ux%u pre-integration table", n, n);
+        if (vxl_preint_build(f->tf, f->tf_size, f->opacity_scale, f->step, n, table)) {
+            free(table);
+            return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "cannot build the pre-integration table");
+        }
+        if (!r->preint_tex) r->preint_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_LINEAR);
+        else {
+            gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
+            gl->BindTexture(GL_TEXTURE_2D, r->preint_tex);
+        }
+        gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, (GLsizei)n, (GLsizei)n, 0, GL_RGBA, GL_FLOAT, table);
+        free(table);
+        r->preint_key = key;
+    }
+    gl->ActiveTexture(GL_TEXTURE6);
+    gl->BindTexture(GL_TEXTURE_2D, r->preint_tex);
+    return vxl_gl_check(r, "uploading the pre-integration table");
+}
+
+int vxl_classification_prepare(vxl_renderer *r, const vxl_frame *f)
+{
+    switch (f->classify) {
+    case VXL_CLASSIFY_PRE: return prepare_pre(r, f);
+    case VXL_CLASSIFY_PREINT: return prepare_preint(r, f);
+    default: return VXL_OK;
+    }
+}

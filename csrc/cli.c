@@ -15,6 +15,7 @@ static const char usage[] =
     "                  [--reuse-gradients] [--step S] [--azimuth DEG] [--elevation DEG] [--preset NAME]\n"
     "                  [--window LO:HI] [--no-shading] [--backend auto|osmesa|egl] [--memory-budget SIZE]\n"
     "                  [--gradient-store 8bit|16f|32f] [--classify post|pre|preint] [--no-jitter] [--no-skip]\n"
+    "                  [--gradient-opacity off|boundary|iso] [--gradient-ref G] [--iso VALUE] [--iso-thickness R]\n"
     "  voxlight info INPUT\n"
     "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic; presets: auto gray bone hot mri ct\n";
 
@@ -139,7 +140,22 @@ static int parse_render(int argc, char **argv, render_args *a)
         } else if (!strcmp(o, "--no-shading")) p->shading_off = 1;
         else if (!strcmp(o, "--no-jitter")) p->jitter_off = 1;
         else if (!strcmp(o, "--no-skip")) p->no_skip = 1;
-        else if (!strcmp(o, "--classify")) {
+        else if (!strcmp(o, "--gradient-opacity")) {
+            NEED_VALUE();
+            if (!strcasecmp(val, "off")) p->gradient_opacity = VXL_GOPACITY_OFF;
+            else if (!strcasecmp(val, "boundary")) p->gradient_opacity = VXL_GOPACITY_BOUNDARY;
+            else if (!strcasecmp(val, "iso")) p->gradient_opacity = VXL_GOPACITY_ISO;
+            else return die("unknown --gradient-opacity '%s' (off, boundary, iso)", val);
+        } else if (!strcmp(o, "--iso")) {
+            NEED_VALUE();
+            if (!parse_float(val, &p->iso_value)) return die("bad --iso '%s'", val);
+        } else if (!strcmp(o, "--iso-thickness")) {
+            NEED_VALUE();
+            if (!parse_float(val, &p->iso_thickness) || p->iso_thickness <= 0) return die("bad --iso-thickness '%s'", val);
+        } else if (!strcmp(o, "--gradient-ref")) {
+            NEED_VALUE();
+            if (!parse_float(val, &p->gradient_ref) || p->gradient_ref <= 0) return die("bad --gradient-ref '%s'", val);
+        } else if (!strcmp(o, "--classify")) {
             NEED_VALUE();
             if (!strcasecmp(val, "post")) p->classify = VXL_CLASSIFY_POST;
             else if (!strcasecmp(val, "pre")) p->classify = VXL_CLASSIFY_PRE;

@@ -205,6 +205,19 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown classify mode %u", p->classify);
     f->filter = p->filter;
     f->classify = p->classify;
+    f->gopacity = p->gradient_opacity;
+    if (f->gopacity >= VXL_GOPACITY_COUNT)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown gradient_opacity mode %u", f->gopacity);
+    f->gradient_ref = p->gradient_ref == 0 ? 0.05f : p->gradient_ref;
+    f->gradient_exp = p->gradient_exp == 0 ? 1.0f : p->gradient_exp;
+    f->iso_thickness = p->iso_thickness == 0 ? 1.0f : p->iso_thickness;
+    if (!(f->gradient_ref > 0 && f->gradient_ref < 1e6) || !(f->gradient_exp > 0 && f->gradient_exp <= 64) ||
+        !(f->iso_thickness > 0 && f->iso_thickness <= 1000) || !isfinite(p->iso_value))
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "gradient opacity parameters out of range");
+    {
+        double span = g->tex_hi - g->tex_lo;
+        f->iso_pos = (float)((p->iso_value - g->tex_lo) / (span != 0 ? span : 1));
+    }
     f->preint_size = p->preint_size ? p->preint_size : 256;
     if (f->preint_size < 16 || f->preint_size > 4096)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "preint_size %u must be in [16, 4096]", f->preint_size);
@@ -229,7 +242,9 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     rc = check_float(e, "early_termination", et, 1e-6f, 1);
     if (rc) return rc;
     f->early_termination = p->no_skip ? 2.0f : et; /* > 1: never stops early */
-    f->skip = !p->no_skip;
+    /* ISO opacity lives where the value is near iso_value, which the brick
+     * occupancy (derived from the table) does not know: no brick leaps. */
+    f->skip = !p->no_skip && p->gradient_opacity != VXL_GOPACITY_ISO;
     f->depth_threshold = p->depth_threshold == 0 ? 0.5f : p->depth_threshold;
     rc = check_float(e, "depth_threshold", f->depth_threshold, 1e-6f, 1);
     if (rc) return rc;

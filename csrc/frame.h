@@ -21,6 +21,8 @@ typedef struct vxl_frame {
     uint32_t width, height;
     uint32_t filter, shading, reuse, store, jitter, seed;
     uint32_t classify, preint_size;
+    uint32_t gopacity;          /* VXL_GOPACITY_* */
+    float gradient_ref, gradient_exp, iso_pos, iso_thickness; /* iso_pos: normalised value */
     float sample_distance, step;
     int max_steps;
     double view[16], proj[16], model[16];

@@ -11,8 +11,8 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
     "#define FILTER_SOBEL14 1\n", "#define FILTER_SOBEL26 1\n", "#define FILTER_PRECOMPUTED 1\n",
     "#define FILTER_CUBIC 1\n"};
 
-/* flags bits for RAYCAST: 1 shading, 2 reuse gradients, 4-8 the classify
- * mode; for GRAD_STORE: the store format */
+/* flags bits for RAYCAST: 1 shading, 2 reuse gradients, bits 2-3 the
+ * classify mode, bits 4-5 the gradient-opacity mode; for GRAD_STORE: the store format */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
 
 static int compile(vxl_renderer *r, GLenum type, const char *file, const char *defines, GLuint *out)
@@ -69,7 +69,8 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     int rc;
     switch (kind) {
     case VXL_PROG_RAYCAST:
-        snprintf(defines, sizeof defines, "%s%s%s%s", fdef, (flags & 1) ? "#define SHADING 1\n" : "",
+        snprintf(defines, sizeof defines, "%s#define GOPACITY %u\n%s%s%s", fdef, (flags >> 4) & 3,
+                 (flags & 1) ? "#define SHADING 1\n" : "",
                  (flags & 2) ? "#define REUSE_GRADIENTS 1\n" : "",
                  ((flags >> 2) & 3) == VXL_CLASSIFY_PRE      ? "#define CLASSIFY_PRE 1\n"
                  : ((flags >> 2) & 3) == VXL_CLASSIFY_PREINT ? "#define CLASSIFY_PREINT 1\n"

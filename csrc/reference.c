@@ -146,13 +146,26 @@ static void trace(const ref_ctx *c, double px, double py, float *out_rgba, float
     for (double t = t0; t < t1; t += c->step) {
         double p[3] = {o[0] + t * dir[0], o[1] + t * dir[1], o[2] + t * dir[2]}, value, g[3];
         vxl_phantom_eval(c->d, p, &value, g);
-        double col[4];
-        /* PREINT approximates the same continuous integral as POST, so both
-         * share this reference; PRE is a different image model. */
-        if (f->classify == VXL_CLASSIFY_PRE) classify_pre(c, p, col);
-        else classify(c, (value - c->vol->tex_lo) / span, col);
-        if (col[3] <= 0) continue;
-        double alpha = correct_opacity(col[3], c->step);
+        double col[4], vn = (value - c->vol->tex_lo) / span;
+        /* gradient magnitude in normalised value per voxel, as the shader sees it */
+        double gm = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) / fabs(span);
+        double alpha;
+        if (f->gopacity == VXL_GOPACITY_ISO) {
+            classify(c, f->iso_pos, col);
+            double dist = fabs(f->iso_pos - vn), r = f->iso_thickness;
+            double a = gm > 0 ? (dist <= r * gm ? col[3] * (1 - dist / (r * gm)) : 0) : (dist == 0 ? col[3] : 0);
+            alpha = correct_opacity(a, c->step);
+        } else {
+            /* PREINT approximates the same continuous integral as POST, so
+             * both share this reference; PRE is a different image model. */
+            if (f->classify == VXL_CLASSIFY_PRE) classify_pre(c, p, col);
+            else classify(c, vn, col);
+            if (col[3] <= 0) continue;
+            alpha = correct_opacity(col[3], c->step);
+            if (f->gopacity == VXL_GOPACITY_BOUNDARY)
+                alpha *= pow(fmin(gm / f->gradient_ref, 1.0), f->gradient_exp);
+        }
+        if (alpha <= 0) continue;
         if (f->shading) {
             double pos[3];
             for (int r = 0; r < 3; r++) pos[r] = c->mv[r] * p[0] + c->mv[4 + r] * p[1] + c->mv[8 + r] * p[2] + c->mv[12 + r];

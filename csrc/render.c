@@ -161,9 +161,10 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
 {
     vxl_gl *gl = &r->gl;
     GLuint prog;
-    uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2);
-    /* unshaded rays never evaluate gradients: one program serves every filter */
-    uint32_t filter = f->shading ? f->filter : VXL_FILTER_CENTRAL;
+    uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2) |
+                     (f->gopacity << 4);
+    /* rays that never evaluate gradients: one program serves every filter */
+    uint32_t filter = f->shading || f->gopacity ? f->filter : VXL_FILTER_CENTRAL;
     int rc = vxl_program_get(r, VXL_PROG_RAYCAST, filter, flags, &prog);
     if (!rc) rc = ensure_framebuffer(r, f->width, f->height);
     if (rc) return rc;
@@ -181,6 +182,10 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     vxl_uniform_i(r, prog, "u_classified", 5);
     vxl_uniform_i(r, prog, "u_preint", 6);
     vxl_uniform_f(r, prog, "u_preint_size", (float)f->preint_size);
+    if (f->gopacity == VXL_GOPACITY_BOUNDARY)
+        gl->Uniform2f(gl->GetUniformLocation(prog, "u_gopacity_param"), f->gradient_ref, f->gradient_exp);
+    else if (f->gopacity == VXL_GOPACITY_ISO)
+        gl->Uniform2f(gl->GetUniformLocation(prog, "u_gopacity_param"), f->iso_pos, f->iso_thickness);
     const GLuint zeros[4] = {0, 0, 0, 0};
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[2]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zeros, zeros, GL_DYNAMIC_READ);

@@ -48,3 +48,22 @@ vec4 preint_segment(float v_front, float v_back)
     return textureLod(u_preint, (x * (u_preint_size - 1.0) + 0.5) / u_preint_size, 0.0);
 }
 #endif
+
+#ifndef GOPACITY
+#define GOPACITY 0
+#endif
+
+// Levoy's opacity functions: opacity from the gradient magnitude (g in
+// normalised value per voxel). BOUNDARY scales the table opacity; ISO
+// replaces it by a surface of constant thickness around u_iso.
+uniform vec2 u_gopacity_param; // boundary: (ref, exp); iso: (normalised value, thickness)
+
+float gradient_opacity(float alpha, float v, float g)
+{
+#if GOPACITY == 1
+    return alpha * pow(clamp(g / u_gopacity_param.x, 0.0, 1.0), u_gopacity_param.y);
+#endif
+    float d = abs(u_gopacity_param.x - v), r = u_gopacity_param.y;
+    if (g > 0.0) return d <= r * g ? alpha * (1.0 - d / (r * g)) : 0.0;
+    return d == 0.0 ? alpha : 0.0;
+}

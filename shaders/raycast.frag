@@ -1,9 +1,14 @@
 // raycast.frag - front-to-back ray casting with premultiplied compositing.
 // Variants by define: FILTER_* (gradients.glsl), SHADING, REUSE_GRADIENTS,
-// CLASSIFY_PRE / CLASSIFY_PREINT (classify.glsl; post-classification otherwise).
+// CLASSIFY_PRE / CLASSIFY_PREINT (classify.glsl; post-classification otherwise),
+// GOPACITY 1 (boundary) / 2 (iso-surface): Levoy's gradient-magnitude opacity.
 #include "gradients.glsl"
 #include "classify.glsl"
 #include "shading.glsl"
+
+#ifndef GOPACITY
+#define GOPACITY 0
+#endif
 
 uniform mat4 u_inv_mvp;      // clip -> voxel space
 uniform mat4 u_mv;           // voxel -> view space
@@ -119,7 +124,15 @@ void main()
         }
         taken++;
         float v = sample_value(p);
-#if defined(CLASSIFY_PREINT)
+#if GOPACITY == 2
+        // iso-surface of constant thickness: the colour and opacity of the
+        // iso value, fading out over iso_thickness voxels of the gradient
+        vec4 c = classify(u_gopacity_param.x);
+        vec3 g = gradient_at(p, v);
+        float a = correct_opacity(gradient_opacity(c.a, v, length(g)), u_step);
+        if (a <= 0.0) continue;
+        vec3 rgb = c.rgb;
+#elif defined(CLASSIFY_PREINT)
         // A segment ending in an empty brick is still integrated: its front
         // may lie in an occupied one. After a leap the next segment starts
         // from the last sample inside the empty region.
@@ -144,8 +157,15 @@ void main()
         float a = correct_opacity(c.a, u_step);
         vec3 rgb = c.rgb;
 #endif
-#ifdef SHADING
+#if GOPACITY == 1
         vec3 g = gradient_at(p, v);
+        a = gradient_opacity(a, v, length(g)); // region boundaries: scaled by |grad|
+        if (a <= 0.0) continue;
+#endif
+#ifdef SHADING
+#if GOPACITY == 0
+        vec3 g = gradient_at(p, v);
+#endif
 #ifdef REUSE_GRADIENTS
         g = reuse_gradient(gs, g);
 #endif

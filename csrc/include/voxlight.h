@@ -78,6 +78,12 @@ extern "C" {
 #define VXL_CLASSIFY_PREINT 2  /* pre-integrated segments from a 2D (front, back) table */
 #define VXL_CLASSIFY_COUNT 3
 
+/* ---- gradient-magnitude opacity ---- */
+#define VXL_GOPACITY_OFF 0
+#define VXL_GOPACITY_BOUNDARY 1
+#define VXL_GOPACITY_ISO 2
+#define VXL_GOPACITY_COUNT 3
+
 /* ---- transfer-function presets ---- */
 #define VXL_PRESET_AUTO 0 /* MRI or CT default, chosen from the data range */
 #define VXL_PRESET_GRAY 1
@@ -213,7 +219,18 @@ typedef struct vxl_render_params {
     float depth_threshold;           /* opacity that defines output depth; 0 = 0.5 */
     uint32_t no_skip;                /* 1: disable every in-frame skip (testing) */
     uint32_t preint_size;            /* pre-integration table entries per axis; 0 = 256 */
-    uint32_t reserved[6];
+
+    /* Levoy's opacity functions (gradient-magnitude opacity), VXL_GOPACITY_*:
+     * BOUNDARY multiplies opacity by min(1, |grad| / gradient_ref)^gradient_exp
+     * (region boundaries, as MRIcroGL's boundExp and VTK's gradient opacity);
+     * ISO draws the iso-surface at iso_value with a constant thickness of
+     * iso_thickness voxels: opacity = tf(iso) * (1 - |iso - f| / (r |grad|)). */
+    uint32_t gradient_opacity;
+    float gradient_ref;              /* normalised value per voxel; 0 = 0.05 */
+    float gradient_exp;              /* 0 = 1 */
+    float iso_value;                 /* data units (ISO) */
+    float iso_thickness;             /* voxels; 0 = 1 (ISO) */
+    uint32_t reserved[1];
 } vxl_render_params;
 
 VXL_API int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out);

@@ -262,6 +262,90 @@ static int run_workload(FILE *csv, const options *o, workload *w)
     return rc;
 }
 
+/* A thin opacity spike on the sphere phantom: the high-frequency transfer
+ * function where classification modes differ. Post, pre and pre-integrated
+ * classification across steps, against the analytic reference. */
+static int run_spike_study(FILE *csv, const options *o)
+{
+    enum { NTF = 256 };
+    static float tf[NTF * 4];
+    for (int i = 0; i < NTF; i++) {
+        double x = i / (NTF - 1.0);
+        tf[4 * i + 0] = (float)(0.4 + 0.6 * x);
+        tf[4 * i + 1] = (float)(0.9 - 0.5 * x);
+        tf[4 * i + 2] = 0.5f;
+        tf[4 * i + 3] = (float)(0.8 * exp(-0.5 * pow((x - 0.5) / 0.02, 2)));
+    }
+    vxl_phantom_desc pd = {sizeof pd, VXL_PHANTOM_SPHERE, {64, 64, 64}, 0, 0};
+    vxl_volume *v = NULL;
+    vxl_renderer *r = NULL;
+    size_t n = (size_t)o->size * o->size * 4;
+    float *ref = malloc(n * sizeof *ref), *img = malloc(n * sizeof *img);
+    int rc = !ref || !img || vxl_phantom_create(&pd, &v) || vxl_renderer_create(NULL, &r) || vxl_renderer_set_volume(r, v);
+    vxl_render_params p = base_params(o->size);
+    p.tf_rgba = tf;
+    p.tf_size = NTF;
+    p.has_window = 1;
+    p.window_low = 0.42f;
+    p.window_high = 0.62f;
+    p.shading_off = 1;
+    if (!rc) rc = vxl_reference_render(&pd, v, &p, ref, NULL);
+    const float steps[5] = {2.0f, 1.0f, 0.5f, 0.25f, 0.125f};
+    const char *modes[VXL_CLASSIFY_COUNT] = {"post", "pre", "preint"};
+    vxl_renderer_info info = {.struct_size = sizeof info};
+    if (!rc) vxl_renderer_get_info(r, &info);
+    for (uint32_t m = 0; m < VXL_CLASSIFY_COUNT && !rc; m++)
+        for (int s = 0; s < (o->quick ? 3 : 5) && !rc; s++) {
+            p.classify = m;
+            p.step = steps[s];
+            double t[64];
+            rc = vxl_render(r, &p, img, NULL);
+            for (uint32_t i = 0; i < o->frames && !rc; i++) {
+                double t0 = now_ms();
+                rc = vxl_render(r, &p, img, NULL);
+                t[i] = now_ms() - t0;
+            }
+            if (rc) break;
+            qsort(t, o->frames, sizeof *t, cmp_d);
+            double rmse, psnr, maxabs;
+            image_error(img, ref, n, &rmse, &psnr, &maxabs);
+            fprintf(csv, "spike64,central,,%g,0,%s,%s,voxlight,%.2f,1,,,%.6f,%.2f,%.5f,%ux%u,%u,,analytic\n", p.step,
+                    modes[m], info.backend_name, t[o->frames / 2], rmse, psnr, maxabs, o->size, o->size, o->frames);
+        }
+    if (rc) fprintf(stderr, "bench: spike study: %s\n", vxl_last_error());
+    vxl_renderer_destroy(r);
+    vxl_volume_destroy(v);
+    free(ref);
+    free(img);
+    return rc;
+}
+
+/* Rebuild time of the pre-integration table, the cost of every transfer
+ * function edit in PREINT mode. */
+static void time_preint_tables(const char *path)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return;
+    float tf[256 * 4];
+    for (int i = 0; i < 256; i++)
+        for (int c = 0; c < 4; c++) tf[4 * i + c] = (float)(0.5 + 0.5 * sin(i * 0.1 + c));
+    fprintf(f, "table_size,ms_median\n");
+    const uint32_t sizes[2] = {256, 1024};
+    for (int k = 0; k < 2; k++) {
+        float *out = malloc((size_t)sizes[k] * sizes[k] * 4 * sizeof *out);
+        double t[7];
+        for (int i = 0; i < 7 && out; i++) {
+            double t0 = now_ms();
+            vxl_preint_table(tf, 256, 1, 0.5f, sizes[k], out);
+            t[i] = now_ms() - t0;
+        }
+        qsort(t, 7, sizeof *t, cmp_d);
+        if (out) fprintf(f, "%u,%.2f\n", sizes[k], t[3]);
+        free(out);
+    }
+    fclose(f);
+}
+
 int main(int argc, char **argv)
 {
     options o = {.quick = 0, .size = 512, .frames = 5, .csv = "bench/results.csv", .scene_dir = "bench/out",
@@ -296,7 +380,10 @@ int main(int argc, char **argv)
     }
     fprintf(csv, "workload,filter,sample_distance,step,reuse_gradients,classify,backend,renderer,ms_median,"
                  "fetches_per_sample,ang_mean_deg,ang_p95_deg,rmse,psnr_db,max_abs,size,frames,samples,reference\n");
-    int rc = 0;
+    char preint_path[512];
+    snprintf(preint_path, sizeof preint_path, "%s/preint_timing.csv", o.scene_dir);
+    time_preint_tables(preint_path);
+    int rc = run_spike_study(csv, &o);
     for (int i = 0; i < 4 && !rc; i++) {
         double t = now_ms();
         rc = run_workload(csv, &o, &w[i]);

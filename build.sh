@@ -110,14 +110,35 @@ case "$cmd" in
         ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions="$ROOT/tests/lsan.supp" UBSAN_OPTIONS=print_stacktrace=1 \
             run_suite "C tests under ASan+UBSan" run_c_tests build-asan
         run_suite "CLI tests" /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/cli
+        run_suite "Benchmark smoke" /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/bench
         if [ -x tools/run_blender_tests.sh ]; then
             run_suite "Blender and binding tests" tools/run_blender_tests.sh build
         fi
         echo "=== all suites"
         echo "$TOTAL_PASS passed, $TOTAL_FAIL failed"
         [ "$TOTAL_FAIL" -eq 0 ] ;;
+    stress)
+        # the larger stability sweep; the default matrix runs in ./build.sh test
+        install_deps; build
+        ./build/tests/test_stress --full ;;
+    bench)
+        # ./build.sh bench [--quick]: run time against error, written to
+        # bench/results.csv, bench/skipping.csv, docs/benchmark.{md,png}
+        install_deps; build
+        mode=${2:---full}
+        mkdir -p bench/out
+        ./build/voxlight-bench "$mode" --out bench/results.csv --scene-dir bench/out
+        ./build/voxlight-skipbench $([ "$mode" = --quick ] && echo --quick) --out bench/skipping.csv
+        if [ -f bench/vtk_peer.py ]; then
+            xvfb-run -a -s "-screen 0 1024x768x24" /usr/bin/python3 bench/vtk_peer.py bench/out/scene_ch2better.json \
+                --out bench/results.csv
+        fi
+        if [ -f bench/plot.py ]; then
+            /usr/bin/python3 bench/plot.py bench/results.csv --png docs/benchmark.png --md docs/benchmark.md \
+                --command "./build.sh bench $mode"
+        fi ;;
     clean)
         make clean ;;
     *)
-        echo "usage: ./build.sh [build|demo|test|clean]" >&2; exit 2 ;;
+        echo "usage: ./build.sh [build|demo|test|stress|bench [--quick]|clean]" >&2; exit 2 ;;
 esac

@@ -51,13 +51,46 @@ $(BUILD)/voxlight-bench: bench/bench.c $(BUILD)/libvoxlight.so
 $(BUILD)/voxlight-skipbench: bench/skip_study.c $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
-$(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h) $(BUILD)/libvoxlight.so | $(BUILD)/tests
+$(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h tests/fuzz/*.h) $(BUILD)/libvoxlight.so | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
 
 $(BUILD)/obj $(BUILD)/gen $(BUILD)/tests:
 	mkdir -p $@
 
+# ---- fuzzing (issue 7): `make fuzz` builds one libFuzzer binary per loader
+# in build/fuzz/ with Debian's clang under ASan+UBSan, the loaders compiled
+# in directly, plus the seed writer; ./build.sh fuzz / test run them.
+FUZZ_BUILD := build/fuzz
+FUZZ_SAN := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+FUZZ_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include -Icsrc
+FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include -Icsrc \
+	$(shell pkg-config --cflags OpenImageIO)
+FUZZ_LIB_C := volume.c error.c nifti.c nrrd.c metaimage.c loader_util.c
+FUZZ_LIB_CXX := image_stack.cpp
+FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
+FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))
+
+fuzz: $(FUZZ_TARGETS) $(FUZZ_BUILD)/make_seeds
+
+$(FUZZ_BUILD)/obj/%.o: csrc/%.c $(wildcard csrc/*.h csrc/include/*.h) | $(FUZZ_BUILD)/obj
+	clang $(FUZZ_CFLAGS) -c $< -o $@
+
+$(FUZZ_BUILD)/obj/%.o: csrc/%.cpp $(wildcard csrc/*.h csrc/include/*.h) | $(FUZZ_BUILD)/obj
+	clang++ $(FUZZ_CXXFLAGS) -c $< -o $@
+
+$(FUZZ_BUILD)/obj/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h csrc/include/voxlight.h | $(FUZZ_BUILD)/obj
+	clang $(FUZZ_CFLAGS) -c $< -o $@
+
+$(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/fuzz_%.o $(FUZZ_OBJ)
+	clang++ $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@ $(LIBS)
+
+$(FUZZ_BUILD)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/writers.h tests/nifti_writer.h | $(FUZZ_BUILD)/obj
+	$(CC) -std=c11 -D_GNU_SOURCE $(WARN) -O1 -Itests $< -o $@ -lz
+
+$(FUZZ_BUILD)/obj:
+	mkdir -p $@
+
 clean:
 	rm -rf build build-asan
 
-.PHONY: all clean
+.PHONY: all clean fuzz

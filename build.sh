@@ -10,10 +10,12 @@ ROOT=$(pwd)
 # Debian packages the project needs: compilers, GL headers (we never link GL),
 # OSMesa and Mesa's EGL for the offscreen context, OpenImageIO for image files,
 # the demo brain (mricron-data), Blender and Xvfb for the add-on and its tests,
-# numpy and pytest for the Python tests.
+# numpy and pytest for the Python tests, clang with its sanitizer/libFuzzer
+# runtime for the loader fuzz targets (tests/fuzz/).
 PACKAGES=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
           libgl1-mesa-dri libosmesa6 libosmesa6-dev libopenimageio-dev mricron-data blender
-          xvfb xauth python3 python3-numpy python3-pytest zip unzip)
+          xvfb xauth python3 python3-numpy python3-pytest zip unzip
+          clang libclang-rt-14-dev)
 
 install_deps() {
     local missing=()
@@ -109,6 +111,9 @@ case "$cmd" in
         # by library name (tests/lsan.supp); ours are not.
         ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions="$ROOT/tests/lsan.supp" UBSAN_OPTIONS=print_stacktrace=1 \
             run_suite "C tests under ASan+UBSan" run_c_tests build-asan
+        # every file loader under libFuzzer + ASan/UBSan, 20 s each, after
+        # replaying tests/crashers/ (./build.sh fuzz runs them longer)
+        run_suite "Loader fuzzing (ASan+UBSan)" tests/fuzz/run.sh 20
         run_suite "CLI tests" /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/cli
         run_suite "Benchmark smoke" /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/bench
         if [ -x tools/run_blender_tests.sh ]; then
@@ -117,6 +122,13 @@ case "$cmd" in
         echo "=== all suites"
         echo "$TOTAL_PASS passed, $TOTAL_FAIL failed"
         [ "$TOTAL_FAIL" -eq 0 ] ;;
+    fuzz)
+        # ./build.sh fuzz [SECONDS [TARGET...]]: each loader's libFuzzer target
+        # (nifti nrrd metaimage tiff png) for SECONDS (default 300); crashes
+        # are kept in tests/crashers/<target>/
+        install_deps; build
+        shift
+        tests/fuzz/run.sh "${1:-300}" "${@:2}" ;;
     stress)
         # the larger stability sweep; the default matrix runs in ./build.sh test
         install_deps; build
@@ -140,5 +152,5 @@ case "$cmd" in
     clean)
         make clean ;;
     *)
-        echo "usage: ./build.sh [build|demo|test|stress|bench [--quick]|clean]" >&2; exit 2 ;;
+        echo "usage: ./build.sh [build|demo|test|fuzz [SECONDS [TARGET...]]|stress|bench [--quick]|clean]" >&2; exit 2 ;;
 esac

@@ -74,9 +74,11 @@ static int cmd_info(int argc, char **argv)
     if (vxl_volume_load(argv[0], NULL, &v)) return die("%s", vxl_last_error());
     vxl_volume_info in = {.struct_size = sizeof in};
     vxl_volume_get_info(v, &in);
-    static const char *const src[] = {"none (pixdim)", "qform", "sform"};
+    /* NIfTI names its two affines; other formats store one (reported as 2) */
+    const char *const src[] = {"none (spacing)", "qform", in.nifti_version ? "sform" : "from header"};
     printf("file:        %s\n", argv[0]);
-    printf("format:      NIfTI-%u\n", in.nifti_version);
+    if (in.nifti_version) printf("format:      NIfTI-%u\n", in.nifti_version);
+    else printf("format:      %s\n", strrchr(argv[0], '.') ? strrchr(argv[0], '.') + 1 : "image stack");
     printf("dimensions:  %u x %u x %u\n", in.dims[0], in.dims[1], in.dims[2]);
     printf("spacing:     %g x %g x %g mm\n", in.spacing[0], in.spacing[1], in.spacing[2]);
     printf("data type:   %s (stored as %u-bit %s)\n", dtype_name(in.dtype), in.texture_bits,

@@ -46,4 +46,15 @@ int vxl_volume_build(const void *raw, uint32_t dtype, const uint32_t dims[3], co
 /* NIfTI-1/2 reader (.nii, .nii.gz, .hdr/.img[.gz]); in nifti.c. */
 int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 
+/* The other file loaders, same contract as vxl_nifti_load: *out is NULL on
+ * failure, every failure is a vxl_fail naming the file, sizes from headers
+ * pass vxl_volume_check_limits before any allocation. */
+/* NRRD (.nrrd attached, .nhdr detached; raw/gzip); in nrrd.c. */
+int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* MetaImage (.mha, .mhd + ElementDataFile; raw/zlib); in metaimage.c. */
+int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* TIFF/PNG through OpenImageIO: a multi-page TIFF, a numbered series
+ * (slice_0001.tif ...) or a folder of images; in image_stack.cpp. */
+int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+
 #endif

@@ -109,6 +109,10 @@ typedef struct vxl_load_options {
     uint32_t struct_size;
     uint32_t max_dim;             /* largest size of any axis; 0 = 65536 */
     uint64_t memory_budget_bytes; /* largest voxel storage; 0 = 2 GiB */
+    /* Appended after ABI 1's first release; read only when struct_size
+     * covers it (0 = all of this header's struct). */
+    double voxel_size[3];         /* x, y, z in mm for inputs without geometry
+                                     (TIFF/PNG stacks); 0 = 1 mm */
 } vxl_load_options;
 
 /* A volume handed over from memory (e.g. a numpy array). Data is x fastest:

@@ -1,0 +1,399 @@
+// image_stack.cpp - image stacks through OpenImageIO: a multi-page TIFF, a
+// numbered series (slice_0001.tif, slice_0002.tif, ... or .png), or a folder
+// of .tif/.tiff/.png images, as one volume.
+//
+// Layout: slice k is image k of the stack (pages in file order; numbered
+// files by number; a folder in natural name order). Naming one file of a
+// numbered series (same prefix, extension and digit count, numbers without
+// gaps) loads the whole series; naming the folder loads every image in it. Within a slice, voxel
+// (i, j) is pixel (x = i, y = height-1-j): files store the top row first,
+// our voxel j axis points up. Images carry no reliable geometry, so the
+// affine is diag(voxel size) from vxl_load_options.voxel_size (1 mm when
+// unset). Pixel types: 8/16/32-bit integers, half/float/double; colour
+// images are reduced to Rec. 709 luminance, grey+alpha to the grey channel.
+//
+// Hostile input: the first image's header sizes pass the memory budget
+// before any voxel is allocated, every other slice must match it exactly
+// (size, channels, type), and OpenImageIO's messages are passed on with the
+// file name. The library stays C11; this file is only the extern "C" glue.
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <dirent.h>
+#include <limits>
+#include <memory>
+#include <string>
+#include <sys/stat.h>
+#include <vector>
+
+extern "C" {
+#include "loader_util.h"
+}
+
+namespace {
+
+struct Slice {
+    std::string path;
+    int subimage;
+};
+
+std::string lower(std::string s)
+{
+    for (auto &c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+std::string extension(const std::string &name)
+{
+    size_t dot = name.rfind('.');
+    size_t slash = name.rfind('/');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+    return lower(name.substr(dot));
+}
+
+bool is_image_name(const std::string &name)
+{
+    std::string e = extension(name);
+    return e == ".tif" || e == ".tiff" || e == ".png";
+}
+
+// Natural order: runs of digits compare by value, so slice_2 < slice_10.
+bool natural_less(const std::string &a, const std::string &b)
+{
+    size_t i = 0, j = 0;
+    while (i < a.size() && j < b.size()) {
+        if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+            size_t i2 = i, j2 = j;
+            while (i2 < a.size() && a[i2] == '0') i2++;
+            while (j2 < b.size() && b[j2] == '0') j2++;
+            size_t ie = i2, je = j2;
+            while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ie++;
+            while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) je++;
+            if (ie - i2 != je - j2) return ie - i2 < je - j2;
+            int c = a.compare(i2, ie - i2, b, j2, je - j2);
+            if (c) return c < 0;
+            i = ie;
+            j = je;
+        } else {
+            if (a[i] != b[j]) return a[i] < b[j];
+            i++;
+            j++;
+        }
+    }
+    return a.size() - i < b.size() - j;
+}
+
+std::string dir_of(const std::string &p)
+{
+    size_t s = p.rfind('/');
+    return s == std::string::npos ? std::string(".") : (s == 0 ? std::string("/") : p.substr(0, s));
+}
+
+std::string join(const std::string &dir, const std::string &name)
+{
+    return dir == "/" ? "/" + name : dir + "/" + name;
+}
+
+bool is_regular(const std::string &p)
+{
+    struct stat st;
+    return stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+int list_dir(const std::string &dir, std::vector<std::string> &names, vxl_err *e)
+{
+    DIR *d = opendir(dir.c_str());
+    if (!d) return vxl_fail(e, VXL_ERR_IO, "cannot open folder '%s': %s", dir.c_str(), std::strerror(errno));
+    while (struct dirent *ent = readdir(d)) {
+        std::string n = ent->d_name;
+        if (n.empty() || n[0] == '.') continue;
+        names.push_back(n);
+    }
+    closedir(d);
+    return VXL_OK;
+}
+
+// Splits "slice_0012.tif" into prefix "slice_", number 12, ext ".tif".
+bool split_numbered(const std::string &name, std::string &prefix, unsigned long long &number, std::string &ext,
+                    size_t &width)
+{
+    size_t dot = name.rfind('.');
+    if (dot == std::string::npos || dot == 0) return false;
+    size_t end = dot, start = dot;
+    while (start > 0 && std::isdigit(static_cast<unsigned char>(name[start - 1]))) start--;
+    if (start == end || end - start > 9) return false;
+    prefix = name.substr(0, start);
+    width = end - start;
+    number = std::stoull(name.substr(start, end - start));
+    ext = lower(name.substr(dot));
+    return true;
+}
+
+std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path, vxl_err *e, int *rc)
+{
+    *rc = VXL_OK;
+    if (!is_regular(path)) {
+        *rc = vxl_fail(e, VXL_ERR_IO, "cannot open '%s': not a readable regular file", path.c_str());
+        return nullptr;
+    }
+    auto in = OIIO::ImageInput::create(path);
+    if (!in) {
+        std::string msg = OIIO::geterror();
+        *rc = vxl_fail(e, VXL_ERR_FORMAT, "'%s': no image reader for this file: %s", path.c_str(), msg.c_str());
+        return nullptr;
+    }
+    in->threads(1); // slices are tiny work items: no thread-pool hand-off per read
+    OIIO::ImageSpec config, spec;
+    config.attribute("oiio:UnassociatedAlpha", 1); // keep grey values of grey+alpha images as stored
+    if (!in->open(path, spec, config)) {
+        std::string msg = in->geterror();
+        *rc = vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read image: %s", path.c_str(),
+                       msg.empty() ? "unknown error" : msg.c_str());
+        return nullptr;
+    }
+    return in;
+}
+
+uint32_t dtype_for(OIIO::TypeDesc t, OIIO::TypeDesc &read_as)
+{
+    using OIIO::TypeDesc;
+    switch (t.basetype) {
+    case TypeDesc::UINT8: read_as = TypeDesc::UINT8; return VXL_DTYPE_U8;
+    case TypeDesc::INT8: read_as = TypeDesc::INT8; return VXL_DTYPE_I8;
+    case TypeDesc::UINT16: read_as = TypeDesc::UINT16; return VXL_DTYPE_U16;
+    case TypeDesc::INT16: read_as = TypeDesc::INT16; return VXL_DTYPE_I16;
+    case TypeDesc::UINT32: read_as = TypeDesc::UINT32; return VXL_DTYPE_U32;
+    case TypeDesc::INT32: read_as = TypeDesc::INT32; return VXL_DTYPE_I32;
+    case TypeDesc::HALF:
+    case TypeDesc::FLOAT: read_as = TypeDesc::FLOAT; return VXL_DTYPE_F32;
+    case TypeDesc::DOUBLE: read_as = TypeDesc::DOUBLE; return VXL_DTYPE_F64;
+    default: return 0;
+    }
+}
+
+template <typename T>
+void to_gray(const T *src, int nch, size_t w, size_t h, T *dst_slice)
+{
+    // src: h rows top first, nch channels; dst: rows bottom first
+    for (size_t y = 0; y < h; y++) {
+        const T *row = src + y * w * static_cast<size_t>(nch);
+        T *out = dst_slice + (h - 1 - y) * w;
+        for (size_t x = 0; x < w; x++) {
+            const T *p = row + x * static_cast<size_t>(nch);
+            if (nch < 3) {
+                out[x] = p[0];
+            } else {
+                double v = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                if (std::numeric_limits<T>::is_integer) {
+                    v = std::nearbyint(v);
+                    v = std::min<double>(std::max<double>(v, std::numeric_limits<T>::lowest()),
+                                         std::numeric_limits<T>::max());
+                }
+                out[x] = static_cast<T>(v);
+            }
+        }
+    }
+}
+
+void gray_slice(uint32_t dtype, const void *src, int nch, size_t w, size_t h, void *dst)
+{
+    switch (dtype) {
+    case VXL_DTYPE_U8: to_gray(static_cast<const uint8_t *>(src), nch, w, h, static_cast<uint8_t *>(dst)); break;
+    case VXL_DTYPE_I8: to_gray(static_cast<const int8_t *>(src), nch, w, h, static_cast<int8_t *>(dst)); break;
+    case VXL_DTYPE_U16: to_gray(static_cast<const uint16_t *>(src), nch, w, h, static_cast<uint16_t *>(dst)); break;
+    case VXL_DTYPE_I16: to_gray(static_cast<const int16_t *>(src), nch, w, h, static_cast<int16_t *>(dst)); break;
+    case VXL_DTYPE_U32: to_gray(static_cast<const uint32_t *>(src), nch, w, h, static_cast<uint32_t *>(dst)); break;
+    case VXL_DTYPE_I32: to_gray(static_cast<const int32_t *>(src), nch, w, h, static_cast<int32_t *>(dst)); break;
+    case VXL_DTYPE_F32: to_gray(static_cast<const float *>(src), nch, w, h, static_cast<float *>(dst)); break;
+    default: to_gray(static_cast<const double *>(src), nch, w, h, static_cast<double *>(dst)); break;
+    }
+}
+
+// The slices of a numbered series that path belongs to; empty when path is
+// not numbered. Gaps and duplicate numbers are errors.
+int numbered_series(const std::string &path, std::vector<Slice> &slices, vxl_err *e)
+{
+    std::string dir = dir_of(path);
+    size_t slash = path.rfind('/');
+    std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
+    std::string prefix, ext;
+    unsigned long long num;
+    size_t width;
+    if (!split_numbered(base, prefix, num, ext, width)) return VXL_OK;
+    std::vector<std::string> names;
+    int rc = list_dir(dir, names, e);
+    if (rc) return rc;
+    std::vector<std::pair<unsigned long long, std::string>> found;
+    for (const auto &n : names) {
+        std::string p2, e2;
+        unsigned long long k;
+        size_t w2;
+        // same prefix, extension and digit count (slice_0009, slice_0010):
+        // unrelated names such as scan8.png / scan16.png are no series
+        if (split_numbered(n, p2, k, e2, w2) && p2 == prefix && e2 == ext && w2 == width) found.emplace_back(k, n);
+    }
+    if (found.size() < 2) return VXL_OK;
+    std::sort(found.begin(), found.end());
+    for (size_t i = 1; i < found.size(); i++) {
+        if (found[i].first == found[i - 1].first)
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s' and '%s' in '%s' have the same slice number %llu",
+                            found[i - 1].second.c_str(), found[i].second.c_str(), dir.c_str(), found[i].first);
+        if (found[i].first != found[i - 1].first + 1)
+            return vxl_fail(e, VXL_ERR_FORMAT,
+                            "numbered series '%s*%s' in '%s': missing slices between %llu ('%s') and %llu ('%s')",
+                            prefix.c_str(), ext.c_str(), dir.c_str(), found[i - 1].first,
+                            found[i - 1].second.c_str(), found[i].first, found[i].second.c_str());
+    }
+    for (const auto &f : found) slices.push_back({join(dir, f.second), 0});
+    return VXL_OK;
+}
+
+// keep/keep_path receive the first file, still open, so it is not opened twice.
+int collect_slices(const std::string &path, const vxl_load_options *opt, std::vector<Slice> &slices,
+                   std::unique_ptr<OIIO::ImageInput> &keep, std::string &keep_path, vxl_err *e)
+{
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0)
+        return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path.c_str(), std::strerror(errno));
+    if (S_ISDIR(st.st_mode)) {
+        std::vector<std::string> names;
+        int rc = list_dir(path, names, e);
+        if (rc) return rc;
+        names.erase(std::remove_if(names.begin(), names.end(), [](const std::string &n) { return !is_image_name(n); }),
+                    names.end());
+        if (names.empty())
+            return vxl_fail(e, VXL_ERR_FORMAT, "folder '%s' has no .tif, .tiff or .png images", path.c_str());
+        std::sort(names.begin(), names.end(), natural_less);
+        for (const auto &n : names) slices.push_back({join(path, n), 0});
+        return VXL_OK;
+    }
+    // A file: all pages of a multi-page TIFF, else its numbered series.
+    int rc;
+    auto in = open_image(path, e, &rc);
+    if (!in) return rc;
+    uint32_t max_pages = (opt && opt->max_dim) ? opt->max_dim : VXL_DEFAULT_MAX_DIM;
+    int pages = 1;
+    while (in->seek_subimage(pages, 0)) {
+        if (static_cast<uint32_t>(pages) >= max_pages)
+            return vxl_fail(e, VXL_ERR_LIMIT, "'%s' has more than %u pages, the per-axis limit", path.c_str(),
+                            max_pages);
+        pages++;
+    }
+    (void)in->geterror(); // seeking past the last page is not an error
+    keep = std::move(in);
+    keep_path = path;
+    if (pages > 1) {
+        for (int s = 0; s < pages; s++) slices.push_back({path, s});
+        return VXL_OK;
+    }
+    rc = numbered_series(path, slices, e);
+    if (rc) return rc;
+    if (slices.empty()) slices.push_back({path, 0});
+    return VXL_OK;
+}
+
+std::string slice_name(const Slice &s)
+{
+    return s.subimage ? s.path + " (page " + std::to_string(s.subimage + 1) + ")" : s.path;
+}
+
+} // namespace
+
+extern "C" int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+{
+    if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
+    *out = nullptr;
+    if (!path || !*path) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "path is empty");
+    try {
+        std::vector<Slice> slices;
+        std::unique_ptr<OIIO::ImageInput> in;
+        std::string open_path;
+        int rc = collect_slices(path, opt, slices, in, open_path, e);
+        if (rc) return rc;
+        uint32_t max_dim = (opt && opt->max_dim) ? opt->max_dim : VXL_DEFAULT_MAX_DIM;
+        if (slices.size() > max_dim)
+            return vxl_fail(e, VXL_ERR_LIMIT, "'%s': %zu slices exceed the per-axis limit of %u", path, slices.size(),
+                            max_dim);
+
+        std::vector<unsigned char> raw, tmp;
+        uint32_t dims[3] = {0, 0, static_cast<uint32_t>(slices.size())};
+        uint32_t dtype = 0;
+        int nch = 0, nread = 0;
+        OIIO::TypeDesc read_as;
+        std::string first;
+        size_t es = 0, slice_bytes = 0;
+        for (size_t k = 0; k < slices.size(); k++) {
+            const Slice &s = slices[k];
+            if (!in || open_path != s.path) {
+                if (in) in->close();
+                in = open_image(s.path, e, &rc);
+                if (!in) return rc;
+                open_path = s.path;
+            }
+            if (!in->seek_subimage(s.subimage, 0)) {
+                std::string msg = in->geterror();
+                return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read page %d: %s", s.path.c_str(), s.subimage + 1,
+                                msg.c_str());
+            }
+            const OIIO::ImageSpec &spec = in->spec();
+            std::string name = slice_name(s);
+            if (spec.deep)
+                return vxl_fail(e, VXL_ERR_FORMAT, "'%s': deep images are not supported", name.c_str());
+            if (spec.width < 1 || spec.height < 1 || spec.depth != 1 || spec.nchannels < 1)
+                return vxl_fail(e, VXL_ERR_FORMAT, "'%s': unsupported image size %dx%dx%d with %d channels",
+                                name.c_str(), spec.width, spec.height, spec.depth, spec.nchannels);
+            if (k == 0) {
+                dtype = dtype_for(spec.format, read_as);
+                if (!dtype)
+                    return vxl_fail(e, VXL_ERR_FORMAT, "'%s': unsupported pixel type %s", name.c_str(),
+                                    spec.format.c_str());
+                dims[0] = static_cast<uint32_t>(spec.width);
+                dims[1] = static_cast<uint32_t>(spec.height);
+                nch = spec.nchannels;
+                nread = nch >= 3 ? 3 : 1;
+                first = name;
+                uint64_t nbytes = 0;
+                rc = vxl_plan_voxels(path, dims, dtype, opt, &nbytes, e);
+                if (rc) return rc;
+                es = vxl_dtype_size(dtype);
+                slice_bytes = static_cast<size_t>(dims[0]) * dims[1] * es;
+                raw.resize(static_cast<size_t>(nbytes));
+                tmp.resize(slice_bytes * static_cast<size_t>(nread));
+            } else if (static_cast<uint32_t>(spec.width) != dims[0] || static_cast<uint32_t>(spec.height) != dims[1] ||
+                       spec.nchannels != nch) {
+                return vxl_fail(e, VXL_ERR_FORMAT,
+                                "mixed slices: '%s' is %dx%d with %d channels, but '%s' is %ux%u with %d channels",
+                                name.c_str(), spec.width, spec.height, spec.nchannels, first.c_str(), dims[0], dims[1],
+                                nch);
+            }
+            OIIO::TypeDesc rt;
+            if (dtype_for(spec.format, rt) != dtype)
+                return vxl_fail(e, VXL_ERR_FORMAT, "mixed slices: '%s' has pixel type %s, unlike '%s'", name.c_str(),
+                                spec.format.c_str(), first.c_str());
+            if (!in->read_image(s.subimage, 0, 0, nread, read_as, tmp.data())) {
+                std::string msg = in->geterror();
+                return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read pixels: %s", name.c_str(),
+                                msg.empty() ? "unknown error" : msg.c_str());
+            }
+            gray_slice(dtype, tmp.data(), nread, dims[0], dims[1], raw.data() + k * slice_bytes);
+        }
+        if (in) in->close();
+        double vs[3];
+        vxl_load_voxel_size(opt, vs);
+        std::vector<unsigned char>().swap(tmp);
+        vxl_err inner = {};
+        rc = vxl_volume_build(raw.data(), dtype, dims, vs, nullptr, 0.0, 0.0, opt, out, &inner);
+        if (rc) return vxl_fail_in(e, path, &inner);
+        return VXL_OK;
+    } catch (const std::bad_alloc &) {
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory", path);
+    } catch (const std::exception &x) {
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %s", path, x.what());
+    } catch (...) {
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': unexpected error while reading images", path);
+    }
+}

@@ -1,0 +1,57 @@
+/* fuzz_common.h - the body every libFuzzer target shares: write the input
+ * to a file with the format's extension and load it through the public
+ * vxl_volume_load (so dispatch is exercised too) with a small memory budget,
+ * then check the API contract: success gives a volume, failure gives NULL
+ * and a non-empty message. Anything else aborts, which libFuzzer reports. */
+#ifndef VXL_FUZZ_COMMON_H
+#define VXL_FUZZ_COMMON_H
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "voxlight.h"
+
+static char vxl_fuzz_dir[64];
+static char vxl_fuzz_path[128];
+
+static void vxl_fuzz_cleanup(void)
+{
+    if (vxl_fuzz_path[0]) unlink(vxl_fuzz_path);
+    if (vxl_fuzz_dir[0]) rmdir(vxl_fuzz_dir);
+}
+
+static int vxl_fuzz_load(const uint8_t *data, size_t size, const char *ext)
+{
+    if (!vxl_fuzz_dir[0]) {
+        /* a file per input: tmpfs (/dev/shm) where there is one, since a
+         * disk-backed /tmp can cost milliseconds per write */
+        snprintf(vxl_fuzz_dir, sizeof vxl_fuzz_dir, "/dev/shm/vxl_fuzz_XXXXXX");
+        if (!mkdtemp(vxl_fuzz_dir)) {
+            snprintf(vxl_fuzz_dir, sizeof vxl_fuzz_dir, "/tmp/vxl_fuzz_XXXXXX");
+            if (!mkdtemp(vxl_fuzz_dir)) abort();
+        }
+        snprintf(vxl_fuzz_path, sizeof vxl_fuzz_path, "%s/input.%s", vxl_fuzz_dir, ext);
+        atexit(vxl_fuzz_cleanup);
+    }
+    FILE *f = fopen(vxl_fuzz_path, "wb");
+    if (!f) abort();
+    if (size && fwrite(data, 1, size, f) != size) abort();
+    fclose(f);
+    vxl_load_options opt = {.struct_size = sizeof opt, .max_dim = 4096, .memory_budget_bytes = 16u << 20};
+    vxl_volume *v = NULL;
+    int rc = vxl_volume_load(vxl_fuzz_path, &opt, &v);
+    if (rc == VXL_OK && !v) abort();
+    if (rc != VXL_OK && (v || !vxl_last_error()[0])) abort();
+    if (v) {
+        vxl_volume_info info = {.struct_size = sizeof info};
+        if (vxl_volume_get_info(v, &info) != VXL_OK) abort();
+        if (info.dims[0] * (uint64_t)info.dims[1] * info.dims[2] == 0) abort();
+    }
+    vxl_volume_destroy(v);
+    return 0;
+}
+
+#endif

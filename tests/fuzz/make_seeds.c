@@ -1,0 +1,116 @@
+/* make_seeds.c - writes the seed corpus for the fuzz targets: small valid
+ * files of every format and the main variants (types, byte orders,
+ * compression, geometry, pages, channels).
+ *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png}/seed_*
+ * Built and run by `make fuzz-seeds` (./build.sh test / fuzz). */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "fuzz/writers.h"
+#include "nifti_writer.h"
+
+static char g_out[512];
+
+static const char *path(const char *fmt, const char *name)
+{
+    static char p[1024];
+    char d[768];
+    snprintf(d, sizeof d, "%s/%s", g_out, fmt);
+    mkdir(d, 0755);
+    snprintf(p, sizeof p, "%s/%s", d, name);
+    return p;
+}
+
+static int failures;
+static void ok(int rc, const char *what)
+{
+    if (rc) {
+        fprintf(stderr, "make_seeds: cannot write %s\n", what);
+        failures++;
+    }
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: make_seeds OUTDIR\n");
+        return 2;
+    }
+    snprintf(g_out, sizeof g_out, "%s", argv[1]);
+    mkdir(g_out, 0755);
+
+    uint8_t u8[24];
+    int16_t i16[24];
+    float f32[24];
+    for (int i = 0; i < 24; i++) {
+        u8[i] = (uint8_t)(i * 10);
+        i16[i] = (int16_t)(i * 1000 - 12000);
+        f32[i] = (float)i * 0.5f - 3.0f;
+    }
+    void *i16_be = tw_swapped(i16, 24, 2);
+
+    /* NIfTI: -1 and -2, native and swapped, plain and gzip */
+    tnw_header h;
+    tnw_init(&h, 1, 2, 4, 3, 2);
+    ok(tnw_write(path("nifti", "seed_u8.nii"), &h, u8, sizeof u8), "nifti u8");
+    tnw_init(&h, 1, 4, 4, 3, 2);
+    h.swap = 1;
+    h.sform_code = 1;
+    for (int r = 0; r < 3; r++) h.srow[r][r] = 1.5;
+    ok(tnw_write(path("nifti", "seed_i16_swapped.nii"), &h, i16_be, sizeof i16), "nifti i16 swapped");
+    tnw_init(&h, 2, 16, 4, 3, 2);
+    h.qform_code = 1;
+    h.quatern[0] = 0.5;
+    ok(tnw_write(path("nifti", "seed_f32_v2.nii.gz"), &h, f32, sizeof f32), "nifti f32 v2 gz");
+
+    /* NRRD */
+    ok(tw_write_header_data(path("nrrd", "seed_u8.nrrd"),
+                            "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 3 2\nencoding: raw\n\n", u8, sizeof u8,
+                            TW_RAW, NULL), "nrrd u8");
+    ok(tw_write_header_data(path("nrrd", "seed_i16_gz_lps.nrrd"),
+                            "NRRD0005\n# seed\ntype: short\ndimension: 3\nspace: left-posterior-superior\n"
+                            "sizes: 4 3 2\nspace directions: (0,1.5,0) (-1,0,0) (0,0,2)\nkinds: domain domain domain\n"
+                            "endian: big\nencoding: gzip\nspace origin: (1,2,3)\nkey:=value\n\n",
+                            i16_be, sizeof i16, TW_GZIP, NULL), "nrrd i16 gzip");
+    ok(tw_write_header_data(path("nrrd", "seed_f32_spacings.nrrd"),
+                            "NRRD0004\ntype: float\ndimension: 3\nsizes: 4 3 2\nspacings: 0.5 nan 2\n"
+                            "endian: little\nencoding: raw\nbyte skip: 0\n\n",
+                            f32, sizeof f32, TW_RAW, NULL), "nrrd f32");
+    ok(tw_write_header_data(path("nrrd", "seed_u8_4d.nrrd"),
+                            "NRRD0004\ntype: uint8\ndimension: 4\nsizes: 2 3 2 2\nspace: RAS\n"
+                            "space directions: (1,0,0) (0,1,0) (0,0,1) none\nencoding: raw\n\n",
+                            u8, sizeof u8, TW_RAW, NULL), "nrrd 4d");
+
+    /* MetaImage */
+    ok(tw_write_header_data(path("metaimage", "seed_u8.mha"),
+                            "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_UCHAR\n"
+                            "ElementDataFile = LOCAL\n", u8, sizeof u8, TW_RAW, NULL), "mha u8");
+    ok(tw_write_header_data(path("metaimage", "seed_f32_zlib.mha"),
+                            "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
+                            "CompressedData = True\nTransformMatrix = 0 1 0 -1 0 0 0 0 1\nOffset = 1 2 3\n"
+                            "ElementSpacing = 0.5 1 2\nDimSize = 4 3 2\nElementType = MET_FLOAT\n"
+                            "ElementDataFile = LOCAL\n", f32, sizeof f32, TW_ZLIB, NULL), "mha f32 zlib");
+    ok(tw_write_header_data(path("metaimage", "seed_i16_msb.mha"),
+                            "NDims = 3\nDimSize = 4 3 2\nElementByteOrderMSB = True\nElementType = MET_SHORT\n"
+                            "HeaderSize = -1\nElementDataFile = LOCAL\n", i16_be, sizeof i16, TW_RAW, NULL),
+       "mha i16 msb");
+
+    /* TIFF */
+    ok(tw_write_tiff(path("tiff", "seed_u8_pages.tif"), 4, 3, 2, 1, 8, 1, u8), "tiff u8 pages");
+    ok(tw_write_tiff(path("tiff", "seed_i16.tif"), 4, 3, 1, 1, 16, 2, i16), "tiff i16");
+    ok(tw_write_tiff(path("tiff", "seed_f32.tif"), 4, 3, 2, 1, 32, 3, f32), "tiff f32");
+    ok(tw_write_tiff(path("tiff", "seed_rgb.tif"), 4, 2, 1, 3, 8, 1, u8), "tiff rgb");
+
+    /* PNG */
+    uint16_t u16[24];
+    for (int i = 0; i < 24; i++) u16[i] = (uint16_t)(i * 2000);
+    ok(tw_write_png(path("png", "seed_gray8.png"), 4, 3, 1, 8, u8), "png gray8");
+    ok(tw_write_png(path("png", "seed_gray16.png"), 4, 3, 1, 16, u16), "png gray16");
+    ok(tw_write_png(path("png", "seed_rgb8.png"), 4, 2, 3, 8, u8), "png rgb8");
+    ok(tw_write_png(path("png", "seed_ga8.png"), 4, 3, 2, 8, u8), "png grey+alpha");
+    free(i16_be);
+    return failures ? 1 : 0;
+}

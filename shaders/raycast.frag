@@ -89,7 +89,10 @@ void main()
     vec4 acc = vec4(0.0);
     float depth = uintBitsToFloat(0x7f800000u);
 #ifdef REUSE_GRADIENTS
+    // "previous sample" is the previous sample along the ray: a transparent
+    // or skipped one has no gradient, so the state restarts after it
     GradientState gs = gradient_state_init();
+    int last_shaded = -2;
 #endif
 #ifdef CLASSIFY_PREINT
     // the first segment is a point: constant value over its step
@@ -167,6 +170,8 @@ void main()
         vec3 g = gradient_at(p, v);
 #endif
 #ifdef REUSE_GRADIENTS
+        if (last_shaded != i - 1) gs = gradient_state_init();
+        last_shaded = i;
         g = reuse_gradient(gs, g);
 #endif
         vec3 pos = (u_mv * vec4(p, 1.0)).xyz;

@@ -11,6 +11,7 @@
 #define DEFAULT_SAMPLE_DISTANCE 1.0f
 #define MAX_STEP 1000.0f
 #define MAX_SAMPLES_PER_RAY 16384
+#define MAX_TF_SIZE 4096
 
 static const float default_material[4] = {0.3f, 0.7f, 0.3f, 24.0f};
 
@@ -71,14 +72,22 @@ static int resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume
     if (p->tf_rgba) {
         if (p->tf_size < 2 || p->tf_size > 65536)
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "tf_size %u must be in [2, 65536]", p->tf_size);
-        f->tf_copy = malloc((size_t)p->tf_size * 4 * sizeof(float));
+        /* 1D textures are limited (16384 on llvmpipe): longer tables are
+         * resampled, exactly as GL_LINEAR would read them, to MAX_TF_SIZE. */
+        uint32_t n = p->tf_size > MAX_TF_SIZE ? MAX_TF_SIZE : p->tf_size;
+        f->tf_copy = malloc((size_t)n * 4 * sizeof(float));
         if (!f->tf_copy) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the transfer function");
-        for (uint32_t i = 0; i < p->tf_size * 4; i++) {
-            float v = p->tf_rgba[i];
-            f->tf_copy[i] = v > 0 ? (v < 1 ? v : 1) : 0; /* also maps NaN to 0 */
+        for (uint32_t i = 0; i < n; i++) {
+            double u = n == p->tf_size ? i : i * (double)(p->tf_size - 1) / (n - 1);
+            uint32_t i0 = (uint32_t)u, i1 = i0 + 1 < p->tf_size ? i0 + 1 : i0;
+            double w = u - i0;
+            for (int c = 0; c < 4; c++) {
+                double v = p->tf_rgba[4 * i0 + c] * (1 - w) + p->tf_rgba[4 * i1 + c] * w;
+                f->tf_copy[4 * i + c] = v > 0 ? (float)(v < 1 ? v : 1) : 0.0f; /* also maps NaN to 0 */
+            }
         }
         f->tf = f->tf_copy;
-        f->tf_size = p->tf_size;
+        f->tf_size = n;
     } else {
         if (!vxl_preset_table(preset, f->preset_tf))
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown preset %u", p->preset);
@@ -95,7 +104,9 @@ static int resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume
         vxl_preset_window(preset, g->value_min, g->value_max, &lo, &hi);
     }
     /* an empty window becomes a step at lo instead of a division by zero */
-    double w = hi - lo, eps = fmax(fabs(lo), fabs(hi)) * 1e-6 + 1e-30;
+    /* relative, so denormal-scaled data keeps its own window */
+    double w = hi - lo, eps = fmax(fabs(lo), fabs(hi)) * 1e-6;
+    if (!(eps > 0)) eps = 1e-300;
     if (fabs(w) < eps) w = eps;
     double span = g->tex_hi - g->tex_lo;
     if (span == 0) span = 1;

@@ -124,7 +124,7 @@ int vxl_program_get(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t fl
     GLuint p = 0;
     int rc = build(r, kind, filter, flags, &p);
     if (rc) return rc;
-    if (r->n_programs == VXL_MAX_PROGRAMS) { /* cannot happen with the current key space */
+    if (r->n_programs == VXL_MAX_PROGRAMS) { /* the key space is smaller than the cache */
         r->gl.DeleteProgram(p);
         return vxl_fail(&r->err, VXL_ERR_STATE, "program cache full");
     }

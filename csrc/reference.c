@@ -111,13 +111,15 @@ static void trace(const ref_ctx *c, double px, double py, float *out_rgba, float
     vxl_mat4_transform(c->inv_mvp, a, hn);
     vxl_mat4_transform(c->inv_mvp, b, hf);
     double o[3], dir[3];
+    /* as raycast.frag: the direction without dividing by the far point's w */
     for (int k = 0; k < 3; k++) {
         o[k] = hn[k] / hn[3];
-        dir[k] = hf[k] / hf[3] - o[k];
+        dir[k] = hf[k] * hn[3] - hn[k] * hf[3];
     }
-    double t_far = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-    if (!(t_far > 0) || !isfinite(t_far)) return;
-    for (int k = 0; k < 3; k++) dir[k] /= t_far;
+    double len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    double t_far = hn[3] * hf[3] > 0 ? len / (hn[3] * hf[3]) : INFINITY;
+    if (!(len > 0) || !isfinite(len) || isnan(t_far)) return;
+    for (int k = 0; k < 3; k++) dir[k] /= len;
     double t0 = 0, t1 = t_far;
     const uint32_t *dims = c->vol->dims;
     for (int k = 0; k < 3; k++) {

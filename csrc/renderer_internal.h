@@ -13,7 +13,7 @@
 #include "frame.h"
 #include "voxlight.h"
 
-#define VXL_MAX_PROGRAMS 96
+#define VXL_MAX_PROGRAMS 512 /* every raycast variant (7*4*3*3) plus compute programs */
 #define VXL_MAX_SAMPLES_PER_RAY 16384 /* bounds every ray, whatever the step */
 #define VXL_MAX_IMAGE_SIDE 16384
 #define VXL_SCRATCH_UNIT 7 /* texture unit used only to create and fill textures */

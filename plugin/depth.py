@@ -43,3 +43,42 @@ def planar_to_window(distance, proj):
     ndc = planar_to_ndc(np.where(np.isfinite(d), d, 0.0), proj)
     win = np.clip(ndc * 0.5 + 0.5, 0.0, 1.0)
     return np.where(np.isfinite(d), win, 1.0).astype(np.float32)
+
+
+def downsample(img, w, h):
+    """Nearest sample at the centre of each (w, h) pixel of a (H, W) image."""
+    H, W = img.shape[:2]
+    if (W, H) == (w, h):
+        return img
+    ys = np.minimum(((np.arange(h) + 0.5) * H / h).astype(np.int64), H - 1)
+    xs = np.minimum(((np.arange(w) + 0.5) * W / w).astype(np.int64), W - 1)
+    return np.ascontiguousarray(img[ys][:, xs])
+
+
+def for_library(planar, near, far, quantum, rect=None):
+    """The scene depth as the library is given it, reduced to what can
+    change the image, so that the frame key (a hash of it) changes only
+    when the image would:
+      * depth at or beyond `far` (the box's farthest planar distance) stops
+        no ray inside the box: +inf;
+      * depth at or before `near` (the box's nearest, when > 0) stops every
+        ray before it enters: 0;
+      * outside `rect` (x0, y0, x1, y1), the box's screen footprint, no ray
+        meets the box: +inf;
+      * the rest is rounded down to a multiple of `quantum` (a fraction of
+        a voxel), so a ray stops at most that much earlier and sub-quantum
+        wobble of the depth buffer does not re-render.
+    The first three are exact; the rounding is not (by < quantum)."""
+    d = np.array(planar, dtype=np.float64)
+    finite = np.isfinite(d)
+    if quantum > 0:
+        d[finite] = np.floor(d[finite] / quantum) * quantum
+    d[finite & (d >= far)] = np.inf
+    if near > 0:
+        d[np.isfinite(d) & (d <= near)] = 0.0
+    if rect is not None:
+        x0, y0, x1, y1 = rect
+        mask = np.ones(d.shape, bool)
+        mask[y0:y1, x0:x1] = False
+        d[mask] = np.inf
+    return d.astype(np.float32)

@@ -15,14 +15,21 @@ Conventions kept from the header:
 """
 
 import ctypes
+import hashlib
 import os
+import time
 
 import numpy as np
 
 ABI_VERSION = 1
 LIBRARY_NAME = "libvoxlight.so"
 
-FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed")
+# The names this binding was written against (VXL_FILTER_* / VXL_PRESET_*
+# order). The library is the authority: Library.filter_names() reads
+# vxl_filter_name() up to the first NULL, so a filter added to the library
+# shows up in the add-on without editing this file; these tuples are only
+# the fallback when no library can be loaded (the UI still registers).
+FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed", "cubic")
 PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
 BACKENDS = ("auto", "osmesa", "egl")
 MAX_LIGHTS = 8
@@ -141,6 +148,18 @@ class RenderParams(ctypes.Structure):
                 ("reserved", ctypes.c_uint32 * 7)]
 
 
+class RenderStats(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("sample_bound", ctypes.c_uint32),
+                ("samples", ctypes.c_uint64),
+                ("max_ray_samples", ctypes.c_uint32),
+                ("rays", ctypes.c_uint32),
+                ("effective_step", ctypes.c_float),
+                ("bricks_total", ctypes.c_uint32),
+                ("bricks_occupied", ctypes.c_uint32),
+                ("brick_size", ctypes.c_uint32)]
+
+
 def _sized(struct_type):
     s = struct_type()
     s.struct_size = ctypes.sizeof(struct_type)
@@ -204,6 +223,7 @@ def _declare(lib):
         "vxl_renderer_set_volume": (ctypes.c_int, [vp, vp]),
         "vxl_render": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                       P(ctypes.c_float)]),
+        "vxl_renderer_get_stats": (ctypes.c_int, [vp, P(RenderStats)]),
         "vxl_default_camera": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                               P(ctypes.c_float)]),
         "vxl_probe_gradients": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
@@ -276,6 +296,22 @@ class Library:
         self.check(self.cdll.vxl_filter_from_name(name.encode(), ctypes.byref(out)))
         return out.value
 
+    def _names(self, fn):
+        out = []
+        for i in range(256):  # the library returns NULL past its last entry
+            n = fn(i)
+            if not n:
+                break
+            out.append(n.decode())
+        return tuple(out)
+
+    def filter_names(self):
+        """Every gradient filter the library has, in VXL_FILTER_* order."""
+        return self._names(self.cdll.vxl_filter_name)
+
+    def preset_names(self):
+        return self._names(self.cdll.vxl_preset_name)
+
     def preset_index(self, name):
         out = ctypes.c_uint32()
         self.check(self.cdll.vxl_preset_from_name(name.encode(), ctypes.byref(out)))
@@ -322,6 +358,15 @@ def load_library(path=None, reload=False):
         return lib
     _library_error = "libvoxlight not usable: " + "; ".join(errors)
     raise LibraryUnavailable(_library_error)
+
+
+def filter_names(lib=None):
+    """The library's filter names (VXL_FILTER_* order), or FILTERS when no
+    library loads."""
+    try:
+        return (lib or load_library()).filter_names()
+    except LibraryUnavailable:
+        return FILTERS
 
 
 def library_status():
@@ -488,6 +533,7 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
             raise ValueError("scene_depth has %d values, image has %dx%d" % (d.size, w, h))
         p._keep.append(d)
         p.scene_depth = _fptr(d)
+        p._scene_depth = d
     p.filter = filter if isinstance(filter, int) else lib.filter_index(filter)
     p.sample_distance = sample_distance
     p.reuse_gradients = 1 if reuse_gradients else 0
@@ -518,6 +564,85 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     return p
 
 
+# ---------------------------------------------------- frame keys and tiles
+
+def params_digest(params, *extra):
+    """A digest of everything a render depends on: every field of the
+    params struct (pointers excluded) plus the contents of the arrays it
+    points at (scene depth), plus `extra` (the volume's identity). Equal
+    digests mean the library would be given identical inputs."""
+    c = RenderParams.from_buffer_copy(params)
+    c.scene_depth = None
+    c.tf_rgba = None
+    h = hashlib.blake2b(bytes(c), digest_size=16)
+    for a in getattr(params, "_keep", ()):
+        a = np.ascontiguousarray(a)
+        h.update(str((a.dtype.str, a.shape)).encode())
+        h.update(memoryview(a).cast("B"))
+    for e in extra:
+        h.update(e if isinstance(e, bytes) else repr(e).encode())
+    return h.hexdigest()
+
+
+# The library jitters ray starts with a hash of (pixel x, pixel y, seed)
+# (shaders/raycast.frag: x*1973 + y*9277 + seed*26699 mod 2^32). A tile's
+# pixels are numbered from its own corner, so tile_params adds the tile's
+# offset through the seed: the tiled image then has the very same jitter as
+# the whole one. tests/python/test_native.py checks the equality; if the
+# shader's hash changes, update these constants (or, better, give the library
+# a tile-origin parameter, see plugin/README.md).
+_JITTER_X, _JITTER_Y, _JITTER_SEED = 1973, 9277, 26699
+_JITTER_SEED_INV = pow(_JITTER_SEED, -1, 1 << 32)
+
+
+def tile_params(params, x0, y0, x1, y1):
+    """Params that render the pixel rectangle [x0, x1) x [y0, y1) (row 0 =
+    bottom) of the image `params` describes, as an image of its own: the
+    projection is narrowed to the rectangle, the scene depth is cropped and
+    the jitter keeps the whole image's pattern. Needs an explicit camera."""
+    W, H = params.width or 512, params.height or 512
+    if not params.has_camera:
+        raise ValueError("tiles need an explicit camera (view and proj)")
+    if not (0 <= x0 < x1 <= W and 0 <= y0 < y1 <= H):
+        raise ValueError("tile %r outside the %dx%d image" % ((x0, y0, x1, y1), W, H))
+    t = RenderParams.from_buffer_copy(params)
+    t._keep = []
+    t.width, t.height = x1 - x0, y1 - y0
+    a, b = 2.0 * x0 / W - 1.0, 2.0 * x1 / W - 1.0
+    c, d = 2.0 * y0 / H - 1.0, 2.0 * y1 / H - 1.0
+    m = np.eye(4)
+    m[0, 0], m[0, 3] = 2.0 / (b - a), -(a + b) / (b - a)
+    m[1, 1], m[1, 3] = 2.0 / (d - c), -(c + d) / (d - c)
+    t.proj = _matrix_cm(m @ matrix_from_cm(params.proj))
+    off = (x0 * _JITTER_X + y0 * _JITTER_Y) * _JITTER_SEED_INV
+    t.jitter_seed = (params.jitter_seed + off) & 0xFFFFFFFF
+    depth = getattr(params, "_scene_depth", None)
+    if params.scene_depth and depth is None:
+        raise ValueError("params.scene_depth was not set by make_params")
+    if depth is not None:
+        sub = np.ascontiguousarray(depth.reshape(H, W)[y0:y1, x0:x1])
+        t._keep.append(sub)
+        t._scene_depth = sub
+        t.scene_depth = _fptr(sub)
+    return t
+
+
+def _empty_stats():
+    return {"samples": 0, "rays": 0, "max_ray_samples": 0, "sample_bound": 0,
+            "effective_step": 0.0, "bricks_total": 0, "bricks_occupied": 0,
+            "brick_size": 0, "calls": 0, "seconds": 0.0}
+
+
+def _merge_stats(acc, s):
+    acc["samples"] += s["samples"]
+    acc["rays"] += s["rays"]
+    acc["max_ray_samples"] = max(acc["max_ray_samples"], s["max_ray_samples"])
+    acc["sample_bound"] = max(acc["sample_bound"], s["sample_bound"])
+    for k in ("effective_step", "bricks_total", "bricks_occupied", "brick_size"):
+        acc[k] = s[k]
+    return acc
+
+
 # -------------------------------------------------------------- renderer
 
 class Renderer:
@@ -535,6 +660,8 @@ class Renderer:
                        what="renderer")
         self._handle = h
         self.volume_info = None
+        # Called with no arguments after every vxl_render (counts library calls).
+        self.on_render = None
 
     @property
     def handle(self):
@@ -567,7 +694,58 @@ class Renderer:
         depth = np.empty((h, w), np.float32) if want_depth else None
         self._check(self.lib.cdll.vxl_render(self.handle, ctypes.byref(params), _fptr(rgba),
                                              _fptr(depth) if want_depth else None), "render")
+        if self.on_render is not None:
+            self.on_render()
         return rgba, depth
+
+    def stats(self):
+        """What the last render did (vxl_renderer_get_stats) as a dict."""
+        st = _sized(RenderStats)
+        self._check(self.lib.cdll.vxl_renderer_get_stats(self.handle, ctypes.byref(st)), "stats")
+        return {k: getattr(st, k) for k, _t in RenderStats._fields_ if k != "struct_size"}
+
+    def render_tiled(self, params, rect=None, rows=None, target_seconds=0.05,
+                     should_stop=None):
+        """Render the image `params` describes as horizontal bands of the
+        pixel rectangle `rect` = (x0, y0, x1, y1) (default: the whole
+        image); pixels outside it are empty (alpha 0, depth +inf), which is
+        exact when rect holds the volume's screen footprint.
+
+        Each band is one library call, sized to take about target_seconds
+        (or `rows` rows), and should_stop() is asked before every band: a
+        caller on another thread abandons a stale frame within one band,
+        and the renderer (whose calls serialize) is free again. Returns
+        (rgba, depth, stats), or None when stopped. Equals render() up to
+        float rounding of the narrowed projections (the jitter pattern is
+        the same)."""
+        W, H = params.width or 512, params.height or 512
+        rgba = np.zeros((H, W, 4), np.float32)
+        depth = np.full((H, W), np.inf, np.float32)
+        acc = _empty_stats()
+        x0, y0, x1, y1 = rect if rect is not None else (0, 0, W, H)
+        x0, y0, x1, y1 = max(0, x0), max(0, y0), min(W, x1), min(H, y1)
+        if x1 <= x0 or y1 <= y0:
+            return rgba, depth, acc
+        n = int(rows) if rows else max(1, 16384 // (x1 - x0))  # first band ~16k pixels
+        y = y0
+        t_start = time.perf_counter()
+        while y < y1:
+            if should_stop is not None and should_stop():
+                return None
+            n = max(1, min(n, y1 - y))
+            tp = tile_params(params, x0, y, x1, y + n)
+            t = time.perf_counter()
+            c, d = self.render(tp)
+            dt = time.perf_counter() - t
+            rgba[y:y + n, x0:x1] = c
+            depth[y:y + n, x0:x1] = d
+            _merge_stats(acc, self.stats())
+            acc["calls"] += 1
+            y += n
+            if not rows:  # aim at target_seconds, growing at most 2x per band
+                n = int(max(1, min(2 * n, y1 - y0, target_seconds * n / max(dt, 1e-4))))
+        acc["seconds"] = time.perf_counter() - t_start
+        return rgba, depth, acc
 
     def default_camera(self, params=None, **kwargs):
         """(view, proj) as numpy 4x4 math matrices."""

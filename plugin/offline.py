@@ -7,7 +7,7 @@ the scene's meshes in numpy (zbuffer.py) and passing that as scene_depth.
 import bpy
 import numpy as np
 
-from . import native, params, runtime, scene_geometry, zbuffer
+from . import native, params, runtime, scene_geometry, volume_space, zbuffer
 
 
 def render_size(scene):
@@ -77,6 +77,14 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
     view = proj = None
     if camera is not None:
         view, proj = camera_matrices(camera, depsgraph, width, height, scene)
+        # Volumes outside the camera's frustum cost nothing: no library call
+        # (and no z-buffer when none is left).
+        vols = [(ob, mw) for ob, mw in vols if not volume_space.outside_frustum(
+            mw @ np.array(ob.voxlight.voxel_to_local, np.float64).reshape(4, 4).T,
+            tuple(ob.voxlight.dims), view, proj)]
+        if not vols:
+            return (np.zeros((height, width, 4), np.float32),
+                    np.full((height, width), np.inf, np.float32))
     zbuf = None
     if occlusion and camera is not None:
         zbuf = zbuffer.rasterize(scene_geometry.triangles(depsgraph, for_render),

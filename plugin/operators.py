@@ -68,6 +68,10 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         obj = bpy.data.objects.new(name, None)
         obj.empty_display_type = "CUBE"
         obj.empty_display_size = 1.0
+        # Drawn in the "in front" pass: its wire cube then stays out of the
+        # depth buffer the viewport reads at POST_VIEW, so rays do not stop
+        # at the volume's own outline.
+        obj.show_in_front = True
         obj.matrix_world = _to_matrix(volume_space.object_matrix(s_from_v, dims))
         # Blender keeps loc/rot/scale only; whatever it could not hold (shear)
         # stays in voxel_to_local so the render remains exact.

@@ -5,6 +5,7 @@ here rather than failing at add-on import."""
 import bpy
 
 from . import native, runtime
+from .properties import FIXED_TAP_FILTERS
 
 
 def _draw_library_status(layout):
@@ -51,7 +52,7 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
         col = layout.column()
         col.prop(p, "filter")
         sub = col.column()
-        sub.active = p.filter != "precomputed"
+        sub.active = p.filter not in FIXED_TAP_FILTERS
         sub.prop(p, "sample_distance", slider=True)
         col.prop(p, "reuse_gradients")
         if p.filter == "precomputed":
@@ -80,6 +81,24 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
         sub.prop(p, "specular", slider=True)
         sub.prop(p, "shininess")
 
+        entry = runtime.find_entry(bpy.path.abspath(p.filepath))
+        frame = entry.last_frame if entry is not None else None
+        if frame:
+            layout.separator()
+            col = layout.column(align=True)
+            col.label(text="Last frame (%s): %d x %d, %.0f ms, %d call%s"
+                      % (frame["kind"], frame["width"], frame["height"],
+                         frame["seconds"] * 1000.0, frame["calls"],
+                         "" if frame["calls"] == 1 else "s"), icon="INFO")
+            col.label(text="%.2f M samples on %d rays, step %.3g voxels"
+                      % (frame["samples"] / 1e6, frame["rays"], frame["effective_step"]))
+            if frame["bricks_total"]:
+                col.label(text="Occupied bricks: %d of %d (%d³ voxels)"
+                          % (frame["bricks_occupied"], frame["bricks_total"],
+                             frame["brick_size"]))
+            else:
+                col.label(text="Empty-space skipping off")
+
 
 class VOXLIGHT_PT_scene(bpy.types.Panel):
     bl_label = "Voxlight"
@@ -98,6 +117,8 @@ class VOXLIGHT_PT_scene(bpy.types.Panel):
         col.prop(s, "viewport_resolution", slider=True)
         col.prop(s, "interactive_resolution", slider=True)
         col.prop(s, "settle_time")
+        col.label(text="Frames rendered: %d (%d library calls, %d stale frames dropped)"
+                  % (runtime.render_count, runtime.call_count, runtime.cancelled_count))
         col = layout.column(heading="Render")
         col.prop(s, "render_enabled")
         col.prop(s, "render_occlusion")

@@ -8,25 +8,49 @@ from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorPro
 
 from . import native
 
-FILTER_ITEMS = [
-    ("central", "Central", "Central differences, 6 taps"),
-    ("forward3", "Forward", "Forward differences, 3 taps against the centre sample"),
-    ("sobel8", "Sobel 8", "8 trilinear taps at (±d, ±d, ±d)"),
-    ("sobel14", "Sobel 14", "6 face and 8 corner taps"),
-    ("sobel26", "Sobel 26", "Classic weighted 26-neighbour Sobel"),
-    ("precomputed", "Precomputed", "Blur + Sobel once per volume, stored in a texture"),
-]
-assert tuple(i[0] for i in FILTER_ITEMS) == native.FILTERS
+# UI names of the filters this add-on knows. The list itself comes from the
+# library (vxl_filter_name up to VXL_FILTER_COUNT), so a filter added there
+# appears in the panel without editing this file; each item's number is the
+# library's VXL_FILTER_* value, so saved files and keyframes stay valid.
+_FILTER_UI = {
+    "central": ("Central", "Central differences, 6 taps"),
+    "forward3": ("Forward", "Forward differences, 3 taps against the centre sample"),
+    "sobel8": ("Sobel 8", "8 trilinear taps at (±d, ±d, ±d)"),
+    "sobel14": ("Sobel 14", "6 face and 8 corner taps"),
+    "sobel26": ("Sobel 26", "Classic weighted 26-neighbour Sobel"),
+    "precomputed": ("Precomputed", "Blur + Sobel once per volume, stored in a texture"),
+    "cubic": ("Cubic B-spline", "Analytic derivative of the interpolating cubic B-spline "
+                                "(prefiltered once per volume), 24 fetches"),
+}
+# Filters whose taps do not depend on sampleDistance.
+FIXED_TAP_FILTERS = {"precomputed", "cubic"}
 
-PRESET_ITEMS = [
-    ("auto", "Auto", "MRI or CT default, chosen from the data range"),
-    ("gray", "Gray", "Gray ramp"),
-    ("bone", "Bone", "Bone"),
-    ("hot", "Hot", "Hot metal"),
-    ("mri", "MRI", "MRI default"),
-    ("ct", "CT", "CT default"),
-]
-assert tuple(i[0] for i in PRESET_ITEMS) == native.PRESETS
+_PRESET_UI = {
+    "auto": ("Auto", "MRI or CT default, chosen from the data range"),
+    "gray": ("Gray", "Gray ramp"),
+    "bone": ("Bone", "Bone"),
+    "hot": ("Hot", "Hot metal"),
+    "mri": ("MRI", "MRI default"),
+    "ct": ("CT", "CT default"),
+}
+
+
+def _items(names, ui, what):
+    return [(n, *ui.get(n, (n.replace("_", " ").title(), "%s '%s' of libvoxlight" % (what, n))), i)
+            for i, n in enumerate(names)]
+
+
+def _library_names(method, fallback):
+    try:
+        return getattr(native.load_library(), method)() or fallback
+    except native.LibraryUnavailable:
+        return fallback  # the panels say why; the properties still register
+
+
+FILTER_ITEMS = _items(_library_names("filter_names", native.FILTERS), _FILTER_UI,
+                      "Gradient filter")
+PRESET_ITEMS = _items(_library_names("preset_names", native.PRESETS), _PRESET_UI,
+                      "Transfer-function preset")
 
 
 def tag_redraw(self=None, context=None):

@@ -80,7 +80,7 @@ def on_frame_change_post(scene, depsgraph=None, *args):
         compositor.mute(scene)
         return
     last_error = ""
-    if result is None:
+    if result is None or not result[0][..., 3].any():  # nothing, or all outside the frame
         compositor.mute(scene)
         return
     rgba, _depth = result

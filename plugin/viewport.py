@@ -1,27 +1,39 @@
 """3D viewport: a POST_VIEW draw handler that composites the library's
 premultiplied RGBA + depth into the view.
 
-Per region and volume it
-  1. reads the depth of the bound framebuffer (the scene's depth at
-     POST_VIEW) and converts it to planar view distance, so the library's
-     rays stop at geometry (a mesh inside the volume hides what is behind);
-  2. re-renders only when an input changed: view, projection, size, the
-     volume's properties, its matrix, the lights or the depth;
-  3. renders at reduced resolution (and double step) while the view moves,
-     and a timer asks for a full-resolution frame once it has settled;
-  4. draws a full-screen quad with gl_FragDepth from the library's depth,
+Per region and volume, on every redraw:
+  1. Skip volumes that are hidden, excluded or outside the view frustum:
+     they cost no render, no depth read-back and no job.
+  2. Read the depth of the bound framebuffer (the scene's depth at
+     POST_VIEW), convert it to planar view distance and reduce it to what
+     can change the image (depth.for_library): rays stop at geometry.
+  3. Build the render parameters and hash them (native.params_digest: every
+     struct field, the scene depth's contents and the volume's identity).
+     Equal hash = the image on screen is still right: nothing is rendered.
+  4. Otherwise, progressive refinement:
+       * an interactive frame (reduced resolution, doubled step) is
+         rendered synchronously so the view follows the mouse;
+       * once the view has been still for "Refine After" seconds, the full
+         frame is queued on the renderer's background worker
+         (runtime.Worker), which renders it in bands and drops it between
+         bands as soon as it is stale (the view or anything else changed);
+         a timer polls for the result and redraws. The draw handler never
+         waits for a full frame: at most for the band in flight.
+  5. Draw a full-screen quad with gl_FragDepth from the library's depth,
      depth test LESS_EQUAL and premultiplied blending (no depth writes).
      Where the volume has no hit the fragment gets the scene's own depth,
      so its colour (in front of that geometry, since the rays stopped
      there) always blends.
 """
 
+import collections
 import time
 import zlib
 
 import bpy
 import gpu
 import numpy as np
+from bpy.app.handlers import persistent
 from gpu_extras.batch import batch_for_shader
 
 from . import depth as _depth
@@ -32,18 +44,68 @@ _shader = None
 _batch = None
 _states = {}          # (region pointer, object name) -> _State
 _refine_pending = False
+_poll_registered = False
 last_error = ""
+
+# Diagnostics for the tests and the panel.
+draw_count = 0        # draw handler calls
+culled_count = 0      # volumes skipped because they were outside the frustum
+# (seconds in the handler, view moving, a refined frame in flight at its start)
+draw_log = collections.deque(maxlen=256)
+
+
+class _Image:
+    """One rendered frame, uploaded: GPUTextures must outlive the draw call
+    that samples them, so they live here until replaced."""
+
+    def __init__(self, key, rgba, vdepth, win_small, proj, full):
+        self.key = key
+        self.full = full
+        self.height, self.width = rgba.shape[:2]
+        self.vdepth = vdepth
+        self.proj = proj
+        self.color = _texture(rgba, "RGBA32F")
+        self.depth = None
+        self.depth_crc = None
+        self.update_depth(win_small)
+
+    def update_depth(self, win_small):
+        """Fragment depth from the volume's hit depth and the scene depth
+        now on screen. Cheap (no library call); redone only when the scene
+        depth at this resolution changed, e.g. by less than the quantum of
+        the frame key."""
+        crc = zlib.crc32(win_small.tobytes()) if win_small is not None else None
+        if crc == self.depth_crc and self.depth is not None:
+            return
+        frag = _depth.planar_to_window(self.vdepth, self.proj)
+        if win_small is not None:
+            frag = np.where(np.isfinite(self.vdepth), np.minimum(frag, win_small), win_small)
+        self.depth = _texture(frag, "R32F")
+        self.depth_crc = crc
 
 
 class _State:
     def __init__(self):
         self.view_key = None
         self.moved_at = -1e9
-        self.key = None
-        # GPUTextures must outlive the draw call that samples them.
-        self.color = None
-        self.depth = None
         self.used_at = 0.0
+        self.fast = None      # latest interactive _Image
+        self.full = None      # latest full-resolution _Image
+        self.shown = None     # the _Image drawn last
+        self.job = None       # runtime.Job of the full frame being refined
+        self.job_entry = None
+        self.announced = False
+        self.error_key = None
+
+    # compatibility with older tests and scripts: the drawn textures
+    @property
+    def color(self):
+        return self.shown.color if self.shown is not None else None
+
+    def cancel_job(self):
+        if self.job is not None and not self.job.done and self.job_entry is not None:
+            self.job_entry.worker.cancel(self.job)
+        self.job = None
 
 
 _VERT = "void main() { uv = pos * 0.5 + 0.5; gl_Position = vec4(pos, 0.0, 1.0); }"
@@ -71,22 +133,23 @@ def _get_shader():
 
 
 def _read_window_depth(width, height):
+    """The bound framebuffer's depth (window depth 0..1) as a (height,
+    width) array, row 0 = bottom.
+
+    Read into a one-dimensional Buffer on purpose: Blender 3.4's
+    gpu.types.Buffer exports multi-dimensional shapes to the buffer
+    protocol with Fortran strides (stride[0] = item size) although the data
+    is row-major, so np.asarray() of read_depth()'s (height, width) Buffer
+    is the transposed memory reshaped: a mesh in front of part of the view
+    came out as vertical stripes. A flat Buffer has one stride and no
+    ambiguity."""
+    buf = gpu.types.Buffer("FLOAT", width * height)
     try:
         fb = gpu.state.active_framebuffer_get()
-        buf = fb.read_depth(0, 0, width, height)
+        fb.read_depth(0, 0, width, height, data=buf)
     except Exception:  # no depth attachment: draw without occlusion input
         return None
     return np.asarray(buf, dtype=np.float32).reshape(height, width)
-
-
-def _downsample(img, w, h):
-    """Nearest sample at the centre of each low-resolution pixel."""
-    H, W = img.shape[:2]
-    if (W, H) == (w, h):
-        return img
-    ys = np.minimum(((np.arange(h) + 0.5) * H / h).astype(np.int64), H - 1)
-    xs = np.minimum(((np.arange(w) + 0.5) * W / w).astype(np.int64), W - 1)
-    return np.ascontiguousarray(img[ys][:, xs])
 
 
 def _texture(arr, fmt):
@@ -97,13 +160,10 @@ def _texture(arr, fmt):
 
 
 def _outside_frustum(model, dims, view, proj):
-    """True when all 8 box corners lie beyond the same clip plane."""
-    c = volume_space.world_corners(model, dims)
-    clip = np.c_[c, np.ones(8)] @ (proj @ view).T
-    w = clip[:, 3:4]
-    return bool(np.any(np.all(clip[:, :3] > w, axis=0)) or
-                np.any(np.all(clip[:, :3] < -w, axis=0)))
+    return volume_space.outside_frustum(model, dims, view, proj)
 
+
+# ------------------------------------------------------------- timers
 
 def _refine():
     global _refine_pending
@@ -120,8 +180,104 @@ def _schedule_refine(delay):
         bpy.app.timers.register(_refine, first_interval=max(delay, 0.02))
 
 
-def _draw():
+def _tag_region(region_ptr):
+    wm = getattr(bpy.context, "window_manager", None)
+    if wm is None:
+        return
+    for win in wm.windows:
+        for area in win.screen.areas:
+            if area.type == "VIEW_3D" and any(r.as_pointer() == region_ptr for r in area.regions):
+                area.tag_redraw()
+
+
+def _poll():
+    """Main-thread timer: redraw the regions whose refined frame is ready."""
+    global _poll_registered
+    waiting = False
+    for (region_ptr, _name), st in list(_states.items()):
+        job = st.job
+        if job is None:
+            continue
+        if job.done:
+            if not st.announced:
+                st.announced = True
+                _tag_region(region_ptr)
+        else:
+            waiting = True
+    if waiting:
+        return 0.03
+    _poll_registered = False
+    return None
+
+
+def _ensure_poll():
+    global _poll_registered
+    if not _poll_registered:
+        _poll_registered = True
+        bpy.app.timers.register(_poll, first_interval=0.03)
+
+
+def busy():
+    """True while a refined frame is queued or being rendered."""
+    return any(st.job is not None and not st.job.done for st in _states.values()) \
+        or runtime.busy()
+
+
+# --------------------------------------------------------------- frames
+
+class _Frame:
+    """Everything one render of one volume at one size needs, and its key."""
+
+    def __init__(self, ob, entry, w, h, view, proj, model, raw_depth, lights, fast):
+        self.w, self.h = w, h
+        dims = tuple(ob.voxlight.dims)
+        self.rect = volume_space.screen_rect(model, dims, view, proj, w, h)
+        self.win_small = None
+        scene_depth = None
+        if raw_depth is not None:
+            self.win_small = _depth.downsample(raw_depth, w, h)
+            near, far = volume_space.planar_range(model, dims, view)
+            quantum = 0.125 * volume_space.voxel_size(model)
+            scene_depth = _depth.for_library(_depth.window_to_planar(self.win_small, proj),
+                                             near, far, quantum, self.rect)
+        self.params = params.build(ob, w, h, view, proj, scene_depth=scene_depth,
+                                   lights=lights, fast=fast)
+        self.key = native.params_digest(self.params, entry.identity)
+
+
+def _size(W, H, frac):
+    return max(1, round(W * frac)), max(1, round(H * frac))
+
+
+def _draw_image(img, shader, batch):
+    if img is None or img.color is None:
+        return
+    shader.bind()
+    shader.uniform_sampler("color_tex", img.color)
+    shader.uniform_sampler("depth_tex", img.depth)
+    gpu.state.depth_test_set("LESS_EQUAL")
+    # No depth writes: Blender may redraw only the overlays and keep the
+    # scene's depth buffer, and the next frame's depth read must not see
+    # the volume's own depth (that feedback made rays stop at stale hits).
+    gpu.state.depth_mask_set(False)
+    gpu.state.blend_set("ALPHA_PREMULT")
+    batch.draw(shader)
+    gpu.state.blend_set("NONE")
+    gpu.state.depth_test_set("NONE")
+
+
+def _report(e):
     global last_error
+    if last_error != str(e):
+        print("Voxlight: viewport render failed: %s" % e)
+    last_error = str(e)
+
+
+def _draw():
+    global draw_count, culled_count, last_error
+    t_draw = time.perf_counter()
+    draw_count += 1
+    in_flight = busy()
     ctx = bpy.context
     scene = ctx.scene
     if scene is None or not scene.voxlight.viewport_enabled:
@@ -130,98 +286,158 @@ def _draw():
     if rv3d is None or region is None:
         return
     view_layer = ctx.view_layer
+    # visible_get covers hidden objects, disabled and excluded collections
+    # and local view; such volumes cost nothing.
     objs = [o for o in view_layer.objects
             if o.type == "EMPTY" and o.voxlight.is_volume and o.visible_get(viewport=space)]
-    if not objs:
-        return
-    s = scene.voxlight
-    W, H = region.width, region.height
-    view = np.array(rv3d.view_matrix, np.float64)
-    proj = np.array(rv3d.window_matrix, np.float64)
-    window_depth = _read_window_depth(W, H)
-    depsgraph = ctx.evaluated_depsgraph_get()
-    lights = params.scene_lights(scene, depsgraph)
-    now = time.monotonic()
-    view_key = (view.tobytes(), proj.tobytes(), W, H)
-    shader, batch = _get_shader()
+    region_ptr = region.as_pointer()
+    drawn = set()
+    moving_any = False
+    if objs:
+        s = scene.voxlight
+        vp = gpu.state.viewport_get()
+        W, H = (vp[2], vp[3]) if vp[2] > 0 and vp[3] > 0 else (region.width, region.height)
+        view = np.array(rv3d.view_matrix, np.float64)
+        proj = np.array(rv3d.window_matrix, np.float64)
+        depsgraph = ctx.evaluated_depsgraph_get()
+        now = time.monotonic()
+        view_key = (view.tobytes(), proj.tobytes(), W, H)
+        raw_depth = None
+        depth_read = False
+        lights = None
+        shader, batch = _get_shader()
 
-    for obj in objs:
-        ob = obj.evaluated_get(depsgraph)
-        model = params.model_matrix(ob)
-        if _outside_frustum(model, tuple(ob.voxlight.dims), view, proj):
-            continue
-        st = _states.get((region.as_pointer(), obj.name))
-        if st is None:
-            st = _states[(region.as_pointer(), obj.name)] = _State()
-        st.used_at = now
-        if view_key != st.view_key:
-            if st.view_key is not None:
-                st.moved_at = now
-            st.view_key = view_key
-        moving = (now - st.moved_at) < s.settle_time
-        frac = s.interactive_resolution if moving else s.viewport_resolution
-        w, h = max(1, round(W * frac)), max(1, round(H * frac))
-        win_small = _downsample(window_depth, w, h) if window_depth is not None else None
-        key = (view_key, w, h, params.look_key(ob.voxlight, fast=moving), tuple(lights),
-               model.tobytes(), ob.voxlight.filepath,
-               zlib.crc32(win_small.tobytes()) if win_small is not None else None)
-        if key != st.key:
+        for obj in objs:
+            ob = obj.evaluated_get(depsgraph)
+            model = params.model_matrix(ob)
+            if _outside_frustum(model, tuple(ob.voxlight.dims), view, proj):
+                culled_count += 1
+                continue
+            key = (region_ptr, obj.name)
+            drawn.add(key)
+            st = _states.get(key)
+            if st is None:
+                st = _states[key] = _State()
+            st.used_at = now
+            if view_key != st.view_key:
+                if st.view_key is not None:
+                    st.moved_at = now
+                st.view_key = view_key
+            moving = (now - st.moved_at) < s.settle_time
+            moving_any |= moving
             try:
                 entry = runtime.get_entry(bpy.path.abspath(ob.voxlight.filepath), s.backend)
-                scene_depth = (_depth.window_to_planar(win_small, proj)
-                               if win_small is not None else None)
-                p = params.build(ob, w, h, view, proj, scene_depth=scene_depth,
-                                 lights=lights, fast=moving)
-                rgba, vdepth = runtime.render(entry, p)
             except native.VoxlightError as e:
-                if last_error != str(e):
-                    print("Voxlight: viewport render failed: %s" % e)
-                last_error = str(e)
-                st.key, st.color, st.depth = key, None, None
+                _report(e)
+                continue
+            if not depth_read:
+                raw_depth = _read_window_depth(W, H)
+                depth_read = True
+                lights = params.scene_lights(scene, depsgraph)
+            try:
+                shown = _update(st, ob, entry, W, H, view, proj, model, raw_depth, lights,
+                                moving, key)
+            except native.VoxlightError as e:
+                _report(e)
                 continue
             last_error = ""
-            frag_depth = _depth.planar_to_window(vdepth, proj)
-            if win_small is not None:
-                frag_depth = np.where(np.isfinite(vdepth),
-                                      np.minimum(frag_depth, win_small), win_small)
-            st.color = _texture(rgba, "RGBA32F")
-            st.depth = _texture(frag_depth, "R32F")
-            st.key = key
-        if moving:
-            _schedule_refine(s.settle_time - (now - st.moved_at) + 0.01)
-        if st.color is None:
-            continue
-        shader.bind()
-        shader.uniform_sampler("color_tex", st.color)
-        shader.uniform_sampler("depth_tex", st.depth)
-        gpu.state.depth_test_set("LESS_EQUAL")
-        # No depth writes: Blender may redraw only the overlays and keep the
-        # scene's depth buffer, and the next frame's depth read must not see
-        # the volume's own depth (that feedback made rays stop at stale hits).
-        gpu.state.depth_mask_set(False)
-        gpu.state.blend_set("ALPHA_PREMULT")
-        batch.draw(shader)
-        gpu.state.blend_set("NONE")
-        gpu.state.depth_test_set("NONE")
+            if moving:
+                _schedule_refine(s.settle_time - (now - st.moved_at) + 0.01)
+            st.shown = shown
+            _draw_image(shown, shader, batch)
 
+    # Volumes of this region that were not drawn (hidden, culled, deleted)
+    # must not keep a worker busy.
+    for key, st in _states.items():
+        if key[0] == region_ptr and key not in drawn:
+            st.cancel_job()
     if len(_states) > 64:  # forget regions and objects not drawn for a minute
+        now = time.monotonic()
         for k in [k for k, v in _states.items() if now - v.used_at > 60.0]:
-            del _states[k]
+            _states.pop(k).cancel_job()
+    draw_log.append((time.perf_counter() - t_draw, moving_any, in_flight))
+
+
+def _update(st, ob, entry, W, H, view, proj, model, raw_depth, lights, moving, owner):
+    """Decide what to show for one volume; render only what is missing."""
+    s = bpy.context.scene.voxlight
+    if not moving:
+        fw, fh = _size(W, H, s.viewport_resolution)
+        full = _Frame(ob, entry, fw, fh, view, proj, model, raw_depth, lights, fast=False)
+        job = st.job
+        if job is not None and job.done and job.key == full.key and job.result is not None:
+            rgba, vdepth, _stats = job.result
+            st.full = _Image(full.key, rgba, vdepth, full.win_small, proj, True)
+            st.job = None
+        elif job is not None and job.done and job.key == full.key and job.error is not None:
+            st.job = None
+            st.error_key = full.key
+            raise native.VoxlightError(str(job.error))
+        if st.full is not None and st.full.key == full.key:
+            st.full.update_depth(full.win_small)
+            st.cancel_job()
+            return st.full
+        if st.error_key == full.key:
+            return None
+        if full.rect is None:  # nothing of the box on screen at this size
+            return None
+        if st.job is None or st.job.key != full.key or (st.job.done and st.job.result is None):
+            st.cancel_job()
+            st.job = entry.worker.submit(runtime.Job(owner, full.key, full.params, full.rect))
+            st.job_entry = entry
+            st.announced = False
+            _ensure_poll()
+    else:
+        st.cancel_job()
+    iw, ih = _size(W, H, s.interactive_resolution)
+    fast = _Frame(ob, entry, iw, ih, view, proj, model, raw_depth, lights, fast=True)
+    if st.fast is None or st.fast.key != fast.key:
+        if fast.rect is None or st.error_key == fast.key:
+            return None  # off screen, or failed with exactly these inputs: no retry per redraw
+        try:
+            rgba, vdepth, _stats = runtime.render_rect(entry, fast.params, fast.rect)
+        except native.VoxlightError:
+            st.error_key = fast.key
+            raise
+        st.fast = _Image(fast.key, rgba, vdepth, fast.win_small, proj, False)
+    else:
+        st.fast.update_depth(fast.win_small)
+    return st.fast
+
+
+def _forget_all():
+    for st in _states.values():
+        st.cancel_job()
+    _states.clear()
+
+
+@persistent
+def _on_load_pre(*_args):
+    """A file is being opened: its regions are new, drop every cached
+    frame and refine in flight."""
+    _forget_all()
 
 
 def register():
     global _handle
     if _handle is None:
         _handle = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
+    if _on_load_pre not in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.append(_on_load_pre)
 
 
 def unregister():
-    global _handle, _shader, _batch, _refine_pending
+    global _handle, _shader, _batch, _refine_pending, _poll_registered
     if _handle is not None:
         bpy.types.SpaceView3D.draw_handler_remove(_handle, "WINDOW")
         _handle = None
-    if bpy.app.timers.is_registered(_refine):
-        bpy.app.timers.unregister(_refine)
-    _refine_pending = False
-    _states.clear()
+    for fn in (_refine, _poll):
+        if bpy.app.timers.is_registered(fn):
+            bpy.app.timers.unregister(fn)
+    _refine_pending = _poll_registered = False
+    for h in list(bpy.app.handlers.load_pre):
+        if h is _on_load_pre or (getattr(h, "__name__", "") == _on_load_pre.__name__ and
+                                 getattr(h, "__module__", "") == _on_load_pre.__module__):
+            bpy.app.handlers.load_pre.remove(h)
+    _forget_all()
     _shader = _batch = None

@@ -53,3 +53,55 @@ def world_corners(model, dims):
     hi = np.asarray(dims, np.float64) - 0.5
     pts = np.array([[hi[a] if (c >> a) & 1 else lo for a in range(3)] + [1.0] for c in range(8)])
     return (pts @ np.asarray(model, np.float64).T)[:, :3]
+
+
+def _clip_corners(model, dims, view, proj):
+    c = world_corners(model, dims)
+    return np.c_[c, np.ones(8)] @ (np.asarray(proj, np.float64) @ np.asarray(view, np.float64)).T
+
+
+def outside_frustum(model, dims, view, proj):
+    """True when all 8 box corners lie beyond the same clip plane (the box
+    cannot be seen; conservative: a box may be reported visible when it
+    is not, never the other way round)."""
+    clip = _clip_corners(model, dims, view, proj)
+    w = clip[:, 3:4]
+    return bool(np.any(np.all(clip[:, :3] > w, axis=0)) or
+                np.any(np.all(clip[:, :3] < -w, axis=0)))
+
+
+def screen_rect(model, dims, view, proj, width, height, margin=1):
+    """Pixel rectangle (x0, y0, x1, y1), row 0 = bottom, end exclusive, that
+    holds every pixel whose ray can meet the box; None when the box is
+    outside the view frustum. The whole image when a corner lies behind
+    the camera (its projection is then not bounded by the corners')."""
+    if outside_frustum(model, dims, view, proj):
+        return None
+    clip = _clip_corners(model, dims, view, proj)
+    w = clip[:, 3]
+    if np.any(w <= 1e-9):
+        return (0, 0, int(width), int(height))
+    ndc = clip[:, :2] / w[:, None]
+    sx = (ndc[:, 0] * 0.5 + 0.5) * width
+    sy = (ndc[:, 1] * 0.5 + 0.5) * height
+    x0 = int(np.clip(np.floor(sx.min()) - margin, 0, width))
+    x1 = int(np.clip(np.ceil(sx.max()) + margin, 0, width))
+    y0 = int(np.clip(np.floor(sy.min()) - margin, 0, height))
+    y1 = int(np.clip(np.ceil(sy.max()) + margin, 0, height))
+    if x1 <= x0 or y1 <= y0:
+        return None
+    return (x0, y0, x1, y1)
+
+
+def planar_range(model, dims, view):
+    """(nearest, farthest) view-space planar distance of the box: the range
+    in which a scene depth can stop a ray inside it."""
+    c = world_corners(model, dims)
+    z = (np.c_[c, np.ones(8)] @ np.asarray(view, np.float64).T)[:, 2]
+    return float((-z).min()), float((-z).max())
+
+
+def voxel_size(model):
+    """The smallest world-space edge of one voxel under `model`."""
+    m = np.asarray(model, np.float64).reshape(4, 4)
+    return float(np.linalg.norm(m[:3, :3], axis=0).min())

@@ -53,10 +53,13 @@ void main()
     vec4 hn = u_inv_mvp * vec4(ndc, -1.0, 1.0);
     vec4 hf = u_inv_mvp * vec4(ndc, 1.0, 1.0);
     vec3 o = hn.xyz / hn.w;
-    vec3 dir = hf.xyz / hf.w - o;
-    float t_far = length(dir);
-    if (!(t_far > 0.0) || isinf(t_far) || any(isnan(o)) || any(isinf(o))) { emit_nothing(); return; }
-    dir /= t_far;
+    // The direction from the homogeneous points without dividing by hf.w,
+    // which is ~0 for a far plane at 1e9 (or infinity) in float.
+    vec3 dir = hf.xyz * hn.w - hn.xyz * hf.w;
+    float len = length(dir);
+    float t_far = hn.w * hf.w > 0.0 ? len / (hn.w * hf.w) : uintBitsToFloat(0x7f800000u);
+    if (!(len > 0.0) || isinf(len) || any(isnan(o)) || any(isinf(o)) || isnan(t_far)) { emit_nothing(); return; }
+    dir /= len;
 
     // Slab test with a guarded reciprocal: an axis-parallel ray whose origin
     // lies on a slab plane would otherwise give 0 * inf = NaN.

@@ -77,7 +77,7 @@ for script in "$ROOT"/tests/blender/test_*.py; do
                 continue
             fi
             run_script "$label" xvfb-run -a -s "-screen 0 1280x1024x24" \
-                "$BLENDER" --factory-startup --python-exit-code 1 --python "$script"
+                "$BLENDER" --factory-startup --enable-event-simulate --python-exit-code 1 --python "$script"
             ;;
         *)
             run_script "$label" "$BLENDER" -b --factory-startup --python-exit-code 1 \

@@ -1,12 +1,18 @@
 """GUI Blender under Xvfb: the viewport draw handler composites the volume.
 
 xvfb-run -a -s "-screen 0 1280x1024x24" blender --factory-startup \
-    --python-exit-code 1 --python tests/blender/test_gui.py
+    --enable-event-simulate --python-exit-code 1 --python tests/blender/test_gui.py
 
 The steps run from a timer once the window exists. Pixels are read back by
 a POST_PIXEL handler of this test (after the add-on's POST_VIEW composite).
 The script exits itself with status 0 or 1 (a timer's exception would not
 reach --python-exit-code), with a watchdog against hangs.
+
+Renders are counted with the add-on's counters: runtime.render_count
+(frames), runtime.call_count (library vxl_render calls) and
+viewport.draw_count (draw handler calls, to prove that a redraw happened).
+--enable-event-simulate lets the test move the mouse over buttons and
+gizmos (Window.event_simulate): real UI hover redraws.
 """
 
 import math
@@ -23,7 +29,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import _util as u  # noqa: E402
 
 START = time.time()
-LIMIT_S = 400
+LIMIT_S = 500
 results = []
 capture = {"want": False, "img": None}
 
@@ -46,10 +52,11 @@ def view3d():
     raise RuntimeError("no 3D viewport")
 
 
-def redraw():
+def redraw(types=None):
     for win in bpy.context.window_manager.windows:
         for area in win.screen.areas:
-            area.tag_redraw()
+            if types is None or area.type in types:
+                area.tag_redraw()
 
 
 def check(name, cond, detail=""):
@@ -67,6 +74,7 @@ def finish():
 def steps():
     """A generator: each yield is the delay (s) before the next step."""
     vx = u.install_addon()
+    rt, vp = vx.runtime, vx.viewport
     bpy.types.SpaceView3D.draw_handler_add(_capture_handler, (), "WINDOW", "POST_PIXEL")
     scene = u.reset_scene()
     scene.voxlight.viewport_resolution = 0.5  # llvmpipe: keep each render short
@@ -79,23 +87,30 @@ def steps():
     r3d.view_location = (0.0, 0.0, 0.0)
     r3d.view_rotation = Euler((math.radians(90), 0.0, 0.0)).to_quaternion()  # front, from -Y
     r3d.view_distance = 4.0
+    region = [r for r in area.regions if r.type == "WINDOW"][0]
+    for a in win.screen.areas:  # the Voxlight panel (with its frame stats) is drawn too
+        if a.type == "PROPERTIES":
+            a.spaces.active.context = "OBJECT"
     yield 0.5
 
     def grab():
         capture["want"], capture["img"] = True, None
-        redraw()
+        redraw(("VIEW_3D",))
 
     def settled():
-        """Grab until the add-on stops re-rendering: after a scene change the
-        viewport's anti-aliasing redraws a few times, and the depth the
-        add-on reads settles with it."""
+        """Grab until the add-on has nothing in flight and stops rendering:
+        the refined frame is rendered in the background after the view
+        settles."""
         last = -1
-        for _ in range(15):
+        for _ in range(40):
             grab()
-            yield 1.0
-            if capture["img"] is not None and vx.runtime.render_count == last:
+            yield 0.5
+            if capture["img"] is not None and not vp.busy() and rt.render_count == last:
                 return
-            last = vx.runtime.render_count
+            last = rt.render_count
+
+    def counts():
+        return rt.render_count, rt.call_count, vp.draw_count
 
     # 1. The scene before the volume exists.
     grab()
@@ -116,19 +131,63 @@ def steps():
     corner = diff[:40, :40].mean()
     check("volume_visible", centre > 0.1 and corner < 0.02, "centre %.3f corner %.3f"
           % (centre, corner))
-    st = [s for k, s in vx.viewport._states.items() if k[1] == ob.name][0]
-    region_w = [r for r in area.regions if r.type == "WINDOW"][0].width
-    check("full_resolution_when_still", st.color is not None
-          and st.color.width == max(1, round(region_w * 0.5)),
-          "texture %dx%d, region width %d" % (st.color.width, st.color.height, region_w))
+    st = [s for k, s in vp._states.items() if k[1] == ob.name][0]
+    check("full_resolution_when_still", st.shown is not None and st.shown.full
+          and st.shown.width == max(1, round(region.width * 0.5)),
+          "texture %dx%d, region width %d" % (st.shown.width, st.shown.height, region.width))
 
-    # 2. Unrelated redraws do not re-render.
-    n = vx.runtime.render_count
+    # 2. Unrelated redraws do not re-render: tagged redraws of every area and
+    # of other editors, frame changes with nothing animated, and the mouse
+    # hovering over header buttons, the navigation gizmo and other editors.
+    f0, c0, d0 = counts()
     for _ in range(3):
         redraw()
         yield 0.3
-    check("no_rerender_on_redraw", vx.runtime.render_count == n,
-          "%d -> %d" % (n, vx.runtime.render_count))
+    for _ in range(2):
+        redraw(("PROPERTIES", "OUTLINER", "DOPESHEET_EDITOR", "TIMELINE"))
+        yield 0.2
+    f1, c1, d1 = counts()
+    check("no_rerender_on_tagged_redraws", (f1, c1) == (f0, c0) and d1 >= d0 + 3,
+          "frames %d -> %d, calls %d -> %d, viewport draws %d -> %d" % (f0, f1, c0, c1, d0, d1))
+
+    for frame in (5, 17, 2, 1):
+        scene.frame_set(frame)
+        yield 0.3
+    scene.frame_current = 40
+    yield 0.3
+    scene.frame_set(1)
+    yield 0.5
+    f2, c2, d2 = counts()
+    check("no_rerender_on_frame_change", (f2, c2) == (f1, c1) and d2 > d1,
+          "frames %d -> %d, calls %d -> %d, viewport draws %d -> %d" % (f1, f2, c1, c2, d1, d2))
+
+    hover_ok = hasattr(win, "event_simulate")
+    if hover_ok:
+        header = [r for r in area.regions if r.type == "HEADER"][0]
+        targets = []
+        # Along the 3D view's header (its buttons highlight under the mouse).
+        for fx in np.linspace(0.05, 0.95, 12):
+            targets.append((header.x + int(header.width * fx), header.y + header.height // 2))
+        # Over the navigation gizmo at the region's top right, and back out.
+        for dx, dy in ((60, 80), (45, 60), (80, 130), (60, 190), (200, 200)):
+            targets.append((region.x + region.width - dx, region.y + region.height - dy))
+        # Over the other editors (outliner, properties, timeline).
+        for a in win.screen.areas:
+            if a.type != "VIEW_3D":
+                for fy in (0.3, 0.6):
+                    targets.append((a.x + a.width // 2, a.y + int(a.height * fy)))
+        try:
+            for x, y in targets:
+                win.event_simulate(type="MOUSEMOVE", value="NOTHING", x=int(x), y=int(y))
+                yield 0.1
+        except Exception as e:  # Blender started without --enable-event-simulate
+            hover_ok = False
+            print("event_simulate unavailable: %s" % e)
+        yield 0.5
+    f3, c3, d3 = counts()
+    check("no_rerender_on_hover", hover_ok and (f3, c3) == (f2, c2) and d3 > d2,
+          "frames %d -> %d, calls %d -> %d, viewport draws %d -> %d (hover simulated: %s)"
+          % (f2, f3, c2, c3, d2, d3, hover_ok))
 
     # 3. An opaque plane in front of the left half hides the volume there.
     with bpy.context.temp_override(window=win, area=area):
@@ -149,23 +208,123 @@ def steps():
     check("occluded_by_mesh_in_front", d_left < 0.02, "left differs from plane by %.3f" % d_left)
     check("visible_beside_mesh", d_right < 0.05 and np.abs(vol[right][:3] - empty[right][:3]).max()
           > 0.1, "right differs from volume-alone by %.3f" % d_right)
+    # The whole unoccluded half equals the volume alone, not only one pixel.
+    half = np.abs(both[:, cx + 10:, :3] - vol[:, cx + 10:, :3]).max(axis=2)
+    check("unoccluded_half_unchanged", np.mean(half > 0.05) < 0.002,
+          "%.4f of the right half differs" % np.mean(half > 0.05))
 
-    # 4. Orbiting changes the image, first coarse then refined.
+    # 4. Hidden, excluded, disabled or off-screen volumes cost nothing: no
+    # library call while they are away. When they come back unchanged, the
+    # cached frame is still right, so even then nothing is rendered.
     plane.hide_set(True)
     yield from settled()
+    coll = bpy.data.collections.new("Volumes")
+    scene.collection.children.link(coll)
+    coll.objects.link(ob)
+    for c in list(ob.users_collection):
+        if c is not coll:
+            c.objects.unlink(ob)
+    yield from settled()
+    layer_coll = bpy.context.view_layer.layer_collection.children[coll.name]
+
+    def away_and_back(label, hide, show):
+        f_a, c_a, d_a = counts()
+        hide()
+        for _ in range(3):
+            grab()
+            yield 0.4
+        gone = capture["img"]
+        f_b, c_b, d_b = counts()
+        no_volume = gone is not None and np.abs(gone[..., :3] - empty[..., :3]).max() < 0.02
+        check("no_render_when_" + label, c_b == c_a and d_b > d_a and no_volume,
+              "calls %d -> %d, draws %d -> %d, volume gone from the pixels: %s"
+              % (c_a, c_b, d_a, d_b, no_volume))
+        show()
+        yield from settled()
+        back = capture["img"]
+        f_c, c_c, _ = counts()
+        same = np.abs(back[..., :3] - vol[..., :3]).max() < 0.02
+        check("cached_frame_when_back_from_" + label, c_c == c_b and same,
+              "calls %d -> %d, image as before: %s" % (c_b, c_c, same))
+
+    yield from away_and_back("hidden", lambda: ob.hide_set(True), lambda: ob.hide_set(False))
+    yield from away_and_back("collection_excluded",
+                             lambda: setattr(layer_coll, "exclude", True),
+                             lambda: setattr(layer_coll, "exclude", False))
+    # exclude resets the layer collection; fetch it again
+    layer_coll = bpy.context.view_layer.layer_collection.children[coll.name]
+    yield from away_and_back("collection_disabled",
+                             lambda: setattr(coll, "hide_viewport", True),
+                             lambda: setattr(coll, "hide_viewport", False))
+    yield from away_and_back("collection_hidden",
+                             lambda: setattr(layer_coll, "hide_viewport", True),
+                             lambda: setattr(layer_coll, "hide_viewport", False))
+    home = tuple(ob.location)
+    culled = vp.culled_count
+    yield from away_and_back("outside_frustum",
+                             lambda: setattr(ob, "location", (home[0] + 50.0, home[1], home[2])),
+                             lambda: setattr(ob, "location", home))
+    check("outside_frustum_was_culled", vp.culled_count > culled,
+          "culled %d -> %d" % (culled, vp.culled_count))
+
+    # 5. Orbiting changes the image, first coarse then refined.
+    yield from settled()
     before = capture["img"]
-    n = vx.runtime.render_count
+    n = rt.render_count
     r3d.view_rotation = Quaternion((0, 0, 1), math.radians(35)) @ r3d.view_rotation
     grab()
     yield 0.05
-    moving_w = st.color.width if st.color is not None else 0
+    moving_w = st.shown.width if st.shown is not None else 0
     yield from settled()
     after = capture["img"]
     change = np.abs(after[..., :3] - before[..., :3]).max(axis=2).mean()
     check("orbit_changes_image", change > 0.01, "mean change %.4f" % change)
-    check("refined_after_moving", vx.runtime.render_count >= n + 2 and moving_w < st.color.width,
-          "renders %d -> %d, widths %d -> %d" % (n, vx.runtime.render_count, moving_w,
-                                                 st.color.width))
+    check("refined_after_moving", rt.render_count >= n + 2 and moving_w < st.shown.width
+          and st.shown.full,
+          "renders %d -> %d, widths %d -> %d" % (n, rt.render_count, moving_w, st.shown.width))
+
+    # 6. A full-resolution frame in flight never blocks navigation. Make the
+    # full frame slow (the whole region), orbit, wait until its refine
+    # is being rendered in the background, then orbit on: the stale frame is
+    # dropped within one band, and the draws made while it was in flight
+    # take far less than a full frame.
+    scene.voxlight.viewport_resolution = 1.0
+    yield from settled()
+    entry = rt.find_entry(ob.voxlight.filepath)
+    full_s = entry.last_frame["seconds"]
+    dropped = rt.cancelled_count
+    waits = []
+    in_flight_seen = 0
+    for i in range(3):
+        r3d.view_rotation = Quaternion((0, 0, 1), math.radians(10)) @ r3d.view_rotation
+        redraw(("VIEW_3D",))
+        for _ in range(100):  # until the refine has started
+            yield 0.05
+            if vp.busy():
+                break
+        in_flight_seen += vp.busy()
+        mark = vp.draw_count
+        r3d.view_rotation = Quaternion((0, 0, 1), math.radians(-7)) @ r3d.view_rotation
+        redraw(("VIEW_3D",))
+        yield 0.05
+        new = vp.draw_count - mark
+        log = list(vp.draw_log)[-new:] if new > 0 else []
+        waits += [d for d, moving, inflight in log if moving and inflight]
+        print("navigation %d: draws %s" % (i, ["%.3f moving=%s in-flight=%s" % x for x in log]),
+              flush=True)
+    yield from settled()
+    last = entry.last_frame
+    if last["kind"] == "refined":
+        full_s = min(full_s, last["seconds"])
+    check("stale_refine_dropped", in_flight_seen == 3 and rt.cancelled_count >= dropped + 3,
+          "refines in flight when the view moved: %d of 3; dropped %d -> %d"
+          % (in_flight_seen, dropped, rt.cancelled_count))
+    check("navigation_not_blocked_by_refine", bool(waits) and max(waits) < 0.5 * full_s,
+          "draws while a refine was in flight took %s s; a full frame takes %.3f s"
+          % (["%.3f" % x for x in waits], full_s))
+    check("refined_in_the_end", st.shown is not None and st.shown.full
+          and st.shown.width == region.width,
+          "shown %dx%d full=%s" % (st.shown.width, st.shown.height, st.shown.full))
 
 
 def main():

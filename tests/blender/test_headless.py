@@ -108,7 +108,8 @@ def every_panel_property_changes_the_render():
     changes = [
         ("filter", "sobel26"), ("filter", "forward3"), ("filter", "sobel8"),
         ("filter", "sobel14"), ("filter", "precomputed"), ("gradient_16f", True),
-        ("filter", "central"), ("sample_distance", 2.5), ("reuse_gradients", True),
+        ("filter", "cubic"), ("filter", "central"), ("sample_distance", 2.5),
+        ("reuse_gradients", True),
         ("step", 1.5), ("jitter", True), ("preset", "hot"), ("preset", "bone"),
         ("use_window", True), ("window_low", 20.0), ("window_high", 70.0),
         ("opacity_scale", 0.4), ("ambient", 0.8), ("diffuse", 0.2), ("specular", 0.9),
@@ -120,6 +121,60 @@ def every_panel_property_changes_the_render():
         img = _render(ob)
         assert _diff(img, prev) > 1e-3, "%s=%r did not change the image" % (name, value)
         prev = img
+
+
+@test
+def filter_choices_come_from_the_library():
+    """The panel's filter enum is the library's list (vxl_filter_name), with
+    the library's VXL_FILTER_* numbers, so issue 4's 'cubic' (6) is there."""
+    lib = vx.native.load_library()
+    prop = bpy.types.Object.bl_rna.properties["voxlight"].fixed_type.properties["filter"]
+    items = [(i.identifier, i.value) for i in prop.enum_items]
+    assert items == [(n, i) for i, n in enumerate(lib.filter_names())], items
+    assert ("cubic", 6) in items and len(items) == 7
+    assert "cubic" in vx.properties.FIXED_TAP_FILTERS  # sampleDistance greyed out
+
+
+@test
+def renders_skip_volumes_nobody_can_see():
+    """F12 and scripted renders make no library call for a volume outside
+    the camera's frustum, hidden from renders or in an excluded collection."""
+    scene, ob = _scene_with_ball()
+    ob.voxlight.jitter = False
+    w, h = 32, 32
+    rt = vx.runtime
+
+    def f12_layers():
+        dg = bpy.context.evaluated_depsgraph_get()
+        calls = rt.call_count
+        res = vx.offline.render(scene, dg, scene.camera, w, h, for_render=True)
+        return res, rt.call_count - calls
+
+    res, calls = f12_layers()
+    assert calls == 1 and res[0][..., 3].max() > 0.5
+    cam = scene.camera
+    cam.rotation_euler.z += 3.14159  # looking away from the volume
+    res, calls = f12_layers()
+    assert calls == 0 and res is not None and not res[0][..., 3].any(), calls
+    before = rt.call_count
+    img = vx.render_volume(ob, resolution=(w, h))
+    assert rt.call_count == before and img.shape == (h, w, 4) and not img.any()
+    cam.rotation_euler.z -= 3.14159
+    ob.hide_render = True
+    res, calls = f12_layers()
+    assert calls == 0 and res is None
+    ob.hide_render = False
+    coll = bpy.data.collections.new("Hidden volumes")
+    scene.collection.children.link(coll)
+    for c in list(ob.users_collection):
+        c.objects.unlink(ob)
+    coll.objects.link(ob)
+    bpy.context.view_layer.layer_collection.children[coll.name].exclude = True
+    res, calls = f12_layers()
+    assert calls == 0 and res is None
+    bpy.context.view_layer.layer_collection.children[coll.name].exclude = False
+    res, calls = f12_layers()
+    assert calls == 1 and res[0][..., 3].max() > 0.5
 
 
 @test
@@ -227,7 +282,8 @@ def unregister_and_register_again():
     assert not hasattr(bpy.types.Object, "voxlight")
     assert not hasattr(bpy.types.Scene, "voxlight")
     assert "VOXLIGHT_PT_volume" not in dir(bpy.types)
-    for lst in (bpy.app.handlers.render_pre, bpy.app.handlers.render_init):
+    for lst in (bpy.app.handlers.render_pre, bpy.app.handlers.render_init,
+                bpy.app.handlers.frame_change_post, bpy.app.handlers.load_pre):
         assert not [h for h in lst if "voxlight" in getattr(h, "__module__", "")], lst
     funcs = bpy.types.TOPBAR_MT_file_import._dyn_ui_initialize()
     assert not any(_is_our_menu(f) for f in funcs)

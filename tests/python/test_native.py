@@ -194,6 +194,117 @@ def test_param_validation(lib):
         assert lib.preset_index(name) == i
 
 
+def test_filter_names_come_from_the_library(lib):
+    """The add-on's filter list is read from vxl_filter_name; the fallback
+    tuple must agree with it (issue 4 added 'cubic' as VXL_FILTER_CUBIC = 6)."""
+    names = lib.filter_names()
+    assert names == native.FILTERS == native.filter_names(lib)
+    assert names[6] == "cubic" and lib.filter_index("cubic") == 6
+    assert lib.preset_names() == native.PRESETS
+
+
+def test_cubic_filter_renders_differently(lib, renderer, ball_file):
+    with native.Volume.load(ball_file, lib=lib) as v:
+        renderer.set_volume(v)
+    base = dict(width=32, height=32, jitter=False)
+    imgs = {f: renderer.render(filter=f, **base)[0] for f in ("central", "cubic", "precomputed")}
+    assert np.isfinite(imgs["cubic"]).all() and imgs["cubic"][..., 3].max() > 0.5
+    assert np.abs(imgs["cubic"] - imgs["central"]).max() > 1e-3
+    assert np.abs(imgs["cubic"] - imgs["precomputed"]).max() > 1e-3
+
+
+def test_render_stats(lib, renderer, ball_file):
+    with native.Volume.load(ball_file, lib=lib) as v:
+        renderer.set_volume(v)
+    renderer.render(width=32, height=32)
+    st = renderer.stats()
+    assert st["rays"] > 0 and st["samples"] >= st["rays"]
+    assert 0 < st["bricks_occupied"] <= st["bricks_total"] and st["brick_size"] > 0
+    renderer.render(width=32, height=32, no_skip=True)
+    assert renderer.stats()["bricks_total"] == 0
+
+
+def _camera_params(renderer, lib, w, h, **kw):
+    view, proj = renderer.default_camera(width=w, height=h)
+    return native.make_params(width=w, height=h, view=view, proj=proj, lib=lib, **kw)
+
+
+@pytest.mark.parametrize("jitter_seed", [0, 12345])
+def test_tiled_render_equals_whole_render(lib, renderer, ball_file, jitter_seed):
+    """Bands of the image (viewport refinement) give the same image as one
+    call, jitter included (tile_params carries the tile offset through the
+    seed), with a scene depth that is cropped per band."""
+    with native.Volume.load(ball_file, lib=lib) as v:
+        renderer.set_volume(v)
+    w, h = 61, 47
+    p0 = _camera_params(renderer, lib, w, h)
+    _, vd = renderer.render(p0)
+    wall = np.full((h, w), np.inf, np.float32)
+    wall[:, :25] = float(np.nanmin(vd[np.isfinite(vd)])) + 2.0  # inside the ball
+    p = _camera_params(renderer, lib, w, h, scene_depth=wall, jitter_seed=jitter_seed)
+    whole, wd = renderer.render(p)
+    calls = []
+    renderer.on_render = lambda: calls.append(1)
+    try:
+        tiled, td, st = renderer.render_tiled(p, rows=5)
+    finally:
+        renderer.on_render = None
+    assert len(calls) == st["calls"] == (h + 4) // 5
+    assert np.abs(tiled - whole).max() < 5e-3
+    assert np.array_equal(np.isfinite(td), np.isfinite(wd))
+    fin = np.isfinite(wd)
+    assert np.abs(td[fin] - wd[fin]).max() < 1e-2 * np.abs(wd[fin]).max()
+    assert st["rays"] > 0 and st["samples"] > 0
+    # Without the seed offset the jitter pattern would differ per band.
+    renderer.render(p)
+    samples_whole = renderer.stats()["samples"]
+    assert st["samples"] == samples_whole
+
+
+def test_tiled_render_of_a_footprint_and_stopping(lib, renderer, ball_file):
+    with native.Volume.load(ball_file, lib=lib) as v:
+        renderer.set_volume(v)
+    w, h = 64, 64
+    p = _camera_params(renderer, lib, w, h)
+    whole, _ = renderer.render(p)
+    ys, xs = np.nonzero(whole[..., 3] > 0)
+    rect = (xs.min() - 1, ys.min() - 1, xs.max() + 2, ys.max() + 2)
+    part, _, st = renderer.render_tiled(p, rect=rect, rows=h)
+    assert st["calls"] == 1 and np.abs(part - whole).max() < 5e-3
+    asked = []
+
+    def stop():
+        asked.append(1)
+        return len(asked) > 2  # stop before the third band
+    assert renderer.render_tiled(p, rows=4, should_stop=stop) is None
+    assert len(asked) == 3
+    with pytest.raises(ValueError):
+        native.tile_params(native.make_params(width=8, height=8, lib=lib), 0, 0, 4, 4)
+
+
+def test_params_digest_covers_every_input(lib):
+    view, proj = np.eye(4), np.diag([1.0, 1.0, -1.0, 1.0])
+    depth = np.full((8, 8), np.inf, np.float32)
+
+    def key(**kw):
+        args = dict(width=8, height=8, view=view, proj=proj, scene_depth=depth, lib=lib)
+        args.update(kw)
+        extra = args.pop("extra", "vol-a")
+        return native.params_digest(native.make_params(**args), extra)
+    ref = key()
+    assert key() == ref and key(scene_depth=depth.copy()) == ref
+    d2 = depth.copy()
+    d2[3, 4] = 2.0
+    variants = [dict(scene_depth=d2), dict(scene_depth=None), dict(width=9, scene_depth=None),
+                dict(view=np.diag([1.0, 1.0, 1.0, 1.0]) + np.eye(4) * 0 + np.array(
+                    [[0, 0, 0, 0.1], [0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0]])),
+                dict(filter="cubic"), dict(step=0.25), dict(opacity_scale=0.5),
+                dict(lights=[((0, 0, 1, 0), (1, 1, 1), 1.0)]), dict(jitter=False),
+                dict(extra="vol-b"), dict(no_skip=True), dict(window=(1.0, 2.0))]
+    keys = {key(**v) for v in variants}
+    assert ref not in keys and len(keys) == len(variants)
+
+
 def test_write_image(lib, tmp_path):
     rgba = np.zeros((8, 8, 4), np.float32)
     rgba[:4] = (0.5, 0.25, 0.0, 0.5)

@@ -65,6 +65,10 @@ int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
     for (size_t i = 0; i < n; i++) {
         double u0 = table_pos(f, b->minmax[2 * i]), u1 = table_pos(f, b->minmax[2 * i + 1]);
         if (u0 > u1) { double t = u0; u0 = u1; u1 = t; }
+        if (isnan(u0) || isnan(u1)) { /* cannot be placed in the table: assume visible */
+            u0 = 0;
+            u1 = f->tf_size - 1;
+        }
         /* linear filtering reads floor(u)..floor(u)+1; widen by one entry
          * each way so float rounding in the shader can never escape */
         long lo = (long)floor(u0) - 1, hi = (long)floor(u1) + 2;

@@ -110,7 +110,9 @@ static int resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume
     if (fabs(w) < eps) w = eps;
     double span = g->tex_hi - g->tex_lo;
     if (span == 0) span = 1;
-    f->window_offset = (float)((lo - g->tex_lo) / span);
+    /* extreme windows over denormal-scaled data must stay finite in float */
+    double offset = (lo - g->tex_lo) / span;
+    f->window_offset = (float)(fabs(offset) < 1e30 ? offset : copysign(1e30, offset));
     double scale = span / w;
     f->window_scale = (float)(fabs(scale) < 1e30 ? scale : copysign(1e30, scale));
     float os = p->opacity_scale == 0 ? 1.0f : p->opacity_scale;

@@ -71,12 +71,6 @@ TEST(marschner_lobb_errors_match_the_planning_figures)
     }
 }
 
-static double psnr(const float *a, const float *b, size_t n)
-{
-    double r = image_rmse(a, b, n);
-    return r > 0 ? 20 * log10(1.0 / r) : 200;
-}
-
 /* Renders converge to the reference as the step shrinks, and the finest is
  * close to it. */
 TEST(renders_converge_to_the_reference)
@@ -102,7 +96,7 @@ TEST(renders_converge_to_the_reference)
     for (int i = 0; i < 3; i++) {
         p.step = steps[i];
         REQUIRE(vxl_render(R, &p, img, NULL) == VXL_OK);
-        double q = psnr(img, ref, W * H * 4);
+        double q = image_psnr(img, ref, W * H * 4);
         fprintf(stderr, "    sphere, cubic, step %.3f: PSNR %.2f dB against the reference\n", steps[i], q);
         CHECKF(q > last - 0.5, "step %.3f got worse", steps[i]);
         last = q;

@@ -15,12 +15,6 @@ static vxl_renderer *R;
 #define W 64
 #define H 64
 
-static double psnr(const float *a, const float *b, size_t n)
-{
-    double r = image_rmse(a, b, n);
-    return r > 0 ? 20 * log10(1.0 / r) : 200;
-}
-
 TEST(skipping_never_changes_the_image)
 {
     static float on[W * H * 4], off[W * H * 4];
@@ -54,7 +48,7 @@ TEST(skipping_never_changes_the_image)
             p.no_skip = 1;
             REQUIRE(vxl_render(R, &p, off, NULL) == VXL_OK);
             vxl_renderer_get_stats(R, &s_off);
-            double q = psnr(on, off, W * H * 4), worst = 0;
+            double q = image_psnr(on, off, W * H * 4), worst = 0;
             for (int i = 0; i < W * H * 4; i++) worst = fmax(worst, fabs(dflt[i] - off[i]));
             CHECKF(worst <= 0.01 + 1e-5, "%s/%s: default termination off by %.4f", vxl_phantom_name(kinds[k]),
                    vxl_filter_name(f), worst);

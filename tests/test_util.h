@@ -106,6 +106,13 @@ static inline double image_rmse(const float *a, const float *b, size_t n)
     return sqrt(s / (double)n);
 }
 
+/* PSNR in dB of two images with values in [0,1]; 200 for identical ones. */
+static inline double image_psnr(const float *a, const float *b, size_t n)
+{
+    double r = image_rmse(a, b, n);
+    return r > 0 ? 20 * log10(1.0 / r) : 200;
+}
+
 static inline double alpha_sum(const float *rgba, size_t npix)
 {
     double s = 0;

@@ -193,7 +193,16 @@ static int resolve_matrices(vxl_frame *f, const vxl_render_params *p, const vxl_
                         "the camera and model matrices are singular or not finite (projection * view * model)");
     if (!vxl_mat3_normal_matrix(f->normal, mv))
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "the view * model matrix is singular");
-    vxl_mat4_to_float(f->inv_mvp, inv);
+    double rn[16], rf[16];
+    memcpy(rn, inv, sizeof rn);
+    memcpy(rf, inv, sizeof rf);
+    for (int r = 0; r < 4; r++) {
+        rn[12 + r] = inv[12 + r] - inv[8 + r]; /* ndc z = -1 */
+        rf[12 + r] = inv[12 + r] + inv[8 + r]; /* ndc z = +1 */
+        rn[8 + r] = rf[8 + r] = 0;
+    }
+    vxl_mat4_to_float(f->ray_near, rn);
+    vxl_mat4_to_float(f->ray_far, rf);
     vxl_mat4_to_float(f->mv, mv);
     return VXL_OK;
 }

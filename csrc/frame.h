@@ -26,7 +26,11 @@ typedef struct vxl_frame {
     float sample_distance, step;
     int max_steps;
     double view[16], proj[16], model[16];
-    float inv_mvp[16], mv[16], normal[9];
+    /* clip -> voxel space with the NDC depth folded in (in double) at z = -1
+     * and z = +1: each maps vec4(ndc.xy, 0, 1) to a homogeneous point. Folding
+     * in float would cancel catastrophically for near planes of 1e-6. */
+    float ray_near[16], ray_far[16];
+    float mv[16], normal[9];
     const float *tf;            /* tf_size*4 straight RGBA, clamped to [0,1] */
     uint32_t tf_size;
     float window_offset, window_scale, opacity_scale;

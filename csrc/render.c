@@ -95,7 +95,8 @@ static void set_frame_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame *f)
 {
     vxl_gl *gl = &r->gl;
 #define LOC(name) gl->GetUniformLocation(prog, name)
-    gl->UniformMatrix4fv(LOC("u_inv_mvp"), 1, GL_FALSE, f->inv_mvp);
+    gl->UniformMatrix4fv(LOC("u_ray_near"), 1, GL_FALSE, f->ray_near);
+    gl->UniformMatrix4fv(LOC("u_ray_far"), 1, GL_FALSE, f->ray_far);
     gl->UniformMatrix4fv(LOC("u_mv"), 1, GL_FALSE, f->mv);
     gl->UniformMatrix3fv(LOC("u_normal_matrix"), 1, GL_FALSE, f->normal);
     gl->Uniform2f(LOC("u_viewport"), (float)f->width, (float)f->height);

@@ -10,7 +10,8 @@
 #define GOPACITY 0
 #endif
 
-uniform mat4 u_inv_mvp;      // clip -> voxel space
+uniform mat4 u_ray_near;     // vec4(ndc.xy, 0, 1) -> homogeneous voxel point at ndc z = -1
+uniform mat4 u_ray_far;      // the same at ndc z = +1 (both folded in double: see frame.h)
 uniform mat4 u_mv;           // voxel -> view space
 uniform vec2 u_viewport;     // pixels
 uniform float u_step;        // voxels
@@ -50,8 +51,8 @@ void emit_nothing()
 void main()
 {
     vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
-    vec4 hn = u_inv_mvp * vec4(ndc, -1.0, 1.0);
-    vec4 hf = u_inv_mvp * vec4(ndc, 1.0, 1.0);
+    vec4 hn = u_ray_near * vec4(ndc, 0.0, 1.0);
+    vec4 hf = u_ray_far * vec4(ndc, 0.0, 1.0);
     vec3 o = hn.xyz / hn.w;
     // The direction from the homogeneous points without dividing by hf.w,
     // which is ~0 for a far plane at 1e9 (or infinity) in float.

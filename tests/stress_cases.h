@@ -351,12 +351,17 @@ static inline void sm_ortho(float m[16], double l, double r, double b, double t,
     m[15] = 1;
 }
 
-/* A perspective camera at eye looking at at, 60 degrees, near/far given. */
+/* F_NEAR_INVARIANT: the near plane sv_camera uses instead of the case's
+ * (thread-local: the backends render concurrently). */
+static _Thread_local double vc_near_override;
+
+/* A perspective camera at eye looking at at, fovy degrees, near/far given. */
 static inline void sv_camera(vxl_render_params *p, const double eye[3], const double at[3], const double up[3],
                              double fovy, double n, double f)
 {
     p->has_camera = 1;
     sm_look_at(p->view, eye, at, up);
+    if (vc_near_override > 0) n = vc_near_override;
     sm_persp(p->proj, fovy, (double)p->width / p->height, n, f);
 }
 
@@ -481,6 +486,13 @@ VIEW(proj_near_1e6_far_1e9)
     sv_ball_tf(p);
     double eye[3] = {vc->c[0] + 2 * vc->n, vc->c[1] - 1.5 * vc->n, vc->c[2] + vc->n};
     sv_camera(p, eye, vc->c, UP_Z, 45, 1e-6, 1e9);
+}
+VIEW(proj_near_1e6_distant) /* the same clip planes, the camera 10x farther with a narrow field of view */
+{
+    sv_ball_tf(p);
+    double eye[3] = {vc->c[0] + 20 * vc->n, vc->c[1] - 15 * vc->n, vc->c[2] + 10 * vc->n};
+    double dist = sqrt(400.0 + 225.0 + 100.0) * vc->n;
+    sv_camera(p, eye, vc->c, UP_Z, 2.0 * atan(0.8 * vc->n / dist) * 180 / M_PI, 1e-6, 1e9);
 }
 VIEW(proj_near_1e3_far_1e6) /* a plausible viewport clip range: ratio 1e9 */
 {
@@ -739,14 +751,15 @@ VIEW(lights_8_extreme)
         l->intensity = 1e6f;
     }
 }
-VIEW(light_point_at_centre) /* a point light exactly on a sample position */
+VIEW(light_point_at_centre) /* a point light on (within float rounding of) the first sample of the central ray */
 {
-    sv_ball_tf(p);
-    cam_inside_centre_axis(p, vc);
+    cam_inside_centre_axis(p, vc); /* near plane 0.01, looking down -Z, no jitter: samples at z = c - 0.01 - k */
     p->jitter_off = 1;
     p->step = 1;
     p->light_count = 1;
-    for (int a = 0; a < 3; a++) p->lights[0].position[a] = (float)vc->c[a];
+    p->lights[0].position[0] = (float)vc->c[0];
+    p->lights[0].position[1] = (float)vc->c[1];
+    p->lights[0].position[2] = (float)(vc->c[2] - 0.01);
     p->lights[0].position[3] = 1;
 }
 VIEW(light_point_at_eye)
@@ -855,7 +868,9 @@ enum {
     F_ALLOW_CREATE_ERROR = 8, /* vxl_volume_create may refuse the data cleanly instead */
     F_BAD_VOLUME = 16,        /* the volume itself is the invalid input: check recovery on a good one */
     F_TF_MATCHES_256 = 64,    /* the image equals (within rounding) the one with the 256-entry ramp */
-    F_FULL_ONLY = 32,         /* --full only: the case needs a texture state of its own (8-bit volumes, no
+    F_FULL_ONLY = 32,
+    F_NEAR_INVARIANT = 128,   /* equals (within rounding) the image with the near plane at 0.1: the volume
+                                 lies far beyond both, so the near plane must not change a pixel */         /* --full only: the case needs a texture state of its own (8-bit volumes, no
                                  skipping), which costs llvmpipe a recompilation of every program */
 };
 
@@ -984,8 +999,9 @@ static const stress_case stress_cases[] = {
     {"default_camera_huge_angles", GROUP_cameras, BALL, default_cam_huge_angles, OK, F_VISIBLE, 0},
 
     /* projections */
-    {"near_1e-6_far_1e9", GROUP_projections, BALL, proj_near_1e6_far_1e9, OK, F_VISIBLE, 0},
-    {"near_1e-3_far_1e6", GROUP_projections, BALL, proj_near_1e3_far_1e6, OK, F_VISIBLE, 0},
+    {"near_1e-6_far_1e9", GROUP_projections, BALL, proj_near_1e6_far_1e9, OK, F_VISIBLE | F_NEAR_INVARIANT, 0},
+    {"near_1e-6_far_1e9_distant_camera", GROUP_projections, BALL, proj_near_1e6_distant, OK, F_VISIBLE | F_NEAR_INVARIANT, 0},
+    {"near_1e-3_far_1e6", GROUP_projections, BALL, proj_near_1e3_far_1e6, OK, F_VISIBLE | F_NEAR_INVARIANT, 0},
     {"near_eq_far_0.999999", GROUP_projections, BALL, proj_near_eq_far, OK, 0, 0},
     {"near_eq_far_ortho", GROUP_projections, BALL, proj_near_eq_far_ortho, OK, 0, 0},
     {"infinite_far_plane", GROUP_projections, BALL, proj_infinite_far, OK, F_VISIBLE, 0},

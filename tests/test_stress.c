@@ -17,14 +17,16 @@
  * build-asan binary.
  *
  * Modes. The default run renders, for every case, filter and classify mode,
- * the shaded image (shading on, reuse off); shading off, reuse on and the
- * gradient-opacity modes are crossed with one filter per case and classify
- * mode, rotating through the filters from case to case (and in the
- * gradient-opacity modes through a fixed filter -> classify pairing), so that
- * the whole table reaches every combination while the number of distinct
- * shader programs stays small: on llvmpipe each program costs ~0.25 s of JIT
- * compilation per backend and per texture-binding state, which dominates the
- * run time. --full renders every mode for every filter and classify mode.
+ * the shaded image (shading on, reuse off). Shading off (with and without
+ * reuse), shading with reuse, and the gradient-opacity modes are crossed with
+ * one filter per case and classify mode, rotating through the filters from
+ * case to case; reuse and gradient opacity pair each filter with one classify
+ * mode. The table as a whole thus reaches every filter with every mode while
+ * the number of distinct shader programs stays small: on llvmpipe each
+ * program costs ~0.25 s of JIT compilation per backend and per
+ * texture-binding state (format and power-of-two-ness of every bound
+ * texture), which dominates the run time. --full renders every mode for every
+ * filter and classify mode.
  *
  * The two backends render concurrently, one thread each (each renderer has
  * its own GL thread), which also exercises two renderers used at once.
@@ -40,7 +42,6 @@
  * prints every render slower than S seconds.
  */
 #include <pthread.h>
-#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -259,7 +260,8 @@ typedef struct buffers {
 
 /* One render of the matrix, with every assertion. Returns 1 if the render
  * failed with an error code (expected or not). */
-static int render_one(case_run *cr, int b, const vxl_render_params *p, int variant, const char *label, buffers *bu)
+static int render_one(case_run *cr, int b, const vxl_render_params *p, int variant, const char *label, buffers *bu,
+                      stress_view_ctx *vc)
 {
     const stress_case *c = cr->c;
     uint32_t w = p->width ? p->width : 512, h = p->height ? p->height : 512;
@@ -330,6 +332,18 @@ static int render_one(case_run *cr, int b, const vxl_render_params *p, int varia
         else if (!(e < 5e-3))
             fail(cr, label, "a %u-entry ramp and the 256-entry ramp give different images: rmse %g", p->tf_size, e);
     }
+    if (c->flags & F_NEAR_INVARIANT) {
+        vxl_render_params q = *p;
+        vc_near_override = 0.1;
+        c->view(&q, vc);
+        vc_near_override = 0;
+        rc = timed_render(b, &q, bu->ref, NULL, label, &dt);
+        double e = rc == VXL_OK ? image_rmse(bu->ref, bu->img, npix * 4) : 0;
+        if (rc != VXL_OK) fail(cr, label, "the render with the near plane at 0.1: %s", vxl_error_name(rc));
+        else if (!(e < 2e-3))
+            fail(cr, label, "the near plane changed the image of a volume far beyond it: rmse %g against near 0.1",
+                 e);
+    }
     if (c->flags & F_SAME_AS_NO_DEPTH) {
         vxl_render_params q = *p;
         q.scene_depth = NULL;
@@ -340,6 +354,14 @@ static int render_one(case_run *cr, int b, const vxl_render_params *p, int varia
                  image_rmse(bu->ref, bu->img, npix * 4));
     }
     return 0;
+}
+
+/* The mode as rendered (a case may set its own gradient opacity). */
+static void mode_label(const vxl_render_params *p, char *out, size_t n)
+{
+    static const char *const gop[VXL_GOPACITY_COUNT] = {"", "+gop_boundary", "+gop_iso"};
+    snprintf(out, n, "%s%s%s", p->shading_off ? "noshade" : "shade", p->reuse_gradients ? "+reuse" : "",
+             p->gradient_opacity < VXL_GOPACITY_COUNT ? gop[p->gradient_opacity] : "+gop_invalid");
 }
 
 typedef struct backend_job {
@@ -389,12 +411,14 @@ static void *run_backend(void *arg)
                     p.iso_value = (float)(0.5 * vc.value_min + 0.5 * vc.value_max);
                     c->view(&p, &vc); /* last: the invalid-input cases may override anything */
                     if (!stress_apply_variant(&p, &vc, c, var)) continue;
-                    const char *fname = vxl_filter_name(f);
+                    const char *fname = vxl_filter_name(p.filter);
+                    char mname[64];
+                    mode_label(&p, mname, sizeof mname);
                     snprintf(label, sizeof label, "[%s] filter=%s classify=%u mode=%s backend=%s%s%s", c->name,
-                             fname ? fname : "?", cl, modes[m].name, backend_names[b],
+                             fname ? fname : "?", p.classify, mname, backend_names[b],
                              ENV.variant_count > 1 ? " variant=" : "",
                              ENV.variant_count > 1 ? stress_variant_name(var) : "");
-                    errors += render_one(cr, b, &p, var, label, &bu);
+                    errors += render_one(cr, b, &p, var, label, &bu, &vc);
                 }
             }
     if (errors) { /* after any failed render the renderer must still work */

@@ -242,6 +242,35 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *o)
     return VXL_OK;
 }
 
+int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double hi, uint64_t *counts)
+{
+    if (!v || !counts || bins == 0)
+        return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "histogram needs a volume, counts and bins >= 1");
+    if (bins > (1u << 24)) return vxl_fail(NULL, VXL_ERR_LIMIT, "histogram of %u bins exceeds 2^24", bins);
+    if (!isfinite(lo) || !isfinite(hi) || !(hi > lo))
+        return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "histogram range [%g, %g] is empty or not finite", lo, hi);
+    memset(counts, 0, bins * sizeof *counts);
+    /* Stored t in [0,1] maps to tex_lo + t*(tex_hi - tex_lo): bin by t directly. */
+    const double span = v->tex_hi - v->tex_lo, scale = bins / (hi - lo);
+    const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
+    for (uint64_t i = 0; i < n; i++) {
+        double t;
+        if (v->texture_bits == 8) t = ((const uint8_t *)v->texels)[i] / 255.0;
+        else if (v->texture_bits == 16) t = ((const uint16_t *)v->texels)[i] / 65535.0;
+        else t = ((const float *)v->texels)[i];
+        double b = (v->tex_lo + t * span - lo) * scale;
+        if (b >= 0 && b <= bins) counts[b >= bins ? bins - 1 : (uint32_t)b]++;
+    }
+    if (v->nan_count) { /* NaN voxels were stored as value_min: take them back out */
+        double b = (v->value_min - lo) * scale;
+        if (b >= 0 && b <= bins) {
+            uint64_t *c = &counts[b >= bins ? bins - 1 : (uint32_t)b];
+            *c -= *c < v->nan_count ? *c : v->nan_count;
+        }
+    }
+    return VXL_OK;
+}
+
 void vxl_volume_destroy(vxl_volume *v)
 {
     if (!v) return;

@@ -23,18 +23,18 @@ if "bpy" in locals():
     import importlib
     for _m in (native, depth, zbuffer, volume_space, runtime, lights, params,  # noqa: F821
                properties, operators, panels, scene_geometry, offline, compositor,  # noqa: F821
-               render_hooks, viewport, api, preferences):  # noqa: F821
+               render_hooks, viewport, api, preferences, tf):  # noqa: F821
         importlib.reload(_m)
 
 import bpy  # noqa: E402
 
 from . import (api, compositor, depth, lights, native, offline, operators, panels,  # noqa: E402
                params, preferences, properties, render_hooks, runtime, scene_geometry,
-               viewport, volume_space, zbuffer)
+               tf, viewport, volume_space, zbuffer)
 from .api import render_volume  # noqa: E402,F401
 
 # Registration order: properties before the UI that shows them; handlers last.
-_modules = (preferences, properties, operators, panels, render_hooks, viewport)
+_modules = (preferences, properties, tf, operators, panels, render_hooks, viewport)
 
 
 def library_status():

@@ -33,6 +33,9 @@ FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed",
 PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
 BACKENDS = ("auto", "osmesa", "egl")
 MAX_LIGHTS = 8
+# VXL_CLASSIFY_* and VXL_GOPACITY_* order.
+CLASSIFY_MODES = ("post", "pre", "preint")
+GRADIENT_OPACITY_MODES = ("off", "boundary", "iso")
 
 _DTYPES = {
     np.dtype(np.uint8): 1, np.dtype(np.int8): 2,
@@ -145,7 +148,13 @@ class RenderParams(ctypes.Structure):
                 ("early_termination", ctypes.c_float),
                 ("depth_threshold", ctypes.c_float),
                 ("no_skip", ctypes.c_uint32),
-                ("reserved", ctypes.c_uint32 * 7)]
+                ("preint_size", ctypes.c_uint32),
+                ("gradient_opacity", ctypes.c_uint32),
+                ("gradient_ref", ctypes.c_float),
+                ("gradient_exp", ctypes.c_float),
+                ("iso_value", ctypes.c_float),
+                ("iso_thickness", ctypes.c_float),
+                ("reserved", ctypes.c_uint32 * 1)]
 
 
 class RenderStats(ctypes.Structure):
@@ -215,6 +224,8 @@ def _declare(lib):
         "vxl_volume_load": (ctypes.c_int, [ctypes.c_char_p, P(LoadOptions), P(vp)]),
         "vxl_volume_create": (ctypes.c_int, [P(VolumeDesc), P(LoadOptions), P(vp)]),
         "vxl_volume_get_info": (ctypes.c_int, [vp, P(VolumeInfo)]),
+        "vxl_volume_histogram": (ctypes.c_int, [vp, ctypes.c_uint32, ctypes.c_double,
+                                                ctypes.c_double, P(ctypes.c_uint64)]),
         "vxl_volume_destroy": (None, [vp]),
         "vxl_renderer_create": (ctypes.c_int, [P(RendererOptions), P(vp)]),
         "vxl_renderer_destroy": (None, [vp]),
@@ -468,6 +479,17 @@ class Volume:
             if info.affine_source < 3 else str(info.affine_source),
         }
 
+    def histogram(self, bins=32, lo=None, hi=None):
+        """Voxel counts (NaN voxels excluded) in `bins` equal bins over
+        [lo, hi], by default the finite data range; any loaded format."""
+        lo = self.info["value_min"] if lo is None else lo
+        hi = self.info["value_max"] if hi is None else hi
+        if not hi > lo:
+            hi = lo + 1.0
+        counts = (ctypes.c_uint64 * bins)()
+        self.lib.check(self.lib.cdll.vxl_volume_histogram(self.handle, bins, lo, hi, counts))
+        return np.frombuffer(counts, np.uint64).astype(np.int64)
+
     @property
     def handle(self):
         if not self._handle:
@@ -507,11 +529,18 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 gradient_16f=False, step=0.5, jitter=True, jitter_seed=0,
                 preset="auto", window=None, opacity_scale=1.0, shading=True,
                 material=None, lights=(), azimuth=0.0, elevation=0.0,
-                early_termination=0.0, depth_threshold=0.0, no_skip=False, lib=None):
+                early_termination=0.0, depth_threshold=0.0, no_skip=False,
+                tf_rgba=None, classify="post", gradient_opacity="off", gradient_ref=0.0,
+                gradient_exp=0.0, iso_value=0.0, iso_thickness=0.0, preint_size=0,
+                lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
-    `window` is (low, high) or None for the preset's default."""
+    `window` is (low, high) or None for the preset's default. `tf_rgba` is
+    an (n, 4) straight-RGBA table (alpha = opacity per voxel of path) that
+    replaces the preset; `window` maps its [0, 1] onto data values.
+    `classify` is one of CLASSIFY_MODES, `gradient_opacity` one of
+    GRADIENT_OPACITY_MODES (or their VXL_* numbers)."""
     lib = lib or load_library()
     p = _sized(RenderParams)
     p.width, p.height = int(width), int(height)
@@ -545,6 +574,22 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     if window is not None:
         p.has_window = 1
         p.window_low, p.window_high = float(window[0]), float(window[1])
+    if tf_rgba is not None:
+        tf = np.ascontiguousarray(tf_rgba, dtype=np.float32).reshape(-1, 4)
+        if len(tf) < 2:
+            raise ValueError("tf_rgba needs at least 2 entries")
+        p._keep.append(tf)
+        p._tf = tf
+        p.tf_size = len(tf)
+        p.tf_rgba = _fptr(tf)
+    p.classify = classify if isinstance(classify, int) else CLASSIFY_MODES.index(classify)
+    p.gradient_opacity = (gradient_opacity if isinstance(gradient_opacity, int)
+                          else GRADIENT_OPACITY_MODES.index(gradient_opacity))
+    p.gradient_ref = gradient_ref
+    p.gradient_exp = gradient_exp
+    p.iso_value = iso_value
+    p.iso_thickness = iso_thickness
+    p.preint_size = preint_size
     p.opacity_scale = opacity_scale
     p.shading_off = 0 if shading else 1
     if material is not None:
@@ -607,6 +652,12 @@ def tile_params(params, x0, y0, x1, y1):
         raise ValueError("tile %r outside the %dx%d image" % ((x0, y0, x1, y1), W, H))
     t = RenderParams.from_buffer_copy(params)
     t._keep = []
+    tf = getattr(params, "_tf", None)
+    if params.tf_rgba and tf is None:
+        raise ValueError("params.tf_rgba was not set by make_params")
+    if tf is not None:  # the copy points at the same table: keep it alive
+        t._keep.append(tf)
+        t._tf = tf
     t.width, t.height = x1 - x0, y1 - y0
     a, b = 2.0 * x0 / W - 1.0, 2.0 * x1 / W - 1.0
     c, d = 2.0 * y0 / H - 1.0, 2.0 * y1 / H - 1.0

@@ -9,7 +9,7 @@ from bpy.props import BoolProperty, FloatProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix
 
-from . import native, runtime, volume_space
+from . import native, runtime, tf, volume_space
 
 
 def _to_matrix(a):
@@ -86,7 +86,10 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         p.data_max = info["value_max"]
         p.window_low = info["value_min"]
         p.window_high = info["value_max"]
+        if "histogram" in info:
+            p.histogram = [int(min(c, 2**31 - 1)) for c in info["histogram"]]
         context.collection.objects.link(obj)
+        tf.ensure_texture(obj)  # grey ramp until a preset or the user edits it
         for o in context.view_layer.objects:
             o.select_set(False)
         obj.select_set(True)

@@ -4,7 +4,7 @@ here rather than failing at add-on import."""
 
 import bpy
 
-from . import native, runtime
+from . import native, runtime, tf
 from .properties import FIXED_TAP_FILTERS
 
 
@@ -62,14 +62,43 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
 
         layout.separator()
         col = layout.column()
-        col.prop(p, "preset")
+        col.prop(p, "use_color_ramp")
+        if p.use_color_ramp:
+            col.operator_menu_enum("voxlight.tf_preset", "preset", text="Load Preset",
+                                   icon="PRESET")
+            if p.tf_texture is not None and p.tf_texture.use_color_ramp:
+                box = layout.box()
+                box.template_color_ramp(p.tf_texture, "color_ramp", expand=True)
+                box.label(text="Stop alpha = opacity per voxel")
+            else:
+                col.operator("voxlight.tf_ramp", icon="ADD")
+        else:
+            col.prop(p, "preset")
+        col = layout.column()
         col.prop(p, "use_window")
         sub = col.column(align=True)
         sub.active = p.use_window
         sub.prop(p, "window_low")
         sub.prop(p, "window_high")
         col.label(text="Data range: %.4g .. %.4g" % (p.data_min, p.data_max))
+        if any(p.histogram):
+            hist = tf.histogram_text(p.histogram)
+            col.label(text="Histogram (log): " + hist)
+            if p.data_max > p.data_min:
+                a = (min(p.window_low, p.window_high) - p.data_min) / (p.data_max - p.data_min)
+                b = (max(p.window_low, p.window_high) - p.data_min) / (p.data_max - p.data_min)
+                i0, i1 = (int(round(min(max(v, 0.0), 1.0) * len(hist))) for v in (a, b))
+                col.label(text="Window:          " + " " * i0 + "▔" * max(i1 - i0, 1))
         col.prop(p, "opacity_scale")
+        col.prop(p, "classify")
+        col.prop(p, "gradient_opacity")
+        if p.gradient_opacity != "off":
+            sub = col.column(align=True)
+            sub.prop(p, "gradient_ref")
+            sub.prop(p, "gradient_exp")
+            if p.gradient_opacity == "iso":
+                sub.prop(p, "iso_value")
+                sub.prop(p, "iso_thickness")
 
         layout.separator()
         col = layout.column()

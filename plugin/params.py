@@ -6,6 +6,7 @@ import numpy as np
 
 from . import lights as _lights
 from . import native
+from . import tf as _tf
 
 
 def model_matrix(obj):
@@ -36,12 +37,20 @@ def look_kwargs(props, fast=False):
         opacity_scale=props.opacity_scale,
         shading=props.shading,
         material=(props.ambient, props.diffuse, props.specular, props.shininess),
+        tf_rgba=_tf.table(props) if props.use_color_ramp else None,
+        classify=props.classify,
+        gradient_opacity=props.gradient_opacity,
+        gradient_ref=props.gradient_ref,
+        gradient_exp=props.gradient_exp,
+        iso_value=props.iso_value,
+        iso_thickness=props.iso_thickness,
     )
 
 
 def look_key(props, fast=False):
     """Hashable summary of look_kwargs, for the viewport's change test."""
-    return tuple(sorted((k, repr(v)) for k, v in look_kwargs(props, fast).items()))
+    return tuple(sorted((k, v.tobytes() if hasattr(v, "tobytes") else repr(v))
+                        for k, v in look_kwargs(props, fast).items()))
 
 
 def scene_lights(scene, depsgraph, for_render=False):

@@ -78,6 +78,9 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     dims: IntVectorProperty(name="Dimensions", size=3, options=set())
     data_min: FloatProperty(name="Data Minimum", options=set())
     data_max: FloatProperty(name="Data Maximum", options=set())
+    histogram: IntVectorProperty(name="Histogram", size=32, options=set(),
+                                 description="Voxel counts in 32 bins over the data range "
+                                             "(computed at import)")
 
     # --- gradients
     filter: EnumProperty(name="Gradient Filter", items=FILTER_ITEMS, default="central",
@@ -102,6 +105,38 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     # --- classification
     preset: EnumProperty(name="Transfer Function", items=PRESET_ITEMS, default="auto",
                          update=tag_redraw)
+    use_color_ramp: BoolProperty(name="Use ColorRamp", default=False,
+                                 description="Use the volume's ColorRamp (colour stops and "
+                                             "their alpha = opacity) instead of the library "
+                                             "preset", update=tag_redraw)
+    tf_texture: PointerProperty(type=bpy.types.Texture, name="Transfer Function",
+                                options=set(),
+                                description="Hidden Blend texture whose ColorRamp is this "
+                                            "volume's transfer function")
+    classify: EnumProperty(
+        name="Classification", default="post", update=tag_redraw,
+        items=[("post", "Post", "Interpolate the value, then look it up", 0),
+               ("pre", "Pre", "Classify voxels, then interpolate colour and opacity", 1),
+               ("preint", "Pre-integrated", "Pre-integrated segments (sharp transfer "
+                                            "functions without slabs)", 2)])
+    gradient_opacity: EnumProperty(
+        name="Gradient Opacity", default="off", update=tag_redraw,
+        items=[("off", "Off", "Opacity from the transfer function only", 0),
+               ("boundary", "Boundary", "Scale opacity by gradient magnitude "
+                                        "(Levoy's boundary emphasis)", 1),
+               ("iso", "Iso-surface", "Levoy's iso-value contour surface", 2)])
+    gradient_ref: FloatProperty(name="Gradient Reference", default=0.05, min=0.0001,
+                                soft_max=1.0, update=tag_redraw,
+                                description="Gradient magnitude (normalised value per "
+                                            "voxel) that gives full opacity")
+    gradient_exp: FloatProperty(name="Gradient Exponent", default=1.0, min=0.01, max=16.0,
+                                update=tag_redraw,
+                                description="Exponent of the gradient-magnitude term")
+    iso_value: FloatProperty(name="Iso Value", default=0.0, update=tag_redraw,
+                             description="Data value of the iso-surface")
+    iso_thickness: FloatProperty(name="Iso Thickness", default=1.0, min=0.01, max=16.0,
+                                 update=tag_redraw,
+                                 description="Thickness of the iso-surface in voxels")
     use_window: BoolProperty(name="Custom Window", default=False,
                              description="Map the transfer function onto Low..High instead of "
                                          "the preset's default window", update=tag_redraw)

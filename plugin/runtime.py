@@ -217,7 +217,7 @@ def load_volume(path, backend="auto", progress=None):
         except Exception:
             renderer.close()
             raise
-        info = vol.info
+        info = dict(vol.info, histogram=vol.histogram(32))  # for the panel, from any format
     finally:
         vol.close()  # the renderer holds its own copy on the GL side
     if progress:

@@ -80,6 +80,30 @@ TEST(nan_voxels_are_counted_and_neutralised)
     vxl_volume_destroy(v);
 }
 
+TEST(histogram_counts_data_values)
+{
+    float data[8] = {1, NAN, 3, INFINITY, 1.5f, 2, 5, NAN};
+    vxl_volume_desc d;
+    memset(&d, 0, sizeof d);
+    d.dtype = VXL_DTYPE_F32;
+    d.dims[0] = 8;
+    d.dims[1] = d.dims[2] = 1;
+    d.data = data;
+    vxl_volume *v = NULL;
+    REQUIRE(vxl_volume_create(&d, NULL, &v) == VXL_OK);
+    uint64_t c[4] = {9, 9, 9, 9};
+    /* bins of width 1 over [1, 5]: {1, 1.5} {2} {3} {5 and +inf clamped to 5}; NaN excluded */
+    REQUIRE(vxl_volume_histogram(v, 4, 1, 5, c) == VXL_OK);
+    CHECK(c[0] == 2 && c[1] == 1 && c[2] == 1 && c[3] == 2);
+    REQUIRE(vxl_volume_histogram(v, 2, 10, 20, c) == VXL_OK); /* all outside */
+    CHECK(c[0] == 0 && c[1] == 0);
+    CHECK(vxl_volume_histogram(v, 0, 1, 5, c) == VXL_ERR_INVALID_ARGUMENT);
+    CHECK(vxl_volume_histogram(v, 4, 5, 1, c) == VXL_ERR_INVALID_ARGUMENT);
+    CHECK(vxl_volume_histogram(v, 4, 1, NAN, c) == VXL_ERR_INVALID_ARGUMENT);
+    CHECK(vxl_volume_histogram(NULL, 4, 1, 5, c) == VXL_ERR_INVALID_ARGUMENT);
+    vxl_volume_destroy(v);
+}
+
 TEST(scaling_and_int_types)
 {
     int16_t data[8] = {-32768, -1, 0, 1, 100, 200, 300, 32767};
@@ -195,6 +219,7 @@ int main(void)
     RUN(destroy_null_is_a_noop);
     RUN(volume_create_validates);
     RUN(nan_voxels_are_counted_and_neutralised);
+    RUN(histogram_counts_data_values);
     RUN(scaling_and_int_types);
     RUN(renderer_errors_are_reported);
     RUN(renderer_budget_and_defaults);

@@ -149,6 +149,11 @@ VXL_API int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_v
 VXL_API int vxl_volume_create(const vxl_volume_desc *desc, const vxl_load_options *opt,
                               vxl_volume **out);
 VXL_API int vxl_volume_get_info(const vxl_volume *vol, vxl_volume_info *out);
+/* Counts of the volume's voxels (data units, NaN voxels excluded) in `bins`
+ * equal bins over [lo, hi]; values outside are not counted. Works for every
+ * loader, so a UI can show the histogram of any format. */
+VXL_API int vxl_volume_histogram(const vxl_volume *vol, uint32_t bins, double lo, double hi,
+                                 uint64_t *counts);
 VXL_API void vxl_volume_destroy(vxl_volume *vol);
 
 /* -------------------------------------------------------------- renderer */

@@ -92,6 +92,19 @@ def test_volume_load_info(lib, ball_file):
     assert info["value_max"] == pytest.approx(data.max(), rel=1e-6)
 
 
+def test_histogram_matches_numpy(lib):
+    rng = np.random.default_rng(3)
+    a = rng.normal(100.0, 30.0, (20, 16, 12)).astype(np.int16)
+    v = native.Volume.from_array(a, lib=lib)
+    try:
+        h = v.histogram(16)
+        ref, _ = np.histogram(a, bins=16, range=(a.min(), a.max()))
+        # the edges of 16-bit normalised storage may move a voxel by one bin
+        assert h.sum() == a.size and np.abs(h - ref).sum() <= 2, (h, ref)
+    finally:
+        v.close()
+
+
 def test_bad_file_raises_with_library_message(lib, tmp_path):
     bad = tmp_path / "bad.nii"
     bad.write_bytes(b"this is not a nifti file" * 4)
@@ -319,3 +332,34 @@ def test_closed_handles(lib, ball_file):
     r.close()  # destroy twice is harmless
     with pytest.raises(native.VoxlightError):
         r.render(width=4, height=4)
+
+
+def test_render_params_tail_matches_header():
+    """Issue 6's fields replaced the reserved slots; the size is unchanged."""
+    import ctypes
+    P = native.RenderParams
+    assert ctypes.sizeof(P) == 624
+    assert P.preint_size.offset == P.no_skip.offset + 4
+    names = [n for n, _t in P._fields_][-7:]
+    assert names == ["preint_size", "gradient_opacity", "gradient_ref", "gradient_exp",
+                     "iso_value", "iso_thickness", "reserved"]
+
+
+def test_make_params_transfer_function_and_modes(lib):
+    tf = np.zeros((256, 4), np.float32)
+    tf[:, 3] = np.linspace(0, 1, 256)
+    p = native.make_params(width=8, height=8, view=np.eye(4), proj=np.eye(4), tf_rgba=tf,
+                           classify="preint", gradient_opacity="iso", iso_value=3.0,
+                           iso_thickness=2.0, gradient_ref=0.1, gradient_exp=2.0, lib=lib)
+    assert p.tf_size == 256 and p.tf_rgba[255 * 4 + 3] == 1.0
+    assert p.classify == 2 and p.gradient_opacity == 2
+    assert (p.iso_value, p.iso_thickness) == (3.0, 2.0)
+    d1 = native.params_digest(p)
+    tf2 = tf.copy()
+    tf2[10, 0] = 0.5
+    p2 = native.make_params(width=8, height=8, view=np.eye(4), proj=np.eye(4), tf_rgba=tf2,
+                            classify="preint", gradient_opacity="iso", iso_value=3.0,
+                            iso_thickness=2.0, gradient_ref=0.1, gradient_exp=2.0, lib=lib)
+    assert native.params_digest(p2) != d1  # the table is part of the frame key
+    t = native.tile_params(p, 0, 0, 4, 8)
+    assert t.tf_rgba[255 * 4 + 3] == 1.0 and t._tf is p._tf

@@ -52,8 +52,12 @@ def test_newest_job_wins_and_stale_jobs_are_dropped(entry):
     dropped = runtime.cancelled_count
     first = entry.worker.submit(runtime.Job("owner", "k1", big))
     _wait(lambda: first.done or entry.worker._running is first)
+    # Built before the counter is read: default_camera is a library call that
+    # waits for the renderer, so building it afterwards would let the first
+    # job render more bands (the lock is not fair) before it is cancelled.
+    small = _params(entry)
     calls_at_cancel = runtime.call_count
-    second = entry.worker.submit(runtime.Job("owner", "k2", _params(entry)))
+    second = entry.worker.submit(runtime.Job("owner", "k2", small))
     _wait(lambda: second.done)
     assert first.done and first.cancelled and first.result is None
     assert second.result is not None

@@ -22,6 +22,7 @@ typedef struct options {
     const char *csv, *scene_dir;
     uint32_t backends[2];
     int n_backends;
+    int spike_only; /* the classification study (and table timings) alone */
 } options;
 
 typedef struct workload {
@@ -358,8 +359,10 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) o.size = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--frames") && i + 1 < argc) o.frames = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--osmesa-only")) o.n_backends = 1;
+        else if (!strcmp(argv[i], "--spike-only")) o.spike_only = 1;
         else {
-            fprintf(stderr, "usage: voxlight-bench [--quick|--full] [--out CSV] [--scene-dir DIR] [--size N] [--frames N] [--osmesa-only]\n");
+            fprintf(stderr, "usage: voxlight-bench [--quick|--full] [--out CSV] [--scene-dir DIR] [--size N] [--frames N] "
+                            "[--osmesa-only] [--spike-only]\n");
             return 2;
         }
     }
@@ -384,7 +387,7 @@ int main(int argc, char **argv)
     snprintf(preint_path, sizeof preint_path, "%s/preint_timing.csv", o.scene_dir);
     time_preint_tables(preint_path);
     int rc = run_spike_study(csv, &o);
-    for (int i = 0; i < 4 && !rc; i++) {
+    for (int i = 0; i < 4 && !rc && !o.spike_only; i++) {
         double t = now_ms();
         rc = run_workload(csv, &o, &w[i]);
         fprintf(stderr, "bench: %s done in %.1f s\n", w[i].name, (now_ms() - t) / 1e3);

@@ -43,9 +43,51 @@ static void chebyshev_axis(uint8_t *d, const uint32_t dims[3], int axis, uint8_t
         }
 }
 
+uint32_t vxl_bricks_gradient_apron(const vxl_frame *f)
+{
+    /* cubic: the prefiltered B-spline's derivative is not bounded by adjacent
+     * differences; precomputed: stored relative to the volume's largest
+     * gradient. Taps at +-d reach floor(p -+ d) .. +1: ceil(d) + 1 voxels. */
+    if (f->filter == VXL_FILTER_CUBIC || f->filter == VXL_FILTER_PRECOMPUTED) return 0;
+    return (uint32_t)ceil(f->sample_distance) + 1;
+}
+
+/* Levoy's iso-surface opacity is non-zero only where |iso - v| <= r*|g|.
+ * A sample's v lies in its brick's [min, max] and |g| <= the brick's
+ * gradient bound, so a brick is occupied unless iso lies outside that range
+ * widened by r times the bound. Without a usable bound, every brick is. */
+static void classify_iso(vxl_bricks *b, const vxl_frame *f)
+{
+    size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
+    uint32_t need = vxl_bricks_gradient_apron(f);
+    int bounded = need && b->gbound && b->gbound_apron >= need;
+    uint32_t occupied = 0;
+    for (size_t i = 0; i < n; i++) {
+        int occ = 1;
+        if (bounded) {
+            /* 2% + 1e-4: texture filtering's fixed-point weights can stretch a
+             * difference quotient slightly beyond the exact interpolant's */
+            double reach = f->iso_thickness * (double)b->gbound[i] * 1.02 + 1e-4;
+            occ = !(f->iso_pos < b->minmax[2 * i] - reach || f->iso_pos > b->minmax[2 * i + 1] + reach);
+            if (isnan(reach) || isnan(b->minmax[2 * i]) || isnan(b->minmax[2 * i + 1])) occ = 1;
+        }
+        b->distance[i] = occ ? 0 : 255;
+        occupied += (uint32_t)occ;
+    }
+    b->occupied = occupied;
+}
+
 int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
 {
     uint64_t key = vxl_classification_key(f);
+    if (f->gopacity == VXL_GOPACITY_ISO) { /* occupancy follows the iso-surface, its thickness and the filter */
+        float iso[5] = {f->iso_pos, f->iso_thickness, f->sample_distance, (float)f->filter, (float)b->gbound_apron};
+        for (int i = 0; i < 5; i++) {
+            uint32_t bits;
+            memcpy(&bits, &iso[i], sizeof bits);
+            key = (key ^ (bits + 0x9e3779b97f4a7c15ull * (i + 1))) * 1099511628211ull;
+        }
+    }
     if (b->distance && b->tf_key == key) return 0;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     if (!b->distance && !(b->distance = malloc(n))) return -1;
@@ -58,6 +100,14 @@ int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
         free(nonzero);
         free(scratch);
         return -1;
+    }
+    if (f->gopacity == VXL_GOPACITY_ISO) {
+        classify_iso(b, f);
+        for (int axis = 0; axis < 3; axis++) chebyshev_axis(b->distance, b->dims, axis, scratch, scratch + maxdim);
+        b->tf_key = key;
+        free(nonzero);
+        free(scratch);
+        return 1;
     }
     nonzero[0] = 0;
     for (uint32_t i = 0; i < f->tf_size; i++) nonzero[i + 1] = nonzero[i] + (f->tf[4 * i + 3] * f->opacity_scale > 0);
@@ -90,5 +140,6 @@ void vxl_bricks_free(vxl_bricks *b)
 {
     free(b->minmax);
     free(b->distance);
+    free(b->gbound);
     memset(b, 0, sizeof *b);
 }

@@ -264,9 +264,9 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     rc = check_float(e, "early_termination", et, 1e-6f, 1);
     if (rc) return rc;
     f->early_termination = p->no_skip ? 2.0f : et; /* > 1: never stops early */
-    /* ISO opacity lives where the value is near iso_value, which the brick
-     * occupancy (derived from the table) does not know: no brick leaps. */
-    f->skip = !p->no_skip && p->gradient_opacity != VXL_GOPACITY_ISO;
+    /* ISO opacity: the occupancy follows the iso-surface instead of the
+     * table (bricks.c), conservatively for filters without a gradient bound. */
+    f->skip = !p->no_skip;
     f->depth_threshold = p->depth_threshold == 0 ? 0.5f : p->depth_threshold;
     rc = check_float(e, "depth_threshold", f->depth_threshold, 1e-6f, 1);
     if (rc) return rc;

@@ -106,7 +106,7 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
         rc = compile(r, GL_COMPUTE_SHADER, "classify_volume.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
-        rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", NULL, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);
         return rc ? rc : link(r, a, 0, out);
     default:
         return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown program kind %u", kind);

@@ -87,6 +87,7 @@ int vxl_gradients_ensure(vxl_renderer *r, int store)
         return rc;
     }
     r->gradient_store = store;
+    r->gradient_max = max_mag.f;
     r->gradient_bytes = n * store_bytes[store];
     return VXL_OK;
 }

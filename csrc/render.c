@@ -66,6 +66,7 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
     vxl_uniform_i(r, prog, "u_volume", 0);
     vxl_uniform_i(r, prog, "u_gradient", 1);
     vxl_uniform_i(r, prog, "u_bspline", 1);
+    if (filter == VXL_FILTER_PRECOMPUTED) vxl_uniform_f(r, prog, "u_gradient_scale", r->gradient_max);
     GLint loc = gl->GetUniformLocation(prog, "u_dims");
     float dims[3] = {(float)r->dims[0], (float)r->dims[1], (float)r->dims[2]};
     if (loc >= 0) gl->Uniform3fv(loc, 1, dims);

@@ -55,6 +55,7 @@ struct vxl_renderer {
      * format: rebuilt on set_volume or a format change, never per frame. */
     GLuint gradient_tex;
     int gradient_store;        /* VXL_GRADIENT_STORE_* of gradient_tex */
+    float gradient_max;        /* largest |gradient| (value per voxel): gradient_tex holds g / gradient_max */
     uint64_t gradient_bytes;
 
     /* Cubic B-spline coefficients: depend only on the volume data. */

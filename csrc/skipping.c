@@ -21,17 +21,14 @@ void vxl_skipping_release(vxl_renderer *r)
     vxl_bricks_free(&r->bricks);
 }
 
-static int build_minmax(vxl_renderer *r)
+/* One per-brick pass of brick_minmax.comp into out (2 floats per brick):
+ * the min-max grid, or (apron > 0) the gradient bound in out[2 * i]. */
+static int brick_pass(vxl_renderer *r, uint32_t apron, float *out)
 {
     vxl_gl *gl = &r->gl;
     vxl_bricks *b = &r->bricks;
-    b->size = brick_size();
-    for (int a = 0; a < 3; a++) b->dims[a] = (r->dims[a] + b->size - 1) / b->size;
-    size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
-    b->minmax = malloc(n * 2 * sizeof(float));
-    if (!b->minmax) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the brick grid");
     GLuint prog;
-    int rc = vxl_program_get(r, VXL_PROG_BRICK_MINMAX, 0, 0, &prog);
+    int rc = vxl_program_get(r, VXL_PROG_BRICK_MINMAX, 0, apron ? 1 : 0, &prog);
     if (rc) return rc;
     gl->GetError();
     GLuint tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
@@ -42,14 +39,50 @@ static int build_minmax(vxl_renderer *r)
     gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
     vxl_uniform_i(r, prog, "u_volume", 0);
     vxl_uniform_i(r, prog, "u_brick", (int)b->size);
+    if (apron) vxl_uniform_i(r, prog, "u_apron", (int)apron);
     gl->BindImageTexture(0, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RG32F);
     gl->DispatchCompute((b->dims[0] + 3) / 4, (b->dims[1] + 3) / 4, (b->dims[2] + 3) / 4);
     gl->MemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
     gl->BindTexture(GL_TEXTURE_3D, tex);
-    gl->GetTexImage(GL_TEXTURE_3D, 0, GL_RG, GL_FLOAT, b->minmax);
+    gl->GetTexImage(GL_TEXTURE_3D, 0, GL_RG, GL_FLOAT, out);
     gl->DeleteTextures(1, &tex);
     gl->UseProgram(0);
-    return vxl_gl_check(r, "building the brick min-max grid");
+    return vxl_gl_check(r, apron ? "bounding the gradient per brick" : "building the brick min-max grid");
+}
+
+static int build_minmax(vxl_renderer *r)
+{
+    vxl_bricks *b = &r->bricks;
+    b->size = brick_size();
+    for (int a = 0; a < 3; a++) b->dims[a] = (r->dims[a] + b->size - 1) / b->size;
+    size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
+    b->minmax = malloc(n * 2 * sizeof(float));
+    if (!b->minmax) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the brick grid");
+    return brick_pass(r, 0, b->minmax);
+}
+
+/* Iso-surface skipping needs a gradient bound over the taps' reach; built on
+ * first use and rebuilt only for a wider reach. Reaches beyond a brick's edge
+ * are not bounded (the pass would read (3 bricks)^3 per brick): no leaps. */
+static int ensure_gradient_bound(vxl_renderer *r, const vxl_frame *f)
+{
+    vxl_bricks *b = &r->bricks;
+    uint32_t need = vxl_bricks_gradient_apron(f);
+    if (f->gopacity != VXL_GOPACITY_ISO || !need || need > b->size || (b->gbound && b->gbound_apron >= need))
+        return VXL_OK;
+    size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
+    float *tmp = malloc(n * 2 * sizeof *tmp);
+    if (!tmp) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the brick gradient bound");
+    int rc = brick_pass(r, need, tmp);
+    if (!rc) { /* keep one float per brick */
+        for (size_t i = 0; i < n; i++) tmp[i] = tmp[2 * i];
+        free(b->gbound);
+        b->gbound = tmp;
+        b->gbound_apron = need;
+    } else {
+        free(tmp);
+    }
+    return rc;
 }
 
 int vxl_skipping_prepare(vxl_renderer *r, const vxl_frame *f)
@@ -62,6 +95,8 @@ int vxl_skipping_prepare(vxl_renderer *r, const vxl_frame *f)
             return rc;
         }
     }
+    int rc = ensure_gradient_bound(r, f);
+    if (rc) return rc;
     int changed = vxl_bricks_classify(&r->bricks, f);
     if (changed < 0) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the brick occupancy");
     if (!r->brick_tex) {

@@ -8,6 +8,7 @@ uniform float u_sample_distance; // tap offset d, in voxels
 
 #ifdef FILTER_PRECOMPUTED
 uniform sampler3D u_gradient; // raw gradient / global max, interpolated then used
+uniform float u_gradient_scale; // that global max: magnitudes in value per voxel like every filter
 #endif
 
 #ifdef FILTER_CUBIC
@@ -98,7 +99,7 @@ vec3 gradient_at(vec3 p, float centre)
             }
     return g / (32.0 * d);
 #elif defined(FILTER_PRECOMPUTED)
-    return textureLod(u_gradient, voxel_to_tex(p), 0.0).xyz;
+    return textureLod(u_gradient, voxel_to_tex(p), 0.0).xyz * u_gradient_scale;
 #elif defined(FILTER_CUBIC)
     // Analytic derivative of the interpolating cubic B-spline: 24 fetches.
     vec3 base = floor(p);

@@ -222,6 +222,38 @@ TEST(gradient_magnitude_opacity)
     vxl_volume_destroy(v);
 }
 
+/* Gradient-magnitude opacity reads |grad| in value per voxel whatever the
+ * filter: the precomputed filter stores g / max|g| and must scale it back
+ * (it once did not, and its iso-surfaces came out 7x too opaque). */
+TEST(gradient_opacity_units_agree_across_filters)
+{
+    static float tf[NTF * 4], img[W * H * 4];
+    smooth_tf(tf);
+    for (int i = 0; i < NTF; i++) tf[4 * i + 3] = 0.3f;
+    vxl_phantom_desc sph = {sizeof sph, VXL_PHANTOM_SPHERE, {48, 48, 48}, 0, 0};
+    vxl_volume *v = NULL;
+    REQUIRE(vxl_phantom_create(&sph, &v) == VXL_OK);
+    REQUIRE(vxl_renderer_set_volume(R, v) == VXL_OK);
+    for (uint32_t m = VXL_GOPACITY_BOUNDARY; m < VXL_GOPACITY_COUNT; m++) {
+        double base = 0;
+        for (uint32_t f = 0; f < VXL_FILTER_COUNT; f++) {
+            vxl_render_params p = scene(tf, VXL_CLASSIFY_POST, 0.5f);
+            p.filter = f;
+            p.sample_distance = 1;
+            p.gradient_opacity = m;
+            p.gradient_ref = 0.05f;
+            p.iso_value = 0.5f;
+            p.iso_thickness = 1.5f;
+            REQUIRE(vxl_render(R, &p, img, NULL) == VXL_OK);
+            double a = alpha_sum(img, W * H);
+            if (f == 0) base = a;
+            CHECKF(a > 0.85 * base && a < 1.15 * base, "mode %u %s: alpha %.1f against central's %.1f", m,
+                   vxl_filter_name(f), a, base);
+        }
+    }
+    vxl_volume_destroy(v);
+}
+
 int main(void)
 {
     R = make_renderer(VXL_BACKEND_OSMESA);
@@ -234,6 +266,7 @@ int main(void)
     RUN(opacity_correction_makes_the_step_irrelevant);
     RUN(preintegration_pays_off_on_a_spike);
     RUN(gradient_magnitude_opacity);
+    RUN(gradient_opacity_units_agree_across_filters);
     vxl_renderer_destroy(R);
     return TEST_SUMMARY();
 }

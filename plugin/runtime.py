@@ -200,12 +200,14 @@ def _mtime(path):
         return None
 
 
-def load_volume(path, backend="auto", progress=None):
+def load_volume(path, backend="auto", progress=None, voxel_size=None):
     """Load `path` into a fresh renderer. Raises native.VoxlightError.
-    progress(fraction) is called between the slow steps."""
+    progress(fraction) is called between the slow steps. voxel_size (mm) is
+    for inputs without geometry; it only changes info["affine"], which the
+    importer bakes into the object, so later reloads need not repeat it."""
     path = os.path.abspath(path)
     lib = native.load_library()
-    vol = native.Volume.load(path, lib=lib)
+    vol = native.Volume.load(path, voxel_size=voxel_size, lib=lib)
     if progress:
         progress(0.4)
     try:

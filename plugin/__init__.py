@@ -23,18 +23,20 @@ if "bpy" in locals():
     import importlib
     for _m in (native, depth, zbuffer, volume_space, runtime, lights, params,  # noqa: F821
                properties, operators, panels, scene_geometry, offline, compositor,  # noqa: F821
-               render_hooks, viewport, api, preferences, tf, import_job, importer):  # noqa: F821
+               render_hooks, viewport, api, preferences, tf, import_job, importer,  # noqa: F821
+               volume_object):  # noqa: F821
         importlib.reload(_m)
 
 import bpy  # noqa: E402
 
 from . import (api, compositor, depth, import_job, importer, lights, native, offline,  # noqa: E402
                operators, panels, params, preferences, properties, render_hooks, runtime,
-               scene_geometry, tf, viewport, volume_space, zbuffer)
+               scene_geometry, tf, viewport, volume_object, volume_space, zbuffer)
 from .api import render_volume  # noqa: E402,F401
 
 # Registration order: properties before the UI that shows them; handlers last.
-_modules = (preferences, properties, tf, operators, importer, panels, render_hooks, viewport)
+_modules = (preferences, properties, tf, operators, importer, volume_object, panels, render_hooks,
+            viewport)
 
 
 def library_status():

@@ -60,6 +60,22 @@ def _switch_off(ob):
         s.saved_display = ""
 
 
+def _load_into(ob, backend):
+    """Switches ob on; returns "" or the library's message, which the panel
+    shows (an update callback cannot report). On failure the object stays
+    an ordinary Volume."""
+    try:
+        _switch_on(ob, backend)
+        err = ""
+    except (native.VoxlightError, OSError) as e:
+        err = str(e)
+        ob.voxlight.is_volume = False
+    ob.voxlight_vdb.error = err
+    from .properties import tag_redraw
+    tag_redraw()
+    return err
+
+
 def _on_toggle(self, context):
     ob = self.id_data
     if not self.enabled:
@@ -67,16 +83,7 @@ def _on_toggle(self, context):
         _switch_off(ob)
         return
     scene = context.scene if context and context.scene else bpy.context.scene
-    try:
-        _switch_on(ob, scene.voxlight.backend)
-        self.error = ""
-    except (native.VoxlightError, OSError) as e:
-        # An update callback cannot report: the panel shows the message and
-        # the object stays an ordinary Volume.
-        self.error = str(e)
-        ob.voxlight.is_volume = False
-    from .properties import tag_redraw
-    tag_redraw()
+    _load_into(ob, scene.voxlight.backend)
 
 
 class VoxlightVolumeObjectSettings(bpy.types.PropertyGroup):
@@ -100,14 +107,10 @@ class VOXLIGHT_OT_volume_object_reload(bpy.types.Operator):
         return ob is not None and ob.type == "VOLUME" and ob.voxlight_vdb.enabled
 
     def execute(self, context):
-        ob = context.object
-        try:
-            _switch_on(ob, context.scene.voxlight.backend)
-        except (native.VoxlightError, OSError) as e:
-            ob.voxlight_vdb.error = str(e)
-            self.report({"ERROR"}, "Voxlight: %s" % e)
+        err = _load_into(context.object, context.scene.voxlight.backend)
+        if err:
+            self.report({"ERROR"}, "Voxlight: %s" % err)
             return {"CANCELLED"}
-        ob.voxlight_vdb.error = ""
         return {"FINISHED"}
 
 

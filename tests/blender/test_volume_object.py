@@ -131,8 +131,13 @@ def broken_file_shows_an_error_and_changes_nothing():
     ob.voxlight_vdb.enabled = True
     assert "broken.vdb" in ob.voxlight_vdb.error
     assert not ob.voxlight.is_volume and ob.display_type == display
+    # fixed on disk: the panel's reload button loads it
+    write_vdb(bad, [{"name": "density", "array": _ball(), "affine": GRID}])
+    bpy.context.view_layer.objects.active = ob
+    assert bpy.ops.voxlight.volume_object_reload() == {"FINISHED"}
+    assert ob.voxlight.is_volume and ob.voxlight_vdb.error == "" and ob.display_type == "BOUNDS"
     ob.voxlight_vdb.enabled = False
-    assert ob.voxlight_vdb.error == ""
+    assert ob.voxlight_vdb.error == "" and ob.display_type == display
 
 
 @test

@@ -66,7 +66,7 @@ FUZZ_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-l
 FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include -Icsrc \
 	$(shell pkg-config --cflags OpenImageIO)
 FUZZ_LIB_C := volume.c error.c nifti.c nrrd.c metaimage.c loader_util.c
-FUZZ_LIB_CXX := image_stack.cpp
+FUZZ_LIB_CXX := image_stack.cpp vdb.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))
 

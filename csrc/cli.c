@@ -16,7 +16,9 @@ static const char usage[] =
     "                  [--window LO:HI] [--no-shading] [--backend auto|osmesa|egl] [--memory-budget SIZE]\n"
     "                  [--gradient-store 8bit|16f|32f] [--classify post|pre|preint] [--no-jitter] [--no-skip]\n"
     "                  [--gradient-opacity off|boundary|iso] [--gradient-ref G] [--iso VALUE] [--iso-thickness R]\n"
-    "  voxlight info INPUT\n"
+    "                  [--voxel-size X[,Y,Z]]\n"
+    "  voxlight info INPUT [--voxel-size X[,Y,Z]]\n"
+    "--voxel-size (mm) is for inputs without geometry (TIFF/PNG stacks); one value sets all three\n"
     "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic; presets: auto gray bone hot mri ct\n";
 
 static int die(const char *fmt, ...)
@@ -61,6 +63,30 @@ static int parse_size(const char *s, uint64_t *out)
     return 1;
 }
 
+/* "0.5" or "0.5,0.5,2" -> voxel size in mm, each finite and > 0 */
+static int parse_voxel_size(const char *s, double out[3])
+{
+    char *end;
+    for (int a = 0; a < 3; a++) {
+        out[a] = strtod(s, &end);
+        if (end == s || !isfinite(out[a]) || !(out[a] > 0)) return 0;
+        if (a == 0 && !*end) {
+            out[1] = out[2] = out[0];
+            return 1;
+        }
+        if (*end != (a < 2 ? ',' : '\0')) return 0;
+        s = end + 1;
+    }
+    return 1;
+}
+
+static int voxel_size_option(const char *val, vxl_load_options *lo)
+{
+    if (!val) return die("--voxel-size needs a value");
+    if (!parse_voxel_size(val, lo->voxel_size)) return die("bad --voxel-size '%s': use X,Y,Z or one value in mm, each > 0", val);
+    return 0;
+}
+
 static const char *dtype_name(uint32_t t)
 {
     static const char *const names[] = {"?", "uint8", "int8", "uint16", "int16", "uint32", "int32", "float32", "float64"};
@@ -69,16 +95,25 @@ static const char *dtype_name(uint32_t t)
 
 static int cmd_info(int argc, char **argv)
 {
-    if (argc != 1) return die("info takes one INPUT file (see voxlight --help)");
+    vxl_load_options lo = {.struct_size = sizeof lo};
+    const char *input = NULL;
+    for (int i = 0; i < argc; i++) {
+        if (!strcmp(argv[i], "--voxel-size")) {
+            if (voxel_size_option(i + 1 < argc ? argv[++i] : NULL, &lo)) return 1;
+        } else if (argv[i][0] == '-' && argv[i][1]) return die("unknown option '%s' (see voxlight --help)", argv[i]);
+        else if (!input) input = argv[i];
+        else return die("info takes one INPUT file (see voxlight --help)");
+    }
+    if (!input) return die("info takes one INPUT file (see voxlight --help)");
     vxl_volume *v = NULL;
-    if (vxl_volume_load(argv[0], NULL, &v)) return die("%s", vxl_last_error());
+    if (vxl_volume_load(input, &lo, &v)) return die("%s", vxl_last_error());
     vxl_volume_info in = {.struct_size = sizeof in};
     vxl_volume_get_info(v, &in);
     /* NIfTI names its two affines; other formats store one (reported as 2) */
     const char *const src[] = {"none (spacing)", "qform", in.nifti_version ? "sform" : "from header"};
-    printf("file:        %s\n", argv[0]);
+    printf("file:        %s\n", input);
     if (in.nifti_version) printf("format:      NIfTI-%u\n", in.nifti_version);
-    else printf("format:      %s\n", strrchr(argv[0], '.') ? strrchr(argv[0], '.') + 1 : "image stack");
+    else printf("format:      %s\n", strrchr(input, '.') ? strrchr(input, '.') + 1 : "image stack");
     printf("dimensions:  %u x %u x %u\n", in.dims[0], in.dims[1], in.dims[2]);
     printf("spacing:     %g x %g x %g mm\n", in.spacing[0], in.spacing[1], in.spacing[2]);
     printf("data type:   %s (stored as %u-bit %s)\n", dtype_name(in.dtype), in.texture_bits,
@@ -180,6 +215,9 @@ static int parse_render(int argc, char **argv, render_args *a)
             NEED_VALUE();
             if (!parse_size(val, &a->ro.memory_budget_bytes)) return die("bad --memory-budget '%s': e.g. 2G or 512M", val);
             a->lo.memory_budget_bytes = a->ro.memory_budget_bytes;
+        } else if (!strcmp(o, "--voxel-size")) {
+            if (voxel_size_option(val, &a->lo)) return 1;
+            i++;
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);

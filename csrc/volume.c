@@ -197,6 +197,7 @@ static vxl_loader_fn vxl_loader_for(const char *path)
         {".nrrd", vxl_nrrd_load}, {".nhdr", vxl_nrrd_load},
         {".mha", vxl_metaimage_load}, {".mhd", vxl_metaimage_load},
         {".tif", vxl_image_stack_load}, {".tiff", vxl_image_stack_load}, {".png", vxl_image_stack_load},
+        {".vdb", vxl_vdb_load},
     };
     for (size_t i = 0; i < sizeof by_ext / sizeof by_ext[0]; i++)
         if (has_suffix(path, by_ext[i].ext)) return by_ext[i].fn;
@@ -206,6 +207,7 @@ static vxl_loader_fn vxl_loader_for(const char *path)
         size_t n = fread(m, 1, sizeof m, f);
         fclose(f);
         if (n >= 4 && !memcmp(m, "NRRD", 4)) return vxl_nrrd_load;
+        if (n >= 4 && !memcmp(m, " BDV", 4)) return vxl_vdb_load; /* OpenVDB magic 0x56444220, little-endian */
         if (n >= 8 && !memcmp(m, "\x89PNG\r\n\x1a\n", 8)) return vxl_image_stack_load;
         if (n >= 4 && (!memcmp(m, "II*\0", 4) || !memcmp(m, "MM\0*", 4))) return vxl_image_stack_load;
         if (n >= 5 && (!strncasecmp((const char *)m, "ObjectType", 10) || !strncasecmp((const char *)m, "NDims", 5)))

@@ -56,5 +56,7 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
 /* TIFF/PNG through OpenImageIO: a multi-page TIFF, a numbered series
  * (slice_0001.tif ...) or a folder of images; in image_stack.cpp. */
 int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* OpenVDB scalar grid through OpenImageIO's OpenVDB reader; in vdb.cpp. */
+int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 
 #endif

@@ -1,4 +1,4 @@
-"""Voxlight for Blender: GPU ray casting of medical volumes (NIfTI) with
+"""Voxlight for Blender: GPU ray casting of medical and scientific volumes with
 selectable gradient filters, composited into the viewport and into F12 /
 background renders. The ray caster is libvoxlight.so, shipped beside this
 file and bound with ctypes (native.py).
@@ -13,7 +13,7 @@ bl_info = {
     "author": "Voxlight developers",
     "version": (0, 1, 0),
     "blender": (3, 4, 0),
-    "location": "File > Import > Medical volume (.nii/.nii.gz); Properties > Object > Voxlight",
+    "location": "File > Import > Medical/Scientific Volume; Properties > Object > Voxlight",
     "description": "Ray cast medical volumes with selectable gradient filters",
     "category": "Import-Export",
 }
@@ -23,18 +23,20 @@ if "bpy" in locals():
     import importlib
     for _m in (native, depth, zbuffer, volume_space, runtime, lights, params,  # noqa: F821
                properties, operators, panels, scene_geometry, offline, compositor,  # noqa: F821
-               render_hooks, viewport, api, preferences, tf):  # noqa: F821
+               render_hooks, viewport, api, preferences, tf, import_job, importer,  # noqa: F821
+               volume_object):  # noqa: F821
         importlib.reload(_m)
 
 import bpy  # noqa: E402
 
-from . import (api, compositor, depth, lights, native, offline, operators, panels,  # noqa: E402
-               params, preferences, properties, render_hooks, runtime, scene_geometry,
-               tf, viewport, volume_space, zbuffer)
+from . import (api, compositor, depth, import_job, importer, lights, native, offline,  # noqa: E402
+               operators, panels, params, preferences, properties, render_hooks, runtime,
+               scene_geometry, tf, viewport, volume_object, volume_space, zbuffer)
 from .api import render_volume  # noqa: E402,F401
 
 # Registration order: properties before the UI that shows them; handlers last.
-_modules = (preferences, properties, tf, operators, panels, render_hooks, viewport)
+_modules = (preferences, properties, tf, operators, importer, volume_object, panels, render_hooks,
+            viewport)
 
 
 def library_status():

@@ -56,7 +56,8 @@ c_double4x4 = ctypes.c_double * 16
 class LoadOptions(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("max_dim", ctypes.c_uint32),
-                ("memory_budget_bytes", ctypes.c_uint64)]
+                ("memory_budget_bytes", ctypes.c_uint64),
+                ("voxel_size", ctypes.c_double * 3)]
 
 
 class VolumeDesc(ctypes.Structure):
@@ -418,11 +419,15 @@ class Volume:
         self.info = self._read_info()
 
     @classmethod
-    def load(cls, path, max_dim=0, memory_budget=0, lib=None):
+    def load(cls, path, max_dim=0, memory_budget=0, voxel_size=None, lib=None):
+        """voxel_size (x, y, z) mm is for inputs without geometry (TIFF/PNG
+        stacks); None or 0 = 1 mm. Files with geometry ignore it."""
         lib = lib or load_library()
         opt = _sized(LoadOptions)
         opt.max_dim = max_dim
         opt.memory_budget_bytes = memory_budget
+        if voxel_size is not None:
+            opt.voxel_size[:] = [float(x) for x in voxel_size]
         h = ctypes.c_void_p()
         # The library's message already names the file.
         lib.check(lib.cdll.vxl_volume_load(os.fsencode(path), ctypes.byref(opt), ctypes.byref(h)))

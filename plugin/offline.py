@@ -41,7 +41,7 @@ def volume_instances(depsgraph, only=None, for_render=True):
     out = []
     for inst in depsgraph.object_instances:
         ob = inst.object
-        if ob.type != "EMPTY" or not ob.voxlight.is_volume:
+        if ob.type not in volume_space.VOLUME_TYPES or not ob.voxlight.is_volume:
             continue
         if only is not None and ob.original not in only:
             continue

@@ -68,7 +68,7 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     # --- identity, set by the importer (not animatable: they are data, not looks)
     is_volume: BoolProperty(name="Voxlight Volume", default=False, options=set())
     filepath: StringProperty(name="File", subtype="FILE_PATH", options=set(),
-                             description="The NIfTI file this volume renders",
+                             description="The file (or folder) this volume renders",
                              update=tag_redraw)
     unit_scale: FloatProperty(name="Scene Units per mm", default=0.01, options=set(),
                               description="Scale applied at import (information only)")

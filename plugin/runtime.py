@@ -200,35 +200,56 @@ def _mtime(path):
         return None
 
 
-def load_volume(path, backend="auto", progress=None):
-    """Load `path` into a fresh renderer. Raises native.VoxlightError.
-    progress(fraction) is called between the slow steps."""
+def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=None):
+    """Load `path` into a fresh renderer that is not registered yet (safe on
+    a worker thread: it touches no shared state). Raises native.VoxlightError.
+    progress(fraction) is called between the slow steps; cancelled() is asked
+    between them too, and when it says yes everything made so far is closed
+    and None returned. voxel_size (mm) is for inputs without geometry; it only
+    changes info["affine"], which the importer bakes into the object, so later
+    reloads need not repeat it."""
     path = os.path.abspath(path)
+    stop = cancelled or (lambda: False)
     lib = native.load_library()
-    vol = native.Volume.load(path, lib=lib)
-    if progress:
-        progress(0.4)
+    vol = native.Volume.load(path, voxel_size=voxel_size, lib=lib)
+    renderer = None
     try:
+        if stop():
+            return None
+        if progress:
+            progress(0.4)
         renderer = native.Renderer(backend=backend, lib=lib)
         if progress:
             progress(0.6)
-        try:
-            renderer.set_volume(vol)
-        except Exception:
-            renderer.close()
-            raise
+        if stop():
+            return None
+        renderer.set_volume(vol)
         info = dict(vol.info, histogram=vol.histogram(32))  # for the panel, from any format
+        if stop():
+            return None
+        entry, renderer = VolumeEntry(path, renderer, info), None
     finally:
         vol.close()  # the renderer holds its own copy on the GL side
+        if renderer is not None:  # failed or cancelled before the entry took it
+            renderer.close()
     if progress:
         progress(0.9)
-    entry = VolumeEntry(path, renderer, info)
-    old = _entries.pop(path, None)
-    if old is not None:
-        old.close()
-    _entries[path] = entry
-    _failures.pop(path, None)
     return entry
+
+
+def adopt(entry):
+    """Registers an entry from open_volume as the live one for its path."""
+    old = _entries.pop(entry.path, None)
+    if old is not None and old is not entry:
+        old.close()
+    _entries[entry.path] = entry
+    _failures.pop(entry.path, None)
+    return entry
+
+
+def load_volume(path, backend="auto", progress=None, voxel_size=None):
+    """open_volume + adopt: load `path` and make it the live entry."""
+    return adopt(open_volume(path, backend, progress, voxel_size))
 
 
 def get_entry(path, backend="auto"):

@@ -289,7 +289,7 @@ def _draw():
     # visible_get covers hidden objects, disabled and excluded collections
     # and local view; such volumes cost nothing.
     objs = [o for o in view_layer.objects
-            if o.type == "EMPTY" and o.voxlight.is_volume and o.visible_get(viewport=space)]
+            if o.type in volume_space.VOLUME_TYPES and o.voxlight.is_volume and o.visible_get(viewport=space)]
     region_ptr = region.as_pointer()
     drawn = set()
     moving_any = False

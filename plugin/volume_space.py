@@ -12,6 +12,11 @@ voxel_to_local: the render stays exact, only the drawn cube is approximate.
 
 import numpy as np
 
+# Object types that can be Voxlight volumes (Object.voxlight.is_volume):
+# imported volumes are Empties; Blender Volume objects (OpenVDB) join when
+# "Render with Voxlight" is on (volume_object.py).
+VOLUME_TYPES = ("EMPTY", "VOLUME")
+
 
 def voxel_to_cube(dims):
     """Maps the voxel box [-0.5, dim-0.5]^3 onto the cube [-1, 1]^3."""

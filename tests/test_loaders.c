@@ -672,6 +672,7 @@ TEST(dispatch_by_extension_folder_and_magic)
         {"junk.mha", "not a MetaImage file"}, {"junk.mhd", "not a MetaImage file"},
         {"junk.nii", "not a NIfTI file"}, {"junk.nii.gz", "not a NIfTI file"}, {"junk.hdr", "not a NIfTI file"},
         {"junk.xyz", "not a NIfTI file"}, {"junk.tif", "junk.tif"}, {"junk.PNG", "junk.PNG"},
+        {"junk.vdb", "cannot read OpenVDB file"},
     };
     for (size_t i = 0; i < sizeof by_ext / sizeof by_ext[0]; i++) {
         tmp(p, sizeof p, by_ext[i].name);
@@ -679,6 +680,10 @@ TEST(dispatch_by_extension_folder_and_magic)
         expect_error(T_, p, NULL, VXL_ERR_FORMAT, by_ext[i].says, NULL);
         unlink(p);
     }
+    /* OpenVDB's magic (0x56444220 little-endian) under another name */
+    static const char vdb_head[24] = " BDV";
+    REQUIRE(tw_write(tmp(p, sizeof p, "smoke.cache"), vdb_head, sizeof vdb_head, NULL, 0) == 0);
+    expect_error(T_, p, NULL, VXL_ERR_FORMAT, "cannot read OpenVDB file", NULL);
     /* a folder is an image stack */
     char dir[128];
     snprintf(dir, sizeof dir, "%s/nothing_here", g_dir);

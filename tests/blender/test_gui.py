@@ -326,6 +326,98 @@ def steps():
           and st.shown.width == region.width,
           "shown %dx%d full=%s" % (st.shown.width, st.shown.height, st.shown.full))
 
+    # 7. The importer from the UI runs modal: the load is on a worker thread,
+    # the operator returns at once and the object appears when it is done.
+    # Esc cancels: nothing is created, and the renderer the worker finishes
+    # after the cancel is closed.
+    yield from gui_import_steps(vx, win, area)
+
+    # 8. A Blender Volume object with "Render with Voxlight" in the viewport.
+    for o in list(bpy.data.objects):
+        o.hide_set(True)
+    scene.voxlight.viewport_resolution = 0.5
+    yield from settled()
+    blank = capture["img"]
+    smoke = volume_object_with_ball(scene)
+    smoke.voxlight_vdb.enabled = True
+    yield from settled()
+    diff = np.abs(capture["img"][..., :3] - blank[..., :3]).max(axis=2)
+    h, w = diff.shape
+    check("volume_object_in_viewport", diff[h // 2 - 10:h // 2 + 10, w // 2 - 10:w // 2 + 10].mean() > 0.1
+          and diff[:30, :30].mean() < 0.02, "centre %.3f corner %.3f"
+          % (diff[h // 2 - 10:h // 2 + 10, w // 2 - 10:w // 2 + 10].mean(), diff[:30, :30].mean()))
+    smoke.voxlight_vdb.enabled = False
+    yield from settled()
+    diff = np.abs(capture["img"][..., :3] - blank[..., :3]).max(axis=2)
+    check("volume_object_off_draws_nothing", diff.mean() < 0.01, "mean %.4f" % diff.mean())
+
+
+def volume_object_with_ball(scene):
+    """A Volume object (bounds display) holding a ball written by pyopenvdb."""
+    from vdb_write import write_vdb
+    i, j, k = np.meshgrid(*[np.arange(24.0)] * 3, indexing="ij")
+    ball = (0.02 + np.clip(1.0 - np.sqrt((i - 11.5) ** 2 + (j - 11.5) ** 2 + (k - 11.5) ** 2) / 11.5, 0, None))
+    aff = np.diag([0.05, 0.05, 0.05, 1.0])
+    aff[:3, 3] = -0.575
+    path = write_vdb(os.path.join(u.TMP, "gui_ball.vdb"),
+                     [{"name": "density", "array": ball.astype(np.float32), "affine": aff}])
+    vol = bpy.data.volumes.new("GuiSmoke")
+    vol.filepath = path
+    ob = bpy.data.objects.new("GuiSmoke", vol)
+    scene.collection.objects.link(ob)
+    return ob
+
+
+def gui_import_steps(vx, win, area):
+    native = vx.native
+    made = []
+    real_init, real_load = native.Renderer.__init__, native.Volume.load
+    gate = {"open": True}
+
+    def init(self, *a, **kw):
+        real_init(self, *a, **kw)
+        made.append(self)
+
+    def gated_load(*a, **kw):
+        while not gate["open"]:
+            time.sleep(0.02)
+        return real_load(*a, **kw)
+    native.Renderer.__init__, native.Volume.load = init, gated_load
+    try:
+        before = set(bpy.data.objects)
+        with bpy.context.temp_override(window=win, area=area):
+            res = bpy.ops.voxlight.import_volume("EXEC_DEFAULT", filepath=u.CH2, use_modal=True)
+        check("import_runs_modal", res == {"RUNNING_MODAL"} and set(bpy.data.objects) == before, str(res))
+        for _ in range(120):
+            yield 0.25
+            if set(bpy.data.objects) != before:
+                break
+        new = set(bpy.data.objects) - before
+        check("modal_import_creates_the_object", len(new) == 1
+              and tuple(new.pop().voxlight.dims) == (301, 370, 316))
+
+        gate["open"] = False  # the next load blocks until released
+        before = set(bpy.data.objects)
+        n_made = len(made)
+        with bpy.context.temp_override(window=win, area=area):
+            bpy.ops.voxlight.import_volume("EXEC_DEFAULT", filepath=u.ball_file("esc.nii.gz"), use_modal=True)
+        yield 0.3
+        win.event_simulate(type="ESC", value="PRESS")
+        win.event_simulate(type="ESC", value="RELEASE")
+        yield 0.5
+        gate["open"] = True  # the worker now finishes, after the cancel
+        yield 2.0
+        # Without the cancel the object would exist by now (the load was
+        # released 2 s ago); the worker stops at its next step, so it makes
+        # no renderer, or closes the one it made.
+        check("esc_cancels_the_import", set(bpy.data.objects) == before
+              and vx.runtime.find_entry(os.path.join(u.TMP, "esc.nii.gz")) is None
+              and all(r._handle is None for r in made[n_made:]),
+              "renderers made %d, closed %s" % (len(made) - n_made, [r._handle is None for r in made[n_made:]]))
+    finally:
+        gate["open"] = True
+        native.Renderer.__init__, native.Volume.load = real_init, real_load
+
 
 def main():
     it = steps()

@@ -11,6 +11,9 @@ cd "$(dirname "$0")/../.."
 secs=${1:-20}
 shift || true
 targets=("$@")
+# vdb is not in the default list: OpenVDB (read by OpenImageIO when it opens
+# the file, before Voxlight sees a byte) aborts on an assertion within a few
+# dozen mutations (tests/fuzz/upstream/); run it by name: run.sh 60 vdb.
 [ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png)
 
 if ! make -s -j"$(nproc)" fuzz; then
@@ -19,6 +22,7 @@ if ! make -s -j"$(nproc)" fuzz; then
     exit 1
 fi
 build/fuzz/make_seeds build/fuzz/seeds || { echo "fuzz: seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
+/usr/bin/python3 tests/fuzz/vdb_seeds.py build/fuzz/seeds/vdb || { echo "fuzz: vdb seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
 
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 pass=0
@@ -31,9 +35,10 @@ for t in "${targets[@]}"; do
     mkdir -p "$crash_dir" "$corpus"
     # OpenImageIO's PNG reader longjmps over a std::string on truncated files
     # (31 bytes lost inside libOpenImageIO, not in Voxlight): leak checks
-    # stay on for our own C loaders only.
+    # stay on for our own C loaders only. OpenVDB (under OpenImageIO's VDB
+    # reader) also loses a 520 KiB block inside libopenvdb on bad files.
     leaks=1
-    case $t in tiff|png) leaks=0 ;; esac
+    case $t in tiff|png|vdb) leaks=0 ;; esac
 
     mapfile -t crashers < <(find "$crash_dir" -maxdepth 1 -type f ! -name '.*' | sort)
     if [ ${#crashers[@]} -gt 0 ]; then

@@ -1,0 +1,106 @@
+"""A volume import running on a worker thread (no bpy), so Blender's UI
+stays live, shows progress and can cancel with Esc.
+
+The library's load call itself cannot be interrupted. Cancelling therefore
+returns control at once and lets the worker finish its current step in the
+background; the worker sees the flag between steps (runtime.open_volume
+asks) and closes whatever it made, and a result that arrives after the
+cancel is closed too. Nothing of a cancelled import is registered or kept.
+"""
+
+import os
+import threading
+
+from . import native, runtime
+
+# Formats the library reads, by name ending (lower case); folders are image
+# stacks or DICOM series. Used for the file browser filter and to name the
+# new object after the file without its extension.
+EXTENSIONS = (".nii.gz", ".nii", ".hdr.gz", ".img.gz", ".hdr", ".img", ".nrrd", ".nhdr", ".mha",
+              ".mhd", ".tiff", ".tif", ".png", ".vdb", ".dcm")
+FILTER_GLOB = ";".join("*" + e for e in EXTENSIONS) + ";DICOMDIR"
+
+
+def display_name(path):
+    """'brain' for /data/brain.nii.gz, the folder's name for a folder."""
+    base = os.path.basename(path.rstrip(os.sep)) or path
+    low = base.lower()
+    for ext in EXTENSIONS:
+        if low.endswith(ext) and len(base) > len(ext):
+            return base[: -len(ext)]
+    return base
+
+
+def is_vdb(path):
+    """OpenVDB geometry is in scene units already (Blender writes them)."""
+    return path.lower().endswith(".vdb")
+
+
+class ImportJob:
+    """Loads `path` with runtime.open_volume on a daemon thread. Poll `done`;
+    then `entry` (an unregistered runtime.VolumeEntry) or `error` (the
+    library's message, which names the file) is set."""
+
+    def __init__(self, path, backend="auto", voxel_size=None, start=True):
+        self.path = path
+        self.backend = backend
+        self.voxel_size = voxel_size
+        self.progress = 0.0
+        self.entry = None
+        self.error = None
+        self._cancelled = threading.Event()
+        self._done = threading.Event()
+        self._lock = threading.Lock()  # entry hand-over against cancel()
+        self._thread = None
+        if start:
+            self._thread = threading.Thread(target=self.run, name="voxlight-import", daemon=True)
+            self._thread.start()
+
+    @property
+    def done(self):
+        return self._done.is_set()
+
+    @property
+    def cancelled(self):
+        return self._cancelled.is_set()
+
+    def _set_progress(self, f):
+        self.progress = f
+
+    def run(self):
+        """The work; called on the thread, or directly for a blocking import."""
+        try:
+            entry = runtime.open_volume(self.path, self.backend, self._set_progress, self.voxel_size,
+                                        cancelled=self._cancelled.is_set)
+        except (native.VoxlightError, OSError) as e:
+            self.error = str(e)
+            entry = None
+        except Exception as e:  # never let a worker die silently
+            self.error = "%s: %s" % (type(e).__name__, e)
+            entry = None
+        with self._lock:
+            if entry is not None and self._cancelled.is_set():
+                entry.close()
+                entry = None
+            self.entry = entry
+            if entry is not None:
+                self.progress = 1.0
+        self._done.set()
+
+    def cancel(self):
+        """Drops the import: a finished result is closed now, one still in
+        flight when it arrives."""
+        with self._lock:
+            self._cancelled.set()
+            if self.entry is not None:
+                self.entry.close()
+                self.entry = None
+
+    def take(self):
+        """Hands the finished entry over (the caller now owns it)."""
+        with self._lock:
+            entry, self.entry = self.entry, None
+        return entry
+
+    def wait(self, timeout=None):
+        return self._done.wait(timeout)

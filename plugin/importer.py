@@ -1,0 +1,190 @@
+"""File › Import › Medical/Scientific Volume: every format libvoxlight loads
+(NIfTI, NRRD, MetaImage, TIFF/PNG stacks, OpenVDB, DICOM files and folders),
+picked by the library from the extension, the folder or the first bytes.
+
+From the menu the load runs on a worker thread (import_job.ImportJob) while
+a modal operator shows progress and cancels on Esc. From scripts,
+bpy.ops.voxlight.import_volume(filepath=...) blocks and returns FINISHED or
+CANCELLED with an error report. Either way nothing is created before the
+load has succeeded, and a failure while creating the object removes what
+was made, so a failed or cancelled import leaves bpy.data as it was.
+"""
+
+import os
+
+import bpy
+import numpy as np
+from bpy.props import BoolProperty, FloatProperty, FloatVectorProperty, StringProperty
+from bpy_extras.io_utils import ImportHelper
+from mathutils import Matrix
+
+from . import import_job, runtime, tf, volume_space
+
+
+def _to_matrix(a):
+    return Matrix([list(map(float, row)) for row in np.asarray(a).reshape(4, 4)])
+
+
+def resolve_path(filepath, directory):
+    """The file, or the folder when no file was picked (the browser then
+    gives a filepath ending in a separator, or only the directory)."""
+    path = bpy.path.abspath(filepath) if filepath else ""
+    if (not path or path.endswith(os.sep)) and directory:
+        path = bpy.path.abspath(directory)
+    return path.rstrip(os.sep) or path
+
+
+def fill_volume_properties(obj, path, info, v2l, unit_scale):
+    """The identity and data fields every Voxlight volume carries (shared by
+    imported volumes and Blender Volume objects rendered with Voxlight)."""
+    p = obj.voxlight
+    p.is_volume = True
+    p.filepath = path
+    p.unit_scale = unit_scale
+    p.voxel_to_local = np.asarray(v2l, np.float64).T.ravel().tolist()
+    p.dims = info["dims"]
+    p.data_min = info["value_min"]
+    p.data_max = info["value_max"]
+    p.window_low = info["value_min"]
+    p.window_high = info["value_max"]
+    if "histogram" in info:
+        p.histogram = [int(min(c, 2**31 - 1)) for c in info["histogram"]]
+
+
+class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
+    """Import a medical or scientific volume (NIfTI, NRRD, MetaImage, TIFF/PNG stack, OpenVDB, DICOM) as a Voxlight volume object"""
+    bl_idname = "voxlight.import_volume"
+    bl_label = "Import Medical/Scientific Volume"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filename_ext = ""
+    filter_glob: StringProperty(default=import_job.FILTER_GLOB, options={"HIDDEN"})
+    directory: StringProperty(subtype="DIR_PATH", options={"HIDDEN", "SKIP_SAVE"},
+                              description="Folder to import when no file is picked "
+                                          "(image stack or DICOM series)")
+    # Default 0.01: 1 mm becomes 1 cm, so a 180 mm head is 1.8 units across,
+    # the size of Blender's default cube. Use 0.001 for true metres.
+    unit_scale: FloatProperty(name="Scene Units per mm", default=0.01, min=1e-6, max=1e3,
+                              soft_min=0.0001, soft_max=1.0,
+                              description="Scene units per millimetre of the scan "
+                                          "(OpenVDB files are in scene units already)")
+    center: BoolProperty(name="Center at 3D Cursor", default=True,
+                         description="Put the volume's centre at the 3D cursor instead of "
+                                     "at the scanner origin")
+    voxel_size: FloatVectorProperty(name="Voxel Size (mm)", size=3, default=(1.0, 1.0, 1.0),
+                                    min=1e-6, soft_min=0.001, soft_max=100.0, precision=4,
+                                    description="x, y, z voxel size for inputs without geometry "
+                                                "(TIFF/PNG stacks); files with geometry ignore it")
+    # Set by invoke: the file browser path runs modal, scripts block.
+    use_modal: BoolProperty(default=False, options={"HIDDEN", "SKIP_SAVE"})
+
+    def invoke(self, context, event):
+        self.use_modal = True
+        return ImportHelper.invoke(self, context, event)
+
+    def execute(self, context):
+        path = resolve_path(self.filepath, self.directory)
+        backend = context.scene.voxlight.backend
+        if self.use_modal and context.window is not None:
+            self._job = import_job.ImportJob(path, backend, tuple(self.voxel_size))
+            wm = context.window_manager
+            wm.progress_begin(0.0, 1.0)
+            self._timer = wm.event_timer_add(0.1, window=context.window)
+            wm.modal_handler_add(self)
+            return {"RUNNING_MODAL"}
+        job = import_job.ImportJob(path, backend, tuple(self.voxel_size), start=False)
+        job.run()
+        return self._finish(context, job)
+
+    def modal(self, context, event):
+        job = self._job
+        if event.type == "ESC":
+            job.cancel()
+            self._end_modal(context)
+            self.report({"WARNING"}, "Voxlight: import of %s cancelled" % os.path.basename(job.path))
+            return {"CANCELLED"}
+        if event.type == "TIMER":
+            context.window_manager.progress_update(job.progress)
+            if job.done:
+                self._end_modal(context)
+                return self._finish(context, job)
+        return {"PASS_THROUGH"}
+
+    def cancel(self, context):  # Blender ends the operator (e.g. the file closes)
+        self._job.cancel()
+        self._end_modal(context)
+
+    def _end_modal(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+
+    def _finish(self, context, job):
+        """Creates the object from a finished job, or reports its error."""
+        name = os.path.basename(job.path)
+        if job.error is not None:
+            # Nothing has been created yet, so a failure leaves no trace.
+            self.report({"ERROR"}, "Voxlight: cannot import %s: %s" % (name, job.error))
+            return {"CANCELLED"}
+        entry = job.take()
+        if entry is None:
+            self.report({"WARNING"}, "Voxlight: import of %s cancelled" % name)
+            return {"CANCELLED"}
+        try:
+            self._create_object(context, job.path, entry.info)
+        except Exception as e:
+            entry.close()
+            self.report({"ERROR"}, "Voxlight: cannot import %s: %s" % (name, e))
+            return {"CANCELLED"}
+        runtime.adopt(entry)
+        info = entry.info
+        self.report({"INFO"}, "Voxlight: imported %s (%d x %d x %d, %s)"
+                    % (name, *info["dims"], info["dtype"]))
+        return {"FINISHED"}
+
+    def _create_object(self, context, path, info):
+        dims = info["dims"]
+        cursor = context.scene.cursor.location if self.center else None
+        unit_scale = 1.0 if import_job.is_vdb(path) else self.unit_scale
+        s_from_v = volume_space.scene_from_voxel(info["affine"], dims, unit_scale, center_at=cursor)
+        obj = bpy.data.objects.new(import_job.display_name(path), None)
+        try:
+            obj.empty_display_type = "CUBE"
+            obj.empty_display_size = 1.0
+            # Drawn in the "in front" pass: its wire cube then stays out of the
+            # depth buffer the viewport reads at POST_VIEW, so rays do not stop
+            # at the volume's own outline.
+            obj.show_in_front = True
+            obj.matrix_world = _to_matrix(volume_space.object_matrix(s_from_v, dims))
+            # Blender keeps loc/rot/scale only; whatever it could not hold
+            # (shear) stays in voxel_to_local so the render remains exact.
+            v2l = volume_space.voxel_to_local(s_from_v, np.array(obj.matrix_world))
+            fill_volume_properties(obj, path, info, v2l, unit_scale)
+            context.collection.objects.link(obj)
+            tf.ensure_texture(obj)  # grey ramp until a preset or the user edits it
+        except Exception:
+            tex = obj.voxlight.tf_texture
+            if tex is not None:
+                bpy.data.textures.remove(tex)
+            bpy.data.objects.remove(obj)
+            raise
+        for o in context.view_layer.objects:
+            o.select_set(False)
+        obj.select_set(True)
+        context.view_layer.objects.active = obj
+        return obj
+
+
+def menu_import(self, context):
+    self.layout.operator(VOXLIGHT_OT_import_volume.bl_idname,
+                         text="Medical/Scientific Volume (.nii, .nrrd, .mha, .tif, .vdb, DICOM...)")
+
+
+def register():
+    bpy.utils.register_class(VOXLIGHT_OT_import_volume)
+    bpy.types.TOPBAR_MT_file_import.append(menu_import)
+
+
+def unregister():
+    bpy.types.TOPBAR_MT_file_import.remove(menu_import)
+    bpy.utils.unregister_class(VOXLIGHT_OT_import_volume)

@@ -712,7 +712,8 @@ static void replay_dir(vxl_test_ctx *T_, const char *dir)
         const char *fmt = strrchr(dir, '/');
         fmt = fmt ? fmt + 1 : dir;
         static const char *const ext[][2] = {
-            {"nifti", "nii"}, {"nrrd", "nrrd"}, {"metaimage", "mha"}, {"tiff", "tif"}, {"png", "png"}};
+            {"nifti", "nii"}, {"nrrd", "nrrd"}, {"metaimage", "mha"}, {"tiff", "tif"}, {"png", "png"},
+            {"dicom", "dcm"}};
         const char *x = fmt;
         for (size_t i = 0; i < sizeof ext / sizeof ext[0]; i++)
             if (!strcmp(fmt, ext[i][0])) x = ext[i][1];

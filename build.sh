@@ -125,7 +125,7 @@ case "$cmd" in
         [ "$TOTAL_FAIL" -eq 0 ] ;;
     fuzz)
         # ./build.sh fuzz [SECONDS [TARGET...]]: each loader's libFuzzer target
-        # (nifti nrrd metaimage tiff png) for SECONDS (default 300); crashes
+        # (nifti nrrd metaimage tiff png dicom) for SECONDS (default 300); crashes
         # are kept in tests/crashers/<target>/
         install_deps; build
         shift

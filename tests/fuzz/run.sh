@@ -11,7 +11,7 @@ cd "$(dirname "$0")/../.."
 secs=${1:-20}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png)
+[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom)
 
 if ! make -s -j"$(nproc)" fuzz; then
     echo "fuzz: build failed"

@@ -579,6 +579,14 @@ extern "C" VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series 
     *count = 0;
     if (!path || !*path) return vxl_fail(nullptr, VXL_ERR_INVALID_ARGUMENT, "path is empty");
     try {
+        // Cheap refusal first, so callers may ask about any input (the CLI's
+        // info does) without a NIfTI's folder being parsed file by file.
+        struct stat st;
+        bool dir = stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+        std::string name(path);
+        bool dcm_ext = name.size() > 4 && strcasecmp(name.c_str() + name.size() - 4, ".dcm") == 0;
+        if (!vxl_dicom_path_is_dicom(path, dir) && !dcm_ext)
+            return vxl_fail(nullptr, VXL_ERR_FORMAT, "'%s' is not DICOM (no DICOMDIR, no \"DICM\" file)", path);
         Scan sc;
         int rc = scan(path, sc, nullptr);
         if (rc) return rc;

@@ -32,6 +32,11 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
     center: BoolProperty(name="Center at 3D Cursor", default=True,
                          description="Put the volume's centre at the 3D cursor instead of "
                                      "at the scanner origin")
+    # DICOM folders with several series: which one (index or UID, as
+    # native.list_dicom_series / `voxlight info` list them); "" = the only one.
+    series: StringProperty(name="DICOM Series", default="",
+                           description="Series of a DICOM folder to import: index or "
+                                       "SeriesInstanceUID (empty = the only series)")
 
     def execute(self, context):
         path = bpy.path.abspath(self.filepath)
@@ -41,7 +46,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             wm.progress_update(0.05)
             try:
                 entry = runtime.load_volume(path, backend=context.scene.voxlight.backend,
-                                            progress=wm.progress_update)
+                                            progress=wm.progress_update, series=self.series)
             except (native.VoxlightError, OSError) as e:
                 # Nothing has been created yet, so a failure leaves no trace.
                 self.report({"ERROR"}, "Voxlight: cannot import %s: %s"
@@ -79,6 +84,8 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         p = obj.voxlight
         p.is_volume = True
         p.filepath = path
+        p.series = self.series
+        p.frame_count = info.get("frame_count", 1)
         p.unit_scale = self.unit_scale
         p.voxel_to_local = v2l.T.ravel().tolist()
         p.dims = dims
@@ -110,7 +117,8 @@ class VOXLIGHT_OT_reload_volume(bpy.types.Operator):
     def execute(self, context):
         p = context.object.voxlight
         try:
-            runtime.load_volume(bpy.path.abspath(p.filepath), backend=context.scene.voxlight.backend)
+            runtime.load_volume(bpy.path.abspath(p.filepath), backend=context.scene.voxlight.backend,
+                                series=p.series)
         except native.VoxlightError as e:
             self.report({"ERROR"}, "Voxlight: %s" % e)
             return {"CANCELLED"}

@@ -16,28 +16,11 @@
 
 #include "fuzz/dicom_writer.h"
 #include "harness.h"
+#include "loader_test_util.h"
 #include "volume.h"
 #include "voxlight.h"
 
 static char g_dir[64];
-
-static void remove_tree(const char *path)
-{
-    DIR *d = opendir(path);
-    if (d) {
-        struct dirent *ent;
-        char p[1024];
-        while ((ent = readdir(d)) != NULL) {
-            if (!strcmp(ent->d_name, ".") || !strcmp(ent->d_name, "..")) continue;
-            snprintf(p, sizeof p, "%s/%s", path, ent->d_name);
-            remove_tree(p);
-        }
-        closedir(d);
-        rmdir(path);
-    } else {
-        unlink(path);
-    }
-}
 
 /* A fresh folder g_dir/name. */
 static const char *folder(char *buf, size_t n, const char *name)
@@ -45,15 +28,6 @@ static const char *folder(char *buf, size_t n, const char *name)
     snprintf(buf, n, "%s/%s", g_dir, name);
     mkdir(buf, 0755);
     return buf;
-}
-
-static double voxel(const vxl_volume *v, uint64_t i)
-{
-    double t;
-    if (v->texture_bits == 8) t = ((const uint8_t *)v->texels)[i] / 255.0;
-    else if (v->texture_bits == 16) t = ((const uint16_t *)v->texels)[i] / 65535.0;
-    else t = ((const float *)v->texels)[i];
-    return v->tex_lo + t * (v->tex_hi - v->tex_lo);
 }
 
 static int contains(const char *s, const char *sub) { return strstr(s, sub) != NULL; }

@@ -9,9 +9,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "harness.h"
+#include "loader_test_util.h"
 #include "nifti_writer.h"
 #include "volume.h"
 #include "voxlight.h"
@@ -41,11 +41,6 @@ static vxl_volume *load_frame(const char *path, uint32_t frame)
     return vxl_volume_load(path, &opt, &v) == VXL_OK ? v : NULL;
 }
 
-static double texel_value(const vxl_volume *v, uint64_t i)
-{
-    return v->tex_lo + ((const float *)v->texels)[i] * (v->tex_hi - v->tex_lo);
-}
-
 static void check_frame(vxl_test_ctx *T_, const char *path, uint32_t f)
 {
     vxl_volume *v = load_frame(path, f);
@@ -57,7 +52,7 @@ static void check_frame(vxl_test_ctx *T_, const char *path, uint32_t f)
     CHECK(info.dims[0] == N && info.dims[1] == N && info.dims[2] == N);
     const uint64_t probes[] = {0, 1, 17, PER / 2, PER - 1};
     for (size_t p = 0; p < sizeof probes / sizeof probes[0]; p++)
-        CHECKF(fabs(texel_value(v, probes[p]) - value((int)f, (int)probes[p])) < 0.5, "%s frame %u voxel %llu", path,
+        CHECKF(fabs(voxel(v, probes[p]) - value((int)f, (int)probes[p])) < 0.5, "%s frame %u voxel %llu", path,
                f, (unsigned long long)probes[p]);
     vxl_volume_destroy(v);
 }
@@ -153,12 +148,6 @@ int main(void)
     RUN(frame_n_of_a_4d_file_is_that_volume);
     RUN(later_frames_are_never_read_so_a_cut_file_opens);
     RUN(dim5_counts_frames_and_3d_files_have_one);
-    const char *files[] = {"fmri.nii", "fmri.nii.gz", "fmri2.nii", "cut.nii", "cut.nii.gz", "5d.nii", "3d.nii"};
-    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-        char p[256];
-        snprintf(p, sizeof p, "%s/%s", g_dir, files[i]);
-        unlink(p);
-    }
-    rmdir(g_dir);
+    remove_tree(g_dir);
     return TEST_SUMMARY();
 }

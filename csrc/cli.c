@@ -104,6 +104,7 @@ static uint32_t print_dicom_series(const char *path)
         for (uint32_t i = 0; i < n; i++) {
             printf("  [%u] %s  %s  %u x %u x %u", i, s[i].uid, s[i].modality[0] ? s[i].modality : "?", s[i].dims[0],
                    s[i].dims[1], s[i].dims[2]);
+            if (s[i].frame_count > 1) printf(" x %u time points", s[i].frame_count);
             if (s[i].description[0]) printf("  \"%s\"", s[i].description);
             if (s[i].gantry_tilt_deg > 0) printf("  gantry tilt %.2f deg (sheared affine)", s[i].gantry_tilt_deg);
             if (!s[i].loadable) printf("  NOT LOADABLE: %s", s[i].problem);

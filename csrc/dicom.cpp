@@ -62,10 +62,12 @@ struct Slice {
     double slope = 1, inter = 0, thickness = 0;
     std::string xfer;
     double dist = 0; // position along the slice normal
+    double tkey = 0; // time order: TemporalPositionIdentifier, TriggerTime, AcquisitionNumber or InstanceNumber
 };
 
 struct Series {
-    std::vector<Slice> slices;
+    std::vector<Slice> slices; // sorted by position, then time: volume t is slices[k * frames + t]
+    size_t frames = 1;         // time points (4D: several files at every position)
     double tilt_deg = 0;
     double affine[16];
     double spacing[3];
@@ -211,6 +213,14 @@ Parse read_slice(const std::string &path, Slice &s, std::string &why)
     if (get_doubles(ds, DCM_RescaleSlope, &v, 1)) s.slope = v;
     if (get_doubles(ds, DCM_RescaleIntercept, &v, 1)) s.inter = v;
     if (get_doubles(ds, DCM_SliceThickness, &v, 1)) s.thickness = v;
+    // the first of these a file has orders its time points (4D series)
+    const DcmTagKey time_tags[] = {DCM_TemporalPositionIdentifier, DCM_TriggerTime, DCM_AcquisitionNumber,
+                                   DCM_InstanceNumber};
+    for (const DcmTagKey &t : time_tags) {
+        Sint32 iv; // IS elements (dcmtk reads no Float64 from them); TriggerTime is DS
+        if (ds->findAndGetSint32(t, iv).good()) { s.tkey = iv; break; }
+        if (get_doubles(ds, t, &v, 1)) { s.tkey = v; break; }
+    }
     DcmXfer x(ds->getOriginalXfer());
     s.xfer = x.getXferName();
     s.encapsulated = x.isEncapsulated();
@@ -256,6 +266,42 @@ std::string check_pixels(const std::vector<Slice> &sl)
     return "";
 }
 
+// Several files at one position are time points of a 4D series (cardiac
+// phases, perfusion) when every position has the same number of them with
+// distinct time keys: each position's files are sorted by time and
+// s.frames set. Files closer than kSamePosition count as one position.
+constexpr double kSamePosition = 0.01; // mm
+bool group_time_points(Series &s)
+{
+    std::vector<Slice> &sl = s.slices;
+    std::vector<size_t> starts;
+    for (size_t i = 0; i < sl.size(); i++)
+        if (starts.empty() || sl[i].dist - sl[starts.back()].dist > kSamePosition) starts.push_back(i);
+    starts.push_back(sl.size());
+    const size_t t = starts[1] - starts[0];
+    for (size_t g = 0; g + 1 < starts.size(); g++) {
+        size_t b = starts[g], e = starts[g + 1];
+        if (e - b != t) {
+            s.problem = format("%zu file(s) at the position of '%s' but %zu at that of '%s' (%.4g mm along the "
+                               "normal): a 4D series needs the same number of time points at every position "
+                               "(missing or duplicate files?)", t, basename_of(sl[0].path).c_str(), e - b,
+                               basename_of(sl[b].path).c_str(), sl[b].dist);
+            return false;
+        }
+        std::stable_sort(sl.begin() + long(b), sl.begin() + long(e),
+                         [](const Slice &x, const Slice &y) { return x.tkey < y.tkey; });
+        for (size_t i = b + 1; i < e; i++)
+            if (sl[i].tkey == sl[i - 1].tkey) {
+                s.problem = format("'%s' and '%s' lie at the same position (%.4g mm along the normal) with the same "
+                                   "time (%.6g): duplicates, not time points", sl[i - 1].path.c_str(),
+                                   sl[i].path.c_str(), sl[i].dist, sl[i].tkey);
+                return false;
+            }
+    }
+    s.frames = t;
+    return true;
+}
+
 // Sorts the slices along the normal and derives the geometry; sets
 // s.problem when the series cannot become one volume.
 void analyse(Series &s)
@@ -288,37 +334,34 @@ void analyse(Series &s)
         t.dist = dot(t.ipp, n);
     }
     std::stable_sort(sl.begin(), sl.end(), [](const Slice &a, const Slice &b) { return a.dist < b.dist; });
+    if (!group_time_points(s)) return;
+    // one file per position from here on: the first time point's
+    std::vector<const Slice *> rep;
+    for (size_t i = 0; i < sl.size(); i += s.frames) rep.push_back(&sl[i]);
 
     double w[3] = {n[0], n[1], n[2]}; // slice axis (LPS), per slice step
-    size_t k = sl.size();
+    size_t k = rep.size();
     if (k > 1) {
         std::vector<double> steps;
-        for (size_t i = 1; i < k; i++) steps.push_back(sl[i].dist - sl[i - 1].dist);
+        for (size_t i = 1; i < k; i++) steps.push_back(rep[i]->dist - rep[i - 1]->dist);
         std::vector<double> sorted = steps;
         std::sort(sorted.begin(), sorted.end());
         double typical = sorted[sorted.size() / 2];
         double tol = 0.01 * std::fabs(typical) + 1e-4;
-        for (size_t i = 0; i < steps.size(); i++) {
-            if (steps[i] < tol) {
-                s.problem = format("'%s' and '%s' lie at the same position (%.4g mm along the normal): several "
-                                   "acquisitions or time points in one series are not supported",
-                                   sl[i].path.c_str(), sl[i + 1].path.c_str(), sl[i].dist);
-                return;
-            }
+        for (size_t i = 0; i < steps.size(); i++)
             if (std::fabs(steps[i] - typical) > tol) {
                 s.problem = format("uneven slice spacing (a missing slice?): %.4g mm between '%s' and '%s', the "
-                                   "series' spacing is %.4g mm", steps[i], basename_of(sl[i].path).c_str(),
-                                   basename_of(sl[i + 1].path).c_str(), typical);
+                                   "series' spacing is %.4g mm", steps[i], basename_of(rep[i]->path).c_str(),
+                                   basename_of(rep[i + 1]->path).c_str(), typical);
                 return;
             }
-        }
-        for (int a = 0; a < 3; a++) w[a] = (sl[k - 1].ipp[a] - sl[0].ipp[a]) / double(k - 1);
+        for (int a = 0; a < 3; a++) w[a] = (rep[k - 1]->ipp[a] - rep[0]->ipp[a]) / double(k - 1);
         // every position must lie on the line first + i*w
         for (size_t i = 0; i < k; i++)
             for (int a = 0; a < 3; a++)
-                if (std::fabs(sl[0].ipp[a] + double(i) * w[a] - sl[i].ipp[a]) > tol) {
+                if (std::fabs(rep[0]->ipp[a] + double(i) * w[a] - rep[i]->ipp[a]) > tol) {
                     s.problem = format("'%s': ImagePositionPatient is off the line through the other slices",
-                                       sl[i].path.c_str());
+                                       rep[i]->path.c_str());
                     return;
                 }
         double wl = std::sqrt(dot(w, w));
@@ -334,7 +377,7 @@ void analyse(Series &s)
         dir[1][a] = c[a] * f.ps[0]; // down a column: row index j, row spacing
         dir[2][a] = w[a];
     }
-    const double *first = sl[0].ipp; // after sorting: the lowest position along the normal
+    const double *first = rep[0]->ipp; // after sorting: the lowest position along the normal
     double origin[3] = {first[0], first[1], first[2]};
     for (int col = 0; col < 3; col++) { dir[col][0] = -dir[col][0]; dir[col][1] = -dir[col][1]; } // LPS -> RAS
     origin[0] = -origin[0];
@@ -397,7 +440,7 @@ int scan(const std::string &path, Scan &out, vxl_err *e)
 std::string series_line(size_t i, const Series &s)
 {
     const Slice &f = s.slices[0];
-    return format("%zu: %s (%s%s%s, %zu slices)", i, f.uid.c_str(), f.modality.empty() ? "?" : f.modality.c_str(),
+    return format("%zu: %s (%s%s%s, %zu files)", i, f.uid.c_str(), f.modality.empty() ? "?" : f.modality.c_str(),
                   f.description.empty() ? "" : ", ", f.description.c_str(), s.slices.size());
 }
 
@@ -478,12 +521,18 @@ uint32_t dtype_of(const Slice &s)
     return s.pixel_rep ? VXL_DTYPE_I16 : VXL_DTYPE_U16;
 }
 
-int load_series(const Series &s, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+int load_series(const Series &s, const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
-    const Slice &f = s.slices[0];
-    const uint32_t dims[3] = {f.cols, f.rows, uint32_t(s.slices.size())};
+    const uint32_t frame = vxl_load_frame(opt);
+    if (frame >= s.frames)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %u requested, the series has %zu (0..%zu)", path,
+                        frame, s.frames, s.frames - 1);
+    std::vector<const Slice *> vol; // this time point's files, in position order
+    for (size_t i = frame; i < s.slices.size(); i += s.frames) vol.push_back(&s.slices[i]);
+    const Slice &f = *vol[0];
+    const uint32_t dims[3] = {f.cols, f.rows, uint32_t(vol.size())};
     bool same_scale = true;
-    for (const Slice &t : s.slices) same_scale = same_scale && t.slope == f.slope && t.inter == f.inter;
+    for (const Slice *t : vol) same_scale = same_scale && t->slope == f.slope && t->inter == f.inter;
     const uint32_t dtype = dtype_of(f);
     // per-slice rescale values (PET, some MR) need floats; checked against
     // the budget at the size they will be stored in, before any allocation
@@ -494,8 +543,8 @@ int load_series(const Series &s, const vxl_load_options *opt, vxl_volume **out, 
     std::vector<unsigned char> raw(same_scale ? size_t(nbytes) : per * elem);
     std::vector<float> scaled;
     if (!same_scale) scaled.resize(per * dims[2]);
-    for (size_t k = 0; k < s.slices.size(); k++) {
-        const Slice &t = s.slices[k];
+    for (size_t k = 0; k < vol.size(); k++) {
+        const Slice &t = *vol[k];
         rc = read_pixels(t, same_scale ? raw.data() + k * per * elem : raw.data(), e);
         if (rc) return rc;
         if (same_scale) continue;
@@ -514,6 +563,8 @@ int load_series(const Series &s, const vxl_load_options *opt, vxl_volume **out, 
         rc = vxl_volume_build(scaled.data(), VXL_DTYPE_F32, dims, s.spacing, s.affine, 0, 0, opt, out, &inner);
     if (rc) return vxl_fail_in(e, f.path.c_str(), &inner);
     (*out)->affine_source = 2; // from the header
+    (*out)->frame_count = uint32_t(s.frames);
+    (*out)->frame = frame;
     return VXL_OK;
 }
 
@@ -561,10 +612,7 @@ extern "C" int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl
         rc = choose(sc, path, vxl_load_series(opt), &s, e);
         if (rc) return rc;
         if (!s->problem.empty()) return vxl_fail(e, VXL_ERR_FORMAT, "%s", s->problem.c_str());
-        if (vxl_load_frame(opt) != 0)
-            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %u requested, a DICOM series has 1 (0)", path,
-                            vxl_load_frame(opt));
-        return load_series(*s, opt, out, e);
+        return load_series(*s, path, opt, out, e);
     } catch (const std::bad_alloc &) {
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory reading the DICOM series", path);
     } catch (const std::exception &x) {
@@ -601,7 +649,8 @@ extern "C" VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series 
             d.slice_count = uint32_t(s.slices.size());
             d.dims[0] = f.cols;
             d.dims[1] = f.rows;
-            d.dims[2] = d.slice_count;
+            d.dims[2] = uint32_t(s.slices.size() / s.frames);
+            d.frame_count = uint32_t(s.frames);
             d.loadable = s.problem.empty();
             d.gantry_tilt_deg = s.tilt_deg;
             copy_field(d.uid, sizeof d.uid, f.uid);

@@ -68,6 +68,7 @@ class DicomSeries(ctypes.Structure):
                 ("slice_count", ctypes.c_uint32),
                 ("dims", ctypes.c_uint32 * 3),
                 ("loadable", ctypes.c_uint32),
+                ("frame_count", ctypes.c_uint32),
                 ("gantry_tilt_deg", ctypes.c_double),
                 ("uid", ctypes.c_char * 72),
                 ("modality", ctypes.c_char * 20),
@@ -546,7 +547,7 @@ class Volume:
 def list_dicom_series(path, lib=None):
     """The series of a DICOM folder, DICOMDIR or file (its folder) as dicts
     (uid, modality, description, slice_count, dims, loadable, problem,
-    gantry_tilt_deg), in the order whose index Volume.load(series=) takes.
+    gantry_tilt_deg, frame_count), in the order whose index Volume.load(series=) takes.
     [] for inputs that are not DICOM."""
     lib = lib or load_library()
     n = ctypes.c_uint32()
@@ -558,7 +559,8 @@ def list_dicom_series(path, lib=None):
     text = lambda b: b.decode("utf-8", "replace")  # noqa: E731
     return [{"uid": text(s.uid), "modality": text(s.modality), "description": text(s.description),
              "slice_count": s.slice_count, "dims": tuple(s.dims), "loadable": bool(s.loadable),
-             "problem": text(s.problem), "gantry_tilt_deg": s.gantry_tilt_deg}
+             "problem": text(s.problem), "gantry_tilt_deg": s.gantry_tilt_deg,
+             "frame_count": s.frame_count}
             for s in arr[:n.value]]
 
 

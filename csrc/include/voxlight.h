@@ -175,8 +175,9 @@ VXL_API void vxl_volume_destroy(vxl_volume *vol);
 typedef struct vxl_dicom_series {
     uint32_t struct_size;
     uint32_t slice_count;       /* files (single-frame images) in the series */
-    uint32_t dims[3];           /* columns, rows, slices (the first file's size) */
+    uint32_t dims[3];           /* columns, rows, positions (the first file's size) */
     uint32_t loadable;          /* 1: passes every check made before pixels are read */
+    uint32_t frame_count;       /* time points (4D: as many files at every position) */
     double gantry_tilt_deg;     /* angle between the slice normal and the stacking
                                    direction; loads with a sheared affine */
     char uid[72];               /* SeriesInstanceUID */

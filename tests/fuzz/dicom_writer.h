@@ -24,6 +24,7 @@ typedef struct dcmw_slice {
     uint16_t pixel_rep;           /* 1 = signed */
     uint32_t frames;              /* 0 = no NumberOfFrames element */
     int instance;
+    int temporal_position;        /* 0 = no TemporalPositionIdentifier (4D series: 1, 2, ...) */
     int no_geometry;              /* 1: no ImagePositionPatient/ImageOrientationPatient */
     double ipp[3], iop[6], ps[2]; /* ps: row spacing, column spacing */
     int has_rescale;
@@ -131,6 +132,11 @@ static size_t dcmw_encode(const dcmw_slice *d, unsigned char *buf, size_t cap)
     if (!d->no_geometry) {
         dcmw_ds(&b, 0x0020, 0x0032, d->ipp, 3);
         dcmw_ds(&b, 0x0020, 0x0037, d->iop, 6);
+    }
+    if (d->temporal_position) {
+        char tp[16];
+        snprintf(tp, sizeof tp, "%d", d->temporal_position);
+        dcmw_str(&b, 0x0020, 0x0100, "IS", tp);
     }
     dcmw_us(&b, 0x0028, 0x0002, 1);
     dcmw_str(&b, 0x0028, 0x0004, "CS", "MONOCHROME2");

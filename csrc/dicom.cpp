@@ -23,9 +23,13 @@
 // reports the angle). Uneven steps (a missing slice) cannot be expressed by
 // one affine and are refused, naming the gap.
 //
+// 4D: when every position holds the same number of files with distinct time
+// keys, they are time points (group_time_points); vxl_load_options.frame
+// picks one.
+//
 // Not decoded: compressed (encapsulated) transfer syntaxes, multi-frame
-// images, colour, BitsAllocated other than 8/16, several slices at one
-// position (4D series). Each is a clear error naming the file.
+// images, colour, BitsAllocated other than 8/16. Each is a clear error naming
+// the file.
 #include <dcmtk/config/osconfig.h>
 #include <dcmtk/dcmdata/dctk.h>
 #include <dcmtk/oflog/oflog.h>

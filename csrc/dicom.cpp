@@ -35,6 +35,7 @@
 #include <dcmtk/oflog/oflog.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdarg>
@@ -44,6 +45,7 @@
 #include <mutex>
 #include <string>
 #include <strings.h>
+#include <type_traits>
 #include <sys/stat.h>
 #include <vector>
 
@@ -265,6 +267,9 @@ std::string check_pixels(const std::vector<Slice> &sl)
             return format("mixed pixel types in the series: '%s' and '%s'", f.path.c_str(), p);
         if (!(s.ps[0] > 0) || !(s.ps[1] > 0))
             return format("'%s': bad PixelSpacing %g\\%g", p, s.ps[0], s.ps[1]);
+        if (std::fabs(s.ps[0] - f.ps[0]) > 1e-4 * f.ps[0] || std::fabs(s.ps[1] - f.ps[1]) > 1e-4 * f.ps[1])
+            return format("mixed PixelSpacing in the series: %g\\%g ('%s') and %g\\%g ('%s')", f.ps[0], f.ps[1],
+                          f.path.c_str(), s.ps[0], s.ps[1], p);
         if (s.slope == 0) return format("'%s': RescaleSlope is 0", p);
     }
     return "";
@@ -313,6 +318,8 @@ void analyse(Series &s)
     std::vector<Slice> &sl = s.slices;
     s.problem = check_pixels(sl);
     if (!s.problem.empty()) return;
+    // every file shares f's orientation and pixel spacing (checked below and
+    // in check_pixels), so f stays valid for them after sorting
     const Slice &f = sl[0];
     const double *r = f.iop, *c = f.iop + 3;
     double n[3];

@@ -363,6 +363,15 @@ TEST(mixed_sizes_compressed_and_multiframe_are_clear_errors)
     CHECKF(contains(vxl_last_error(), "mixed image sizes") && contains(vxl_last_error(), "4x3") &&
            contains(vxl_last_error(), "4x4"), "%s", vxl_last_error());
 
+    folder(dir, sizeof dir, "spacing");
+    for (int k = 0; k < 2; k++) {
+        dcmw_slice d = dcmw_axial("1.2.3.73", NC, NR, 2.0 * k, px, NC * NR * 2);
+        d.ps[1] = k ? 0.5 : 1.0;
+        snprintf(p, sizeof p, "%s/%d.dcm", dir, k);
+        REQUIRE(dcmw_write(p, &d) == 0);
+    }
+    CHECKF(load_series(dir, NULL) == NULL && contains(vxl_last_error(), "mixed PixelSpacing"), "%s", vxl_last_error());
+
     folder(dir, sizeof dir, "jpeg");
     dcmw_slice d = dcmw_axial("1.2.3.71", NC, NR, 0, px, 17);
     d.transfer_syntax = DCMW_JPEG_BASELINE;

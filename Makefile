@@ -12,7 +12,10 @@ OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize
 endif
 CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include -Icsrc
 CXXFLAGS := -std=c++17 $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include $(shell pkg-config --cflags OpenImageIO)
-LIBS := -ldl -lpthread -lz -lm $(shell pkg-config --libs OpenImageIO)
+# dcmtk (DICOM, csrc/dicom.cpp): Debian 12's dcmtk.pc names sndfile, which is
+# not installed, so the three libraries dcmdata needs are named directly.
+DCMTK_LIBS := -ldcmdata -loflog -lofstd
+LIBS := -ldl -lpthread -lz -lm $(shell pkg-config --libs OpenImageIO) $(DCMTK_LIBS)
 
 LIB_C := $(filter-out csrc/cli.c,$(wildcard csrc/*.c))
 LIB_CXX := $(wildcard csrc/*.cpp)
@@ -26,7 +29,7 @@ all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/voxlight-bench $(BUILD)/
 $(BUILD)/obj/%.o: csrc/%.c $(wildcard csrc/*.h csrc/include/*.h) | $(BUILD)/obj
 	$(CC) $(CFLAGS) -c $< -o $@
 
-$(BUILD)/obj/%.o: csrc/%.cpp csrc/include/voxlight.h | $(BUILD)/obj
+$(BUILD)/obj/%.o: csrc/%.cpp $(wildcard csrc/*.h csrc/include/*.h) | $(BUILD)/obj
 	$(CXX) $(CXXFLAGS) -c $< -o $@
 
 # Shaders are embedded at build time so an installed library needs no shader path.
@@ -66,7 +69,7 @@ FUZZ_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-l
 FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include -Icsrc \
 	$(shell pkg-config --cflags OpenImageIO)
 FUZZ_LIB_C := volume.c error.c nifti.c nrrd.c metaimage.c loader_util.c
-FUZZ_LIB_CXX := image_stack.cpp vdb.cpp
+FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))
 
@@ -84,7 +87,7 @@ $(FUZZ_BUILD)/obj/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h csrc/in
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/fuzz_%.o $(FUZZ_OBJ)
 	clang++ $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@ $(LIBS)
 
-$(FUZZ_BUILD)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/writers.h tests/nifti_writer.h | $(FUZZ_BUILD)/obj
+$(FUZZ_BUILD)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/writers.h tests/fuzz/dicom_writer.h tests/nifti_writer.h | $(FUZZ_BUILD)/obj
 	$(CC) -std=c11 -D_GNU_SOURCE $(WARN) -O1 -Itests $< -o $@ -lz
 
 $(FUZZ_BUILD)/obj:

@@ -9,13 +9,14 @@ ROOT=$(pwd)
 
 # Debian packages the project needs: compilers, GL headers (we never link GL),
 # OSMesa and Mesa's EGL for the offscreen context, OpenImageIO for image files,
+# dcmtk for DICOM series,
 # the demo brain (mricron-data), Blender and Xvfb for the add-on and its tests,
 # numpy and pytest for the Python tests, clang with its sanitizer/libFuzzer
 # runtime for the loader fuzz targets (tests/fuzz/), pyopenvdb to write test .vdb files.
 PACKAGES=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
           libgl1-mesa-dri libosmesa6 libosmesa6-dev libopenimageio-dev mricron-data blender
           xvfb xauth python3 python3-numpy python3-pytest zip unzip
-          clang libclang-rt-14-dev python3-matplotlib python3-vtk9 python3-openvdb)
+          clang libclang-rt-14-dev python3-matplotlib python3-vtk9 python3-openvdb libdcmtk-dev)
 
 install_deps() {
     local missing=()
@@ -124,7 +125,7 @@ case "$cmd" in
         [ "$TOTAL_FAIL" -eq 0 ] ;;
     fuzz)
         # ./build.sh fuzz [SECONDS [TARGET...]]: each loader's libFuzzer target
-        # (nifti nrrd metaimage tiff png) for SECONDS (default 300); crashes
+        # (nifti nrrd metaimage tiff png dicom) for SECONDS (default 300); crashes
         # are kept in tests/crashers/<target>/
         install_deps; build
         shift

@@ -16,8 +16,10 @@ static const char usage[] =
     "                  [--window LO:HI] [--no-shading] [--backend auto|osmesa|egl] [--memory-budget SIZE]\n"
     "                  [--gradient-store 8bit|16f|32f] [--classify post|pre|preint] [--no-jitter] [--no-skip]\n"
     "                  [--gradient-opacity off|boundary|iso] [--gradient-ref G] [--iso VALUE] [--iso-thickness R]\n"
-    "                  [--voxel-size X[,Y,Z]]\n"
-    "  voxlight info INPUT [--voxel-size X[,Y,Z]]\n"
+    "                  [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
+    "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
+    "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
+    "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
     "--voxel-size (mm) is for inputs without geometry (TIFF/PNG stacks); one value sets all three\n"
     "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic; presets: auto gray bone hot mri ct\n";
 
@@ -93,18 +95,72 @@ static const char *dtype_name(uint32_t t)
     return t < sizeof names / sizeof *names ? names[t] : "?";
 }
 
+/* --frame N / --series S / --voxel-size X[,Y,Z], shared by render and info.
+ * Returns 1 if o was one of them (*i advanced past its value), -1 on a bad
+ * value, 0 otherwise. */
+static int parse_input_option(int argc, char **argv, int *i, vxl_load_options *lo)
+{
+    const char *o = argv[*i];
+    if (strcmp(o, "--frame") && strcmp(o, "--series") && strcmp(o, "--voxel-size")) return 0;
+    if (*i + 1 >= argc) { die("%s needs a value", o); return -1; }
+    const char *val = argv[++*i];
+    if (!strcmp(o, "--voxel-size")) return voxel_size_option(val, lo) ? -1 : 1;
+    if (!strcmp(o, "--series")) {
+        if (!*val) { die("--series needs an index or a SeriesInstanceUID"); return -1; }
+        lo->series = val;
+        return 1;
+    }
+    char *end;
+    unsigned long f = strtoul(val, &end, 10);
+    if (end == val || *end || val[0] == '-' || f > UINT32_MAX) { die("bad --frame '%s': a frame number from 0", val); return -1; }
+    lo->frame = (uint32_t)f;
+    return 1;
+}
+
+/* The series of a DICOM input, one line each; nothing for other formats.
+ * Returns how many there are. */
+static uint32_t print_dicom_series(const char *path)
+{
+    uint32_t n = 0;
+    if (vxl_dicom_list_series(path, NULL, 0, &n) || n == 0) return 0;
+    vxl_dicom_series *s = calloc(n, sizeof *s);
+    if (!s) return 0;
+    s[0].struct_size = sizeof *s;
+    if (vxl_dicom_list_series(path, s, n, &n) == VXL_OK) {
+        printf("DICOM series: %u\n", n);
+        for (uint32_t i = 0; i < n; i++) {
+            printf("  [%u] %s  %s  %u x %u x %u", i, s[i].uid, s[i].modality[0] ? s[i].modality : "?", s[i].dims[0],
+                   s[i].dims[1], s[i].dims[2]);
+            if (s[i].frame_count > 1) printf(" x %u time points", s[i].frame_count);
+            if (s[i].description[0]) printf("  \"%s\"", s[i].description);
+            if (s[i].gantry_tilt_deg > 0) printf("  gantry tilt %.2f deg (sheared affine)", s[i].gantry_tilt_deg);
+            if (!s[i].loadable) printf("  NOT LOADABLE: %s", s[i].problem);
+            printf("\n");
+        }
+    }
+    free(s);
+    return n;
+}
+
 static int cmd_info(int argc, char **argv)
 {
     vxl_load_options lo = {.struct_size = sizeof lo};
     const char *input = NULL;
     for (int i = 0; i < argc; i++) {
-        if (!strcmp(argv[i], "--voxel-size")) {
-            if (voxel_size_option(i + 1 < argc ? argv[++i] : NULL, &lo)) return 1;
-        } else if (argv[i][0] == '-' && argv[i][1]) return die("unknown option '%s' (see voxlight --help)", argv[i]);
-        else if (!input) input = argv[i];
-        else return die("info takes one INPUT file (see voxlight --help)");
+        int r = parse_input_option(argc, argv, &i, &lo);
+        if (r < 0) return 1;
+        if (r) continue;
+        if (argv[i][0] == '-' && argv[i][1]) return die("unknown option '%s' (see voxlight --help)", argv[i]);
+        if (input) return die("info takes one INPUT (see voxlight --help)");
+        input = argv[i];
     }
-    if (!input) return die("info takes one INPUT file (see voxlight --help)");
+    if (!input) return die("info takes one INPUT (see voxlight --help)");
+    /* several series and none chosen: the listing is the answer */
+    uint32_t series = print_dicom_series(input);
+    if (series > 1 && !lo.series) {
+        printf("choose one with --series N|UID\n");
+        return 0;
+    }
     vxl_volume *v = NULL;
     if (vxl_volume_load(input, &lo, &v)) return die("%s", vxl_last_error());
     vxl_volume_info in = {.struct_size = sizeof in};
@@ -113,8 +169,10 @@ static int cmd_info(int argc, char **argv)
     const char *const src[] = {"none (spacing)", "qform", in.nifti_version ? "sform" : "from header"};
     printf("file:        %s\n", input);
     if (in.nifti_version) printf("format:      NIfTI-%u\n", in.nifti_version);
+    else if (series) printf("format:      DICOM (LPS converted to RAS)\n");
     else printf("format:      %s\n", strrchr(input, '.') ? strrchr(input, '.') + 1 : "image stack");
     printf("dimensions:  %u x %u x %u\n", in.dims[0], in.dims[1], in.dims[2]);
+    if (in.frame_count > 1) printf("frames:      %u (this is frame %u; --frame N)\n", in.frame_count, in.frame);
     printf("spacing:     %g x %g x %g mm\n", in.spacing[0], in.spacing[1], in.spacing[2]);
     printf("data type:   %s (stored as %u-bit %s)\n", dtype_name(in.dtype), in.texture_bits,
            in.texture_bits == 32 ? "float" : "normalised");
@@ -138,6 +196,7 @@ typedef struct render_args {
 static int parse_render(int argc, char **argv, render_args *a)
 {
     vxl_render_params *p = &a->p;
+    int r;
     for (int i = 0; i < argc; i++) {
         const char *o = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -215,9 +274,8 @@ static int parse_render(int argc, char **argv, render_args *a)
             NEED_VALUE();
             if (!parse_size(val, &a->ro.memory_budget_bytes)) return die("bad --memory-budget '%s': e.g. 2G or 512M", val);
             a->lo.memory_budget_bytes = a->ro.memory_budget_bytes;
-        } else if (!strcmp(o, "--voxel-size")) {
-            if (voxel_size_option(val, &a->lo)) return 1;
-            i++;
+        } else if ((r = parse_input_option(argc, argv, &i, &a->lo)) != 0) {
+            if (r < 0) return 1;
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);

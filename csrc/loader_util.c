@@ -338,3 +338,19 @@ void vxl_load_voxel_size(const vxl_load_options *opt, double out[3])
         if (isfinite(v) && v > 0) out[a] = v;
     }
 }
+
+/* The caller's struct reaches field end `need`: 0 means this header's size. */
+static int options_cover(const vxl_load_options *opt, size_t need)
+{
+    return opt && (opt->struct_size == 0 || opt->struct_size >= need);
+}
+
+uint32_t vxl_load_frame(const vxl_load_options *opt)
+{
+    return options_cover(opt, offsetof(vxl_load_options, frame) + sizeof opt->frame) ? opt->frame : 0;
+}
+
+const char *vxl_load_series(const vxl_load_options *opt)
+{
+    return options_cover(opt, offsetof(vxl_load_options, series) + sizeof opt->series) ? opt->series : NULL;
+}

@@ -72,4 +72,9 @@ int vxl_affine_from(const double dir[3][3], const double origin[3], double A[16]
  * each axis defaulting to 1 mm. */
 void vxl_load_voxel_size(const vxl_load_options *opt, double out[3]);
 
+/* vxl_load_options.frame and .series when struct_size covers them (0 and
+ * NULL otherwise). */
+uint32_t vxl_load_frame(const vxl_load_options *opt);
+const char *vxl_load_series(const vxl_load_options *opt);
+
 #endif

@@ -1,15 +1,16 @@
 /* nifti.c - NIfTI-1 / NIfTI-2 reader (.nii, .nii.gz, .hdr/.img[.gz]).
  *
- * Our own reader instead of libnifti: we need only the first 3D volume, want
+ * Our own reader instead of libnifti: we need one 3D volume at a time, want
  * every header field treated as hostile input, and want failures reported
  * through vxl_fail rather than printed. zlib's gz* functions read plain and
  * gzip files alike, so one code path serves both.
  *
  * Flow: find the header file -> read and parse the header into a
- * version-neutral struct -> validate it -> read the first volume's raw bytes
+ * version-neutral struct -> validate it -> read the chosen volume's raw bytes (frame option, 4D)
  * (from the same file at vox_offset, or from the paired .img) -> swap if the
  * file's byte order is foreign -> hand over to vxl_volume_build, which owns
  * scaling, NaN handling and normalisation. */
+#include "loader_util.h"
 #include "volume.h"
 
 #include <errno.h>
@@ -400,7 +401,7 @@ static uint32_t vxl_dtype_from_nifti(int code)
 }
 
 /* Checks dim[] and fills the 3D grid. Axes past dim[0] are absent (= 1);
- * axes 4..7 must still be positive even though only volume 0 is read. */
+ * axes 4..7 must still be positive (they count the volumes of a 4D file). */
 static int check_dims(const nii_header *h, uint32_t dims[3], const char *path, vxl_err *e)
 {
     int64_t nd = h->dim[0];
@@ -547,7 +548,7 @@ static int precheck_size(gzFile f, const char *path, uint64_t offset, uint64_t n
     return VXL_OK;
 }
 
-/* Reads the first volume's nbytes at offset into a new buffer. */
+/* Reads one volume's nbytes at offset into a new buffer. */
 static int read_voxels(gzFile f, const char *path, uint64_t offset, uint64_t nbytes, void **out,
                        vxl_err *e)
 {
@@ -666,6 +667,33 @@ static int plan_read(const nii_header *h, const char *path, const vxl_load_optio
     return VXL_OK;
 }
 
+/* 4D and beyond: every axis past the third counts volumes (fMRI time,
+ * cardiac phases, ...), stored one after another. Picks the requested one by
+ * moving *offset past the volumes before it, so opening frame N reads only
+ * frame N (a seek in .nii; zlib decompresses and discards in .nii.gz). */
+static int select_frame(const nii_header *h, const char *path, const vxl_load_options *opt, uint64_t nbytes,
+                        uint64_t *offset, uint32_t *count, uint32_t *frame, vxl_err *e)
+{
+    uint64_t n = 1;
+    for (int a = 4; a <= h->dim[0] && a <= 7; a++) {
+        if ((uint64_t)h->dim[a] > UINT32_MAX / n)
+            return vxl_fail(e, VXL_ERR_LIMIT, "'%s': dim[4..7] give more than %u volumes", path, UINT32_MAX);
+        n *= (uint64_t)h->dim[a];
+    }
+    *count = (uint32_t)n;
+    *frame = vxl_load_frame(opt);
+    if (*frame >= n)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %u requested, the file has %u (0..%u)", path,
+                        *frame, *count, *count - 1);
+    /* frame < 2^32 and nbytes is within the memory budget: no overflow
+     * short of a 2^64-byte file, which the size check then reports */
+    uint64_t skip = (uint64_t)*frame * nbytes;
+    if (skip > (uint64_t)INT64_MAX - *offset)
+        return vxl_fail(e, VXL_ERR_LIMIT, "'%s': frame %u lies beyond any possible file size", path, *frame);
+    *offset += skip;
+    return VXL_OK;
+}
+
 /* NIfTI: slope 0 or non-finite means "no scaling"; a non-finite intercept
  * with a usable slope is treated as 0 rather than poisoning every value. */
 static void scaling_from(const nii_header *h, double *slope, double *inter)
@@ -691,10 +719,11 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     memset(&h, 0, sizeof h);
     gzFile data = NULL;
     const char *data_path = NULL;
-    uint32_t dims[3], dtype = 0;
+    uint32_t dims[3], dtype = 0, frame_count = 1, frame = 0;
     uint64_t offset = 0, nbytes = 0;
     int rc = open_files(&L, &h, &data, &data_path, e);
     if (!rc) rc = plan_read(&h, L.hdr_path, opt, dims, &dtype, &offset, &nbytes, e);
+    if (!rc) rc = select_frame(&h, L.hdr_path, opt, nbytes, &offset, &frame_count, &frame, e);
     if (!rc) rc = read_voxels(data, data_path, offset, nbytes, &L.raw, e);
     if (rc) {
         load_cleanup(&L);
@@ -718,6 +747,8 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     else {
         (*out)->nifti_version = (uint32_t)h.version;
         (*out)->affine_source = source;
+        (*out)->frame_count = frame_count;
+        (*out)->frame = frame;
     }
     load_cleanup(&L);
     return rc;

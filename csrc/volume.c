@@ -4,6 +4,7 @@
 #include "volume.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -190,7 +191,8 @@ typedef int (*vxl_loader_fn)(const char *path, const vxl_load_options *opt, vxl_
 static vxl_loader_fn vxl_loader_for(const char *path)
 {
     struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) return vxl_image_stack_load;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return vxl_dicom_path_is_dicom(path, 1) ? vxl_dicom_load : vxl_image_stack_load;
     static const struct { const char *ext; vxl_loader_fn fn; } by_ext[] = {
         {".nii", vxl_nifti_load}, {".nii.gz", vxl_nifti_load}, {".hdr", vxl_nifti_load},
         {".img", vxl_nifti_load}, {".hdr.gz", vxl_nifti_load}, {".img.gz", vxl_nifti_load},
@@ -198,6 +200,7 @@ static vxl_loader_fn vxl_loader_for(const char *path)
         {".mha", vxl_metaimage_load}, {".mhd", vxl_metaimage_load},
         {".tif", vxl_image_stack_load}, {".tiff", vxl_image_stack_load}, {".png", vxl_image_stack_load},
         {".vdb", vxl_vdb_load},
+        {".dcm", vxl_dicom_load}, {".dicom", vxl_dicom_load}, {"DICOMDIR", vxl_dicom_load},
     };
     for (size_t i = 0; i < sizeof by_ext / sizeof by_ext[0]; i++)
         if (has_suffix(path, by_ext[i].ext)) return by_ext[i].fn;
@@ -213,6 +216,7 @@ static vxl_loader_fn vxl_loader_for(const char *path)
         if (n >= 5 && (!strncasecmp((const char *)m, "ObjectType", 10) || !strncasecmp((const char *)m, "NDims", 5)))
             return vxl_metaimage_load;
     }
+    if (vxl_dicom_path_is_dicom(path, 0)) return vxl_dicom_load; /* "DICM" after the 128-byte preamble */
     return vxl_nifti_load;
 }
 
@@ -224,11 +228,16 @@ int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **
     return vxl_loader_for(path)(path, opt, out, NULL);
 }
 
-int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *o)
+int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
 {
-    if (!v || !o) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "volume or info is NULL");
+    if (!v || !out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "volume or info is NULL");
+    /* Filled locally and copied up to the caller's struct_size, so a caller
+     * built against an older, shorter struct is not overrun. */
+    const size_t v1 = offsetof(vxl_volume_info, frame_count), s = out->struct_size;
+    size_t have = s >= v1 && s < sizeof *out ? s : sizeof *out;
+    vxl_volume_info info, *o = &info;
     memset(o, 0, sizeof *o);
-    o->struct_size = sizeof *o;
+    o->struct_size = (uint32_t)have;
     o->dtype = v->src_dtype;
     memcpy(o->dims, v->dims, sizeof o->dims);
     o->nifti_version = v->nifti_version;
@@ -241,6 +250,9 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *o)
     o->storage_bytes = v->storage_bytes;
     o->texture_bits = v->texture_bits;
     o->affine_source = v->affine_source;
+    o->frame_count = v->frame_count ? v->frame_count : 1;
+    o->frame = v->frame;
+    memcpy(out, o, have);
     return VXL_OK;
 }
 

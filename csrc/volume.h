@@ -25,6 +25,8 @@ struct vxl_volume {
     uint64_t nan_count, inf_count;
     double spacing[3];
     double affine[16];      /* column-major voxel -> world */
+    uint32_t frame_count;   /* volumes in the 4D input (0 is read as 1) */
+    uint32_t frame;         /* the one this is */
 };
 
 /* Checks dims against max_dim and the budget before anything is allocated.
@@ -58,5 +60,10 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
 int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 /* OpenVDB scalar grid through OpenImageIO's OpenVDB reader; in vdb.cpp. */
 int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* DICOM through dcmtk: a folder, a DICOMDIR or one file of a series; in
+ * dicom.cpp. vxl_dicom_path_is_dicom says whether a folder holds DICOM
+ * (a DICOMDIR, or "DICM" files) or a file is DICOM, for the dispatch. */
+int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+int vxl_dicom_path_is_dicom(const char *path, int is_dir);
 
 #endif

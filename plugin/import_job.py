@@ -41,10 +41,11 @@ class ImportJob:
     then `entry` (an unregistered runtime.VolumeEntry) or `error` (the
     library's message, which names the file) is set."""
 
-    def __init__(self, path, backend="auto", voxel_size=None, start=True):
+    def __init__(self, path, backend="auto", voxel_size=None, start=True, series=""):
         self.path = path
         self.backend = backend
         self.voxel_size = voxel_size
+        self.series = series
         self.progress = 0.0
         self.entry = None
         self.error = None
@@ -71,7 +72,7 @@ class ImportJob:
         """The work; called on the thread, or directly for a blocking import."""
         try:
             entry = runtime.open_volume(self.path, self.backend, self._set_progress, self.voxel_size,
-                                        cancelled=self._cancelled.is_set)
+                                        cancelled=self._cancelled.is_set, series=self.series)
         except (native.VoxlightError, OSError) as e:
             self.error = str(e)
             entry = None

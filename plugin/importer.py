@@ -49,6 +49,7 @@ def fill_volume_properties(obj, path, info, v2l, unit_scale):
     p.window_high = info["value_max"]
     if "histogram" in info:
         p.histogram = [int(min(c, 2**31 - 1)) for c in info["histogram"]]
+    p.frame_count = info.get("frame_count", 1)
 
 
 class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
@@ -75,6 +76,11 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
                                     min=1e-6, soft_min=0.001, soft_max=100.0, precision=4,
                                     description="x, y, z voxel size for inputs without geometry "
                                                 "(TIFF/PNG stacks); files with geometry ignore it")
+    # DICOM folders with several series: which one (index or UID, as
+    # native.list_dicom_series / `voxlight info` list them); "" = the only one.
+    series: StringProperty(name="DICOM Series", default="",
+                           description="Series of a DICOM folder to import: index or "
+                                       "SeriesInstanceUID (empty = the only series)")
     # Set by invoke: the file browser path runs modal, scripts block.
     use_modal: BoolProperty(default=False, options={"HIDDEN", "SKIP_SAVE"})
 
@@ -86,13 +92,13 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         path = resolve_path(self.filepath, self.directory)
         backend = context.scene.voxlight.backend
         if self.use_modal and context.window is not None:
-            self._job = import_job.ImportJob(path, backend, tuple(self.voxel_size))
+            self._job = import_job.ImportJob(path, backend, tuple(self.voxel_size), series=self.series)
             wm = context.window_manager
             wm.progress_begin(0.0, 1.0)
             self._timer = wm.event_timer_add(0.1, window=context.window)
             wm.modal_handler_add(self)
             return {"RUNNING_MODAL"}
-        job = import_job.ImportJob(path, backend, tuple(self.voxel_size), start=False)
+        job = import_job.ImportJob(path, backend, tuple(self.voxel_size), start=False, series=self.series)
         job.run()
         return self._finish(context, job)
 
@@ -160,6 +166,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             # (shear) stays in voxel_to_local so the render remains exact.
             v2l = volume_space.voxel_to_local(s_from_v, np.array(obj.matrix_world))
             fill_volume_properties(obj, path, info, v2l, unit_scale)
+            obj.voxlight.series = self.series
             context.collection.objects.link(obj)
             tf.ensure_texture(obj)  # grey ramp until a preset or the user edits it
         except Exception:

@@ -57,7 +57,23 @@ class LoadOptions(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("max_dim", ctypes.c_uint32),
                 ("memory_budget_bytes", ctypes.c_uint64),
-                ("voxel_size", ctypes.c_double * 3)]
+                ("voxel_size", ctypes.c_double * 3),
+                ("frame", ctypes.c_uint32),      # 4D inputs: which volume
+                ("reserved0", ctypes.c_uint32),
+                ("series", ctypes.c_char_p)]     # DICOM: index or SeriesInstanceUID
+
+
+class DicomSeries(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("slice_count", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("loadable", ctypes.c_uint32),
+                ("frame_count", ctypes.c_uint32),
+                ("gantry_tilt_deg", ctypes.c_double),
+                ("uid", ctypes.c_char * 72),
+                ("modality", ctypes.c_char * 20),
+                ("description", ctypes.c_char * 72),
+                ("problem", ctypes.c_char * 256)]
 
 
 class VolumeDesc(ctypes.Structure):
@@ -85,7 +101,9 @@ class VolumeInfo(ctypes.Structure):
                 ("inf_count", ctypes.c_uint64),
                 ("storage_bytes", ctypes.c_uint64),
                 ("texture_bits", ctypes.c_uint32),
-                ("affine_source", ctypes.c_uint32)]
+                ("affine_source", ctypes.c_uint32),
+                ("frame_count", ctypes.c_uint32),
+                ("frame", ctypes.c_uint32)]
 
 
 class RendererOptions(ctypes.Structure):
@@ -228,6 +246,8 @@ def _declare(lib):
         "vxl_volume_histogram": (ctypes.c_int, [vp, ctypes.c_uint32, ctypes.c_double,
                                                 ctypes.c_double, P(ctypes.c_uint64)]),
         "vxl_volume_destroy": (None, [vp]),
+        "vxl_dicom_list_series": (ctypes.c_int, [ctypes.c_char_p, P(DicomSeries), ctypes.c_uint32,
+                                                 P(ctypes.c_uint32)]),
         "vxl_renderer_create": (ctypes.c_int, [P(RendererOptions), P(vp)]),
         "vxl_renderer_destroy": (None, [vp]),
         "vxl_renderer_error": (ctypes.c_char_p, [vp]),
@@ -419,15 +439,21 @@ class Volume:
         self.info = self._read_info()
 
     @classmethod
-    def load(cls, path, max_dim=0, memory_budget=0, voxel_size=None, lib=None):
+    def load(cls, path, max_dim=0, memory_budget=0, voxel_size=None, lib=None, frame=0, series=None):
         """voxel_size (x, y, z) mm is for inputs without geometry (TIFF/PNG
-        stacks); None or 0 = 1 mm. Files with geometry ignore it."""
+        stacks); None or 0 = 1 mm. Files with geometry ignore it.
+        frame: the volume of a 4D file (only it is read); series: for a
+        DICOM folder of several series, an index (int or its string) or a
+        SeriesInstanceUID, as list_dicom_series() gives them."""
         lib = lib or load_library()
         opt = _sized(LoadOptions)
         opt.max_dim = max_dim
         opt.memory_budget_bytes = memory_budget
         if voxel_size is not None:
             opt.voxel_size[:] = [float(x) for x in voxel_size]
+        opt.frame = int(frame)
+        if series is not None and str(series) != "":
+            opt.series = str(series).encode()
         h = ctypes.c_void_p()
         # The library's message already names the file.
         lib.check(lib.cdll.vxl_volume_load(os.fsencode(path), ctypes.byref(opt), ctypes.byref(h)))
@@ -482,6 +508,8 @@ class Volume:
             "texture_bits": info.texture_bits,
             "affine_source": ("none", "qform", "sform")[info.affine_source]
             if info.affine_source < 3 else str(info.affine_source),
+            "frame_count": max(1, info.frame_count),
+            "frame": info.frame,
         }
 
     def histogram(self, bins=32, lo=None, hi=None):
@@ -518,6 +546,26 @@ class Volume:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def list_dicom_series(path, lib=None):
+    """The series of a DICOM folder, DICOMDIR or file (its folder) as dicts
+    (uid, modality, description, slice_count, dims, loadable, problem,
+    gantry_tilt_deg, frame_count), in the order whose index Volume.load(series=) takes.
+    [] for inputs that are not DICOM."""
+    lib = lib or load_library()
+    n = ctypes.c_uint32()
+    if lib.cdll.vxl_dicom_list_series(os.fsencode(path), None, 0, ctypes.byref(n)) != 0:
+        return []
+    arr = (DicomSeries * max(1, n.value))()
+    arr[0].struct_size = ctypes.sizeof(DicomSeries)
+    lib.check(lib.cdll.vxl_dicom_list_series(os.fsencode(path), arr, n.value, ctypes.byref(n)))
+    text = lambda b: b.decode("utf-8", "replace")  # noqa: E731
+    return [{"uid": text(s.uid), "modality": text(s.modality), "description": text(s.description),
+             "slice_count": s.slice_count, "dims": tuple(s.dims), "loadable": bool(s.loadable),
+             "problem": text(s.problem), "gantry_tilt_deg": s.gantry_tilt_deg,
+             "frame_count": s.frame_count}
+            for s in arr[:n.value]]
 
 
 def voxel_box_corners(dims):

@@ -18,7 +18,8 @@ class VOXLIGHT_OT_reload_volume(bpy.types.Operator):
     def execute(self, context):
         p = context.object.voxlight
         try:
-            runtime.load_volume(bpy.path.abspath(p.filepath), backend=context.scene.voxlight.backend)
+            runtime.load_volume(bpy.path.abspath(p.filepath), backend=context.scene.voxlight.backend,
+                                series=p.series)
         except native.VoxlightError as e:
             self.report({"ERROR"}, "Voxlight: %s" % e)
             return {"CANCELLED"}

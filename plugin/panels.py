@@ -37,7 +37,7 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = True  # keyframe dots: everything is animatable
         if _draw_library_status(layout):
-            err = runtime.last_failure(bpy.path.abspath(p.filepath))
+            err = runtime.last_failure(bpy.path.abspath(p.filepath), p.series)
             if err:
                 box = layout.box()
                 box.alert = True
@@ -47,6 +47,13 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
         col = layout.column(align=True)
         col.label(text="%d x %d x %d voxels, data range %.4g .. %.4g"
                   % (*p.dims, p.data_min, p.data_max))
+        if p.series:
+            col.label(text="DICOM series %s" % p.series)
+        if p.frame_count > 1:  # 4D: which volume frame the scene frame shows
+            col = layout.column(align=True)
+            col.label(text="%d volume frames" % p.frame_count)
+            col.prop(p, "frame_mode")
+            col.prop(p, "frame_offset" if p.frame_mode == "TIMELINE" else "fixed_frame")
 
         layout.separator()
         col = layout.column()
@@ -110,7 +117,7 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
         sub.prop(p, "specular", slider=True)
         sub.prop(p, "shininess")
 
-        entry = runtime.find_entry(bpy.path.abspath(p.filepath))
+        entry = runtime.find_entry(bpy.path.abspath(p.filepath), p.series)
         frame = entry.last_frame if entry is not None else None
         if frame:
             layout.separator()

@@ -4,7 +4,7 @@
 
 import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
-                       IntVectorProperty, PointerProperty, StringProperty)
+                       IntProperty, IntVectorProperty, PointerProperty, StringProperty)
 
 from . import native
 
@@ -81,6 +81,20 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     histogram: IntVectorProperty(name="Histogram", size=32, options=set(),
                                  description="Voxel counts in 32 bins over the data range "
                                              "(computed at import)")
+    # --- DICOM series and 4D time series (frames.py maps scene frames to volume frames)
+    series: StringProperty(name="DICOM Series", options=set(), update=tag_redraw,
+                           description="Series of a DICOM folder: index or SeriesInstanceUID "
+                                       "(empty = the only one)")
+    frame_count: IntProperty(name="Volume Frames", default=1, min=1, options=set(),
+                             description="Volumes in the file (4D: fMRI, cardiac phases)")
+    frame_mode: EnumProperty(name="Frame", default="TIMELINE", update=tag_redraw,
+                             items=[("TIMELINE", "Follow Timeline",
+                                     "Scene frame Start Frame + n shows volume frame n", 0),
+                                    ("FIXED", "Fixed", "Always show Volume Frame", 1)])
+    frame_offset: IntProperty(name="Start Frame", default=1, update=tag_redraw,
+                              description="Scene frame that shows volume frame 0")
+    fixed_frame: IntProperty(name="Volume Frame", default=0, min=0, update=tag_redraw,
+                             description="Volume frame shown in Fixed mode (0-based)")
 
     # --- gradients
     filter: EnumProperty(name="Gradient Filter", items=FILTER_ITEMS, default="central",

@@ -19,7 +19,7 @@ import os
 import threading
 import time
 
-from . import native
+from . import frames, native
 
 _lock = threading.Lock()
 render_count = 0
@@ -158,12 +158,20 @@ class Worker:
             self._thread.join()
 
 
+# Frames of 4D volumes, shared by every entry (frames.py).
+frame_cache = frames.FrameCache()
+
+
 class VolumeEntry:
-    def __init__(self, path, renderer, info):
+    def __init__(self, path, renderer, info, series=""):
         self.path = path
+        self.series = series     # DICOM: the chosen series ("" = the only one)
         self.renderer = renderer
         self.info = info
         self.mtime = _mtime(path)
+        self.frame = info.get("frame", 0)            # the volume frame on the GL side
+        self.pending_frame = None  # 4D: the loaded frame, cached by adopt()
+        self.frame_count = info.get("frame_count", 1)
         self.last_frame = None   # stats of the last frame rendered (panel)
         self._worker = None
         renderer.on_render = _count_call
@@ -171,7 +179,23 @@ class VolumeEntry:
     @property
     def identity(self):
         """Part of every frame key: which data this renderer holds."""
-        return (self.path, self.mtime, id(self))
+        return (self.path, self.series, self.mtime, id(self), self.frame)
+
+    def _frame_key(self, frame):
+        return (self.path, self.series, self.mtime, frame)
+
+    def show_frame(self, frame):
+        """Puts volume frame `frame` (clamped to the series) on the GL side
+        unless it is already there; the frame comes from frame_cache, read
+        from the file on a miss. Returns True when the data changed."""
+        frame = min(max(int(frame), 0), self.frame_count - 1)
+        if frame == self.frame:
+            return False
+        vol = frame_cache.get(self._frame_key(frame),
+                              lambda: native.Volume.load(self.path, frame=frame, series=self.series or None))
+        self.renderer.set_volume(vol)
+        self.frame = frame
+        return True
 
     @property
     def worker(self):
@@ -186,11 +210,14 @@ class VolumeEntry:
         if self._worker is not None:
             self._worker.close()
             self._worker = None
+        if self.pending_frame is not None:  # opened but never adopted
+            self.pending_frame.close()
+            self.pending_frame = None
         self.renderer.close()
 
 
-_entries = {}   # absolute path -> VolumeEntry
-_failures = {}  # absolute path -> (mtime, message): do not retry a broken file every redraw
+_entries = {}   # (absolute path, DICOM series) -> VolumeEntry
+_failures = {}  # (absolute path, series) -> (mtime, message): do not retry a broken file every redraw
 
 
 def _mtime(path):
@@ -200,19 +227,22 @@ def _mtime(path):
         return None
 
 
-def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=None):
-    """Load `path` into a fresh renderer that is not registered yet (safe on
-    a worker thread: it touches no shared state). Raises native.VoxlightError.
+def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=None, series="", frame=0):
+    """Load `path` (frame `frame` of a 4D file; series `series` of a DICOM
+    folder) into a fresh renderer that is not registered yet (safe on a
+    worker thread: it touches no shared state). Raises native.VoxlightError.
     progress(fraction) is called between the slow steps; cancelled() is asked
     between them too, and when it says yes everything made so far is closed
     and None returned. voxel_size (mm) is for inputs without geometry; it only
     changes info["affine"], which the importer bakes into the object, so later
     reloads need not repeat it."""
     path = os.path.abspath(path)
+    series = series or ""
     stop = cancelled or (lambda: False)
     lib = native.load_library()
-    vol = native.Volume.load(path, voxel_size=voxel_size, lib=lib)
-    renderer = None
+    vol = native.Volume.load(path, voxel_size=voxel_size, lib=lib, frame=frame, series=series or None)
+    keep = vol.info["frame_count"] > 1  # 4D: adopt() puts the frame shown into the cache
+    renderer = entry = None
     try:
         if stop():
             return None
@@ -227,9 +257,12 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
         info = dict(vol.info, histogram=vol.histogram(32))  # for the panel, from any format
         if stop():
             return None
-        entry, renderer = VolumeEntry(path, renderer, info), None
+        entry, renderer = VolumeEntry(path, renderer, info, series), None
+        if keep:
+            entry.pending_frame = vol
     finally:
-        vol.close()  # the renderer holds its own copy on the GL side
+        if entry is None or not keep:
+            vol.close()  # the renderer holds its own copy on the GL side
         if renderer is not None:  # failed or cancelled before the entry took it
             renderer.close()
     if progress:
@@ -238,45 +271,62 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
 
 
 def adopt(entry):
-    """Registers an entry from open_volume as the live one for its path."""
-    old = _entries.pop(entry.path, None)
+    """Registers an entry from open_volume as the live one for its path and
+    series; a 4D entry's first frame goes into the shared frame cache."""
+    key = (entry.path, entry.series)
+    frame_cache.drop(lambda k: k[0] == entry.path and k[1] == entry.series)  # a reload rereads
+    vol, entry.pending_frame = entry.pending_frame, None
+    if vol is not None:
+        frame_cache.get(entry._frame_key(entry.frame), lambda: vol)
+    old = _entries.pop(key, None)
     if old is not None and old is not entry:
         old.close()
-    _entries[entry.path] = entry
-    _failures.pop(entry.path, None)
+    _entries[key] = entry
+    _failures.pop(key, None)
     return entry
 
 
-def load_volume(path, backend="auto", progress=None, voxel_size=None):
+def load_volume(path, backend="auto", progress=None, voxel_size=None, series="", frame=0):
     """open_volume + adopt: load `path` and make it the live entry."""
-    return adopt(open_volume(path, backend, progress, voxel_size))
+    return adopt(open_volume(path, backend, progress, voxel_size, series=series, frame=frame))
 
 
-def get_entry(path, backend="auto"):
-    """The live entry for `path`, loading it on first use or when the file
-    changed on disk. Raises native.VoxlightError (remembered per mtime)."""
+def get_entry(path, backend="auto", series=""):
+    """The live entry for `path` (and DICOM series), loading it on first use
+    or when the file changed on disk. Raises native.VoxlightError
+    (remembered per mtime)."""
     path = os.path.abspath(path)
-    entry = _entries.get(path)
+    key = (path, series or "")
+    entry = _entries.get(key)
     mtime = _mtime(path)
     if entry is not None and entry.mtime == mtime:
         return entry
-    failed = _failures.get(path)
+    failed = _failures.get(key)
     if failed is not None and failed[0] == mtime:
         raise native.VoxlightError(failed[1])
     try:
-        return load_volume(path, backend)
+        return load_volume(path, backend, series=series)
     except native.VoxlightError as e:
-        _failures[path] = (mtime, str(e))
+        _failures[key] = (mtime, str(e))
         raise
 
 
-def find_entry(path):
-    """The live entry for `path` or None; never loads."""
-    return _entries.get(os.path.abspath(path))
+def entry_for(path, props, scene_frame, backend="auto"):
+    """The entry of a volume object (props: Object.voxlight, read by name so
+    no bpy is needed) showing the volume frame that `scene_frame` maps to."""
+    entry = get_entry(path, backend, props.series)
+    entry.show_frame(frames.volume_frame(scene_frame, entry.frame_count, props.frame_mode,
+                                         props.frame_offset, props.fixed_frame))
+    return entry
 
 
-def last_failure(path):
-    f = _failures.get(os.path.abspath(path))
+def find_entry(path, series=""):
+    """The live entry for `path` (and series) or None; never loads."""
+    return _entries.get((os.path.abspath(path), series or ""))
+
+
+def last_failure(path, series=""):
+    f = _failures.get((os.path.abspath(path), series or ""))
     return f[1] if f else ""
 
 
@@ -311,6 +361,7 @@ def release_all():
         entry.close()
     _entries.clear()
     _failures.clear()
+    frame_cache.clear()
 
 
 atexit.register(release_all)

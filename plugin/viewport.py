@@ -326,7 +326,8 @@ def _draw():
             moving = (now - st.moved_at) < s.settle_time
             moving_any |= moving
             try:
-                entry = runtime.get_entry(bpy.path.abspath(ob.voxlight.filepath), s.backend)
+                entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
+                                          scene.frame_current, s.backend)
             except native.VoxlightError as e:
                 _report(e)
                 continue

@@ -17,6 +17,7 @@
 
 #include "fuzz/writers.h"
 #include "harness.h"
+#include "loader_test_util.h"
 #include "volume.h"
 #include "voxlight.h"
 
@@ -26,34 +27,6 @@ static const char *tmp(char *buf, size_t n, const char *name)
 {
     snprintf(buf, n, "%s/%s", g_dir, name);
     return buf;
-}
-
-static void remove_tree(const char *path)
-{
-    DIR *d = opendir(path);
-    if (d) {
-        struct dirent *ent;
-        char p[1024];
-        while ((ent = readdir(d)) != NULL) {
-            if (!strcmp(ent->d_name, ".") || !strcmp(ent->d_name, "..")) continue;
-            snprintf(p, sizeof p, "%s/%s", path, ent->d_name);
-            remove_tree(p);
-        }
-        closedir(d);
-        rmdir(path);
-    } else {
-        unlink(path);
-    }
-}
-
-/* Data value of voxel i, reconstructed from the stored texel. */
-static double voxel(const vxl_volume *v, uint64_t i)
-{
-    double t;
-    if (v->texture_bits == 8) t = ((const uint8_t *)v->texels)[i] / 255.0;
-    else if (v->texture_bits == 16) t = ((const uint16_t *)v->texels)[i] / 65535.0;
-    else t = ((const float *)v->texels)[i];
-    return v->tex_lo + t * (v->tex_hi - v->tex_lo);
 }
 
 static int near(double a, double b, double tol) { return fabs(a - b) <= tol * (1.0 + fabs(b)); }
@@ -717,7 +690,8 @@ static void replay_dir(vxl_test_ctx *T_, const char *dir)
         const char *fmt = strrchr(dir, '/');
         fmt = fmt ? fmt + 1 : dir;
         static const char *const ext[][2] = {
-            {"nifti", "nii"}, {"nrrd", "nrrd"}, {"metaimage", "mha"}, {"tiff", "tif"}, {"png", "png"}};
+            {"nifti", "nii"}, {"nrrd", "nrrd"}, {"metaimage", "mha"}, {"tiff", "tif"}, {"png", "png"},
+            {"dicom", "dcm"}};
         const char *x = fmt;
         for (size_t i = 0; i < sizeof ext / sizeof ext[0]; i++)
             if (!strcmp(fmt, ext[i][0])) x = ext[i][1];

@@ -811,14 +811,14 @@ TEST(absurd_sizes_are_limit_errors_before_allocation)
     EXPECT_FAIL("huge64.hdr", &h, g_zeros, 64, NULL, VXL_ERR_LIMIT, "budget");
 
     /* caller's options */
-    vxl_load_options opt = {sizeof opt, 0, 1000, {0, 0, 0}};
+    vxl_load_options opt = {.struct_size = sizeof opt, .max_dim = 0, .memory_budget_bytes = 1000};
     tnw_init(&h, 1, 16, 16, 16, 16);
     EXPECT_FAIL("budget.nii", &h, g_zeros, 64, &opt, VXL_ERR_LIMIT, "budget");
-    vxl_load_options opt2 = {sizeof opt2, 8, 0, {0, 0, 0}};
+    vxl_load_options opt2 = {.struct_size = sizeof opt2, .max_dim = 8, .memory_budget_bytes = 0};
     EXPECT_FAIL("maxdim.nii", &h, g_zeros, 64, &opt2, VXL_ERR_LIMIT, "limit");
 
     /* exactly at the budget: loads (16^3 u8 = 4096 bytes) */
-    vxl_load_options opt3 = {sizeof opt3, 16, 4096, {0, 0, 0}};
+    vxl_load_options opt3 = {.struct_size = sizeof opt3, .max_dim = 16, .memory_budget_bytes = 4096};
     tnw_init(&h, 1, 2, 16, 16, 16);
     vxl_volume *v = NULL;
     CHECKF(write_and_load("at_budget.nii", &h, g_zeros, 4096, &opt3, &v) == VXL_OK, "%s", vxl_last_error());
@@ -865,7 +865,7 @@ TEST(random_header_damage_never_crashes)
     uint32_t seed = 12345u;
 #define RND() (seed = seed * 1664525u + 1013904223u, seed >> 8)
     static const unsigned char interesting[] = {0x00, 0xff, 0x80, 0x7f, 0x01, 0xfe};
-    vxl_load_options opt = {sizeof opt, 0, 16u << 20, {0, 0, 0}};
+    vxl_load_options opt = {.struct_size = sizeof opt, .max_dim = 0, .memory_budget_bytes = 16u << 20};
     int ok = 0, failed = 0;
     for (int iter = 0; iter < 3000; iter++) {
         int version = 1 + (iter & 1);

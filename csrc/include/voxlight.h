@@ -113,6 +113,15 @@ typedef struct vxl_load_options {
      * covers it (0 = all of this header's struct). */
     double voxel_size[3];         /* x, y, z in mm for inputs without geometry
                                      (TIFF/PNG stacks); 0 = 1 mm */
+    /* 4D inputs (NIfTI dim[4..7] > 1): which volume to read, 0 = the first.
+     * Only that volume is read (seek in .nii, stream through .nii.gz);
+     * vxl_volume_info.frame_count says how many there are. */
+    uint32_t frame;
+    uint32_t reserved0;
+    /* DICOM folders holding several series: the SeriesInstanceUID, or the
+     * 0-based index in vxl_dicom_list_series order, as a string. NULL or ""
+     * = the only series (an error listing them when there are several). */
+    const char *series;
 } vxl_load_options;
 
 /* A volume handed over from memory (e.g. a numpy array). Data is x fastest:
@@ -143,6 +152,9 @@ typedef struct vxl_volume_info {
     uint64_t storage_bytes;     /* bytes of voxel storage (texture) */
     uint32_t texture_bits;      /* 8, 16 (normalised) or 32 (float) */
     uint32_t affine_source;     /* 0 none (spacing), 1 qform, 2 sform */
+    /* Appended: written only when the caller's struct_size covers them. */
+    uint32_t frame_count;       /* volumes in a 4D input; 1 for 3D */
+    uint32_t frame;             /* which of them this volume is */
 } vxl_volume_info;
 
 VXL_API int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **out);
@@ -155,6 +167,30 @@ VXL_API int vxl_volume_get_info(const vxl_volume *vol, vxl_volume_info *out);
 VXL_API int vxl_volume_histogram(const vxl_volume *vol, uint32_t bins, double lo, double hi,
                                  uint64_t *counts);
 VXL_API void vxl_volume_destroy(vxl_volume *vol);
+
+/* ---------------------------------------------------------------- DICOM */
+
+/* One series of a DICOM folder (vxl_volume_load takes a folder, a DICOMDIR
+ * or one file of the series; see vxl_load_options.series). */
+typedef struct vxl_dicom_series {
+    uint32_t struct_size;
+    uint32_t slice_count;       /* files (single-frame images) in the series */
+    uint32_t dims[3];           /* columns, rows, positions (the first file's size) */
+    uint32_t loadable;          /* 1: passes every check made before pixels are read */
+    uint32_t frame_count;       /* time points (4D: as many files at every position) */
+    double gantry_tilt_deg;     /* angle between the slice normal and the stacking
+                                   direction; loads with a sheared affine */
+    char uid[72];               /* SeriesInstanceUID */
+    char modality[20];
+    char description[72];       /* SeriesDescription */
+    char problem[256];          /* why it does not load; "" when loadable */
+} vxl_dicom_series;
+
+/* Lists the series under path (folder, DICOMDIR or one file: its folder),
+ * sorted by UID. Up to max entries go to out (stride out[0].struct_size, 0 =
+ * sizeof); *count receives how many series there are. out may be NULL with
+ * max 0 to count. */
+VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint32_t max, uint32_t *count);
 
 /* -------------------------------------------------------------- renderer */
 

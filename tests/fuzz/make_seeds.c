@@ -1,7 +1,7 @@
 /* make_seeds.c - writes the seed corpus for the fuzz targets: small valid
  * files of every format and the main variants (types, byte orders,
  * compression, geometry, pages, channels).
- *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png}/seed_*
+ *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png,dicom}/seed_*
  * Built and run by `make fuzz-seeds` (./build.sh test / fuzz). */
 #include <stdint.h>
 #include <stdio.h>
@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "fuzz/dicom_writer.h"
 #include "fuzz/writers.h"
 #include "nifti_writer.h"
 
@@ -111,6 +112,29 @@ int main(int argc, char **argv)
     ok(tw_write_png(path("png", "seed_gray16.png"), 4, 3, 1, 16, u16), "png gray16");
     ok(tw_write_png(path("png", "seed_rgb8.png"), 4, 2, 3, 8, u8), "png rgb8");
     ok(tw_write_png(path("png", "seed_ga8.png"), 4, 3, 2, 8, u8), "png grey+alpha");
+    /* DICOM: one slice each (the target loads the file's own series):
+     * 16-bit with CT rescale, signed 12-of-16 bits oblique, 8-bit, and the
+     * refused variants (JPEG syntax, multi-frame) so their paths are fuzzed */
+    dcmw_slice d = dcmw_axial("1.2.826.0.1.3680043.9.7777.2", 4, 3, -20, i16, sizeof i16);
+    d.has_rescale = 1;
+    d.slope = 1;
+    d.inter = -1024;
+    d.description = "seed";
+    ok(dcmw_write(path("dicom", "seed_ct16.dcm"), &d), "dicom ct16");
+    d.pixel_rep = 1;
+    d.bits_stored = 12;
+    const double oblique[6] = {0.8, 0.6, 0, 0, 0, -1};
+    memcpy(d.iop, oblique, sizeof oblique);
+    ok(dcmw_write(path("dicom", "seed_signed12_oblique.dcm"), &d), "dicom signed12");
+    d = dcmw_axial("1.2.3", 4, 3, 0, u8, 12);
+    d.bits_alloc = 8;
+    d.modality = "MR";
+    ok(dcmw_write(path("dicom", "seed_u8.dcm"), &d), "dicom u8");
+    d.transfer_syntax = DCMW_JPEG_BASELINE;
+    ok(dcmw_write(path("dicom", "seed_jpeg.dcm"), &d), "dicom jpeg");
+    d = dcmw_axial("1.2.4", 4, 3, 0, i16, sizeof i16);
+    d.frames = 2;
+    ok(dcmw_write(path("dicom", "seed_multiframe.dcm"), &d), "dicom multiframe");
     free(i16_be);
     return failures ? 1 : 0;
 }

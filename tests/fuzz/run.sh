@@ -14,7 +14,7 @@ targets=("$@")
 # vdb is not in the default list: OpenVDB (read by OpenImageIO when it opens
 # the file, before Voxlight sees a byte) aborts on an assertion within a few
 # dozen mutations (tests/fuzz/upstream/); run it by name: run.sh 60 vdb.
-[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png)
+[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom)
 
 if ! make -s -j"$(nproc)" fuzz; then
     echo "fuzz: build failed"

@@ -12,7 +12,8 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
     "#define FILTER_CUBIC 1\n"};
 
 /* flags bits for RAYCAST: 1 shading, 2 reuse gradients, bits 2-3 the
- * classify mode, bits 4-5 the gradient-opacity mode; for GRAD_STORE: the store format */
+ * classify mode, bits 4-5 the gradient-opacity mode, bit 6 (also PROBE)
+ * bricked storage; for GRAD_STORE: the store format */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
 
 static int compile(vxl_renderer *r, GLenum type, const char *file, const char *defines, GLuint *out)
@@ -65,11 +66,12 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
 {
     char defines[256] = "";
     const char *fdef = filter < VXL_FILTER_COUNT ? filter_defines[filter] : filter_defines[0];
+    const char *paged = (flags & VXL_FLAG_PAGED) ? "#define PAGED 1\n" : "";
     GLuint a = 0, b = 0;
     int rc;
     switch (kind) {
     case VXL_PROG_RAYCAST:
-        snprintf(defines, sizeof defines, "%s#define GOPACITY %u\n%s%s%s", fdef, (flags >> 4) & 3,
+        snprintf(defines, sizeof defines, "%s%s#define GOPACITY %u\n%s%s%s", paged, fdef, (flags >> 4) & 3,
                  (flags & 1) ? "#define SHADING 1\n" : "",
                  (flags & 2) ? "#define REUSE_GRADIENTS 1\n" : "",
                  ((flags >> 2) & 3) == VXL_CLASSIFY_PRE      ? "#define CLASSIFY_PRE 1\n"
@@ -84,7 +86,8 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
         }
         return link(r, a, b, out);
     case VXL_PROG_PROBE:
-        rc = compile(r, GL_COMPUTE_SHADER, "probe.comp", fdef, &a);
+        snprintf(defines, sizeof defines, "%s%s", paged, fdef);
+        rc = compile(r, GL_COMPUTE_SHADER, "probe.comp", defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_GRAD_BLUR:
         rc = compile(r, GL_COMPUTE_SHADER, "gradient_blur.comp", NULL, &a);

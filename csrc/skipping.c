@@ -7,7 +7,7 @@
 
 #include "renderer_internal.h"
 
-static uint32_t brick_size(void)
+uint32_t vxl_skip_brick_size(void)
 {
     const char *env = getenv("VOXLIGHT_BRICK_SIZE");
     long v = env ? strtol(env, NULL, 10) : 0;
@@ -25,7 +25,7 @@ static int build_minmax(vxl_renderer *r)
 {
     vxl_gl *gl = &r->gl;
     vxl_bricks *b = &r->bricks;
-    b->size = brick_size();
+    b->size = vxl_skip_brick_size();
     for (int a = 0; a < 3; a++) b->dims[a] = (r->dims[a] + b->size - 1) / b->size;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     b->minmax = malloc(n * 2 * sizeof(float));

@@ -32,6 +32,7 @@ LIBRARY_NAME = "libvoxlight.so"
 FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed", "cubic")
 PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
 BACKENDS = ("auto", "osmesa", "egl")
+STORAGES = ("auto", "dense", "bricked", "sparse")  # VXL_STORAGE_*
 MAX_LIGHTS = 8
 # VXL_CLASSIFY_* and VXL_GOPACITY_* order.
 CLASSIFY_MODES = ("post", "pre", "preint")
@@ -91,7 +92,9 @@ class RendererOptions(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("backend", ctypes.c_uint32),
                 ("memory_budget_bytes", ctypes.c_uint64),
-                ("shader_dir", ctypes.c_char_p)]
+                ("shader_dir", ctypes.c_char_p),
+                ("storage", ctypes.c_uint32),
+                ("page_brick", ctypes.c_uint32)]
 
 
 class RendererInfo(ctypes.Structure):
@@ -166,7 +169,13 @@ class RenderStats(ctypes.Structure):
                 ("effective_step", ctypes.c_float),
                 ("bricks_total", ctypes.c_uint32),
                 ("bricks_occupied", ctypes.c_uint32),
-                ("brick_size", ctypes.c_uint32)]
+                ("brick_size", ctypes.c_uint32),
+                ("storage", ctypes.c_uint32),
+                ("resident_bytes", ctypes.c_uint64),
+                ("page_brick", ctypes.c_uint32),
+                ("pages_total", ctypes.c_uint32),
+                ("pages_resident", ctypes.c_uint32),
+                ("pages_constant", ctypes.c_uint32)]
 
 
 def _sized(struct_type):
@@ -681,7 +690,8 @@ def tile_params(params, x0, y0, x1, y1):
 def _empty_stats():
     return {"samples": 0, "rays": 0, "max_ray_samples": 0, "sample_bound": 0,
             "effective_step": 0.0, "bricks_total": 0, "bricks_occupied": 0,
-            "brick_size": 0, "calls": 0, "seconds": 0.0}
+            "brick_size": 0, "calls": 0, "seconds": 0.0, "storage_name": "", "resident_bytes": 0,
+            "pages_total": 0, "pages_resident": 0, "pages_constant": 0}
 
 
 def _merge_stats(acc, s):
@@ -689,7 +699,8 @@ def _merge_stats(acc, s):
     acc["rays"] += s["rays"]
     acc["max_ray_samples"] = max(acc["max_ray_samples"], s["max_ray_samples"])
     acc["sample_bound"] = max(acc["sample_bound"], s["sample_bound"])
-    for k in ("effective_step", "bricks_total", "bricks_occupied", "brick_size"):
+    for k in ("effective_step", "bricks_total", "bricks_occupied", "brick_size", "storage_name",
+              "resident_bytes", "pages_total", "pages_resident", "pages_constant"):
         acc[k] = s[k]
     return acc
 
@@ -700,11 +711,14 @@ class Renderer:
     """One library renderer: its own GL context on its own thread, holding
     one volume. Safe to call from any Python thread."""
 
-    def __init__(self, backend="auto", memory_budget=0, shader_dir=None, lib=None):
+    def __init__(self, backend="auto", memory_budget=0, shader_dir=None, lib=None,
+                 storage="auto", page_brick=0):
         self.lib = lib or load_library()
         opt = _sized(RendererOptions)
         opt.backend = BACKENDS.index(backend) if isinstance(backend, str) else int(backend)
         opt.memory_budget_bytes = memory_budget
+        opt.storage = STORAGES.index(storage) if isinstance(storage, str) else int(storage)
+        opt.page_brick = page_brick
         opt.shader_dir = os.fsencode(shader_dir) if shader_dir else None
         h = ctypes.c_void_p()
         self.lib.check(self.lib.cdll.vxl_renderer_create(ctypes.byref(opt), ctypes.byref(h)),
@@ -753,7 +767,9 @@ class Renderer:
         """What the last render did (vxl_renderer_get_stats) as a dict."""
         st = _sized(RenderStats)
         self._check(self.lib.cdll.vxl_renderer_get_stats(self.handle, ctypes.byref(st)), "stats")
-        return {k: getattr(st, k) for k, _t in RenderStats._fields_ if k != "struct_size"}
+        d = {k: getattr(st, k) for k, _t in RenderStats._fields_ if k != "struct_size"}
+        d["storage_name"] = STORAGES[d["storage"]] if d["storage"] < len(STORAGES) else "?"
+        return d
 
     def render_tiled(self, params, rect=None, rows=None, target_seconds=0.05,
                      should_stop=None):

@@ -7,28 +7,56 @@
 
 static uint32_t clampi(int64_t i, uint32_t n) { return i < 0 ? 0 : i >= (int64_t)n ? n - 1 : (uint32_t)i; }
 
-/* Copies brick (bx,by,bz) with its ghost into dst; out-of-volume voxels take
- * the nearest edge voxel, as clamp-to-edge sampling of one texture does. */
+/* Range of n consecutive stored values from index i, in typed loops: this
+ * runs over every voxel of volumes of billions. */
+static void row_range(const vxl_volume *v, size_t i, uint32_t n, double *lo, double *hi)
+{
+    double mn = *lo, mx = *hi;
+    if (v->texture_bits == 8) {
+        const uint8_t *t = (const uint8_t *)v->texels + i;
+        uint8_t a = t[0], b = t[0];
+        for (uint32_t k = 1; k < n; k++) { a = t[k] < a ? t[k] : a; b = t[k] > b ? t[k] : b; }
+        mn = a / 255.0 < mn ? a / 255.0 : mn;
+        mx = b / 255.0 > mx ? b / 255.0 : mx;
+    } else if (v->texture_bits == 16) {
+        const uint16_t *t = (const uint16_t *)v->texels + i;
+        uint16_t a = t[0], b = t[0];
+        for (uint32_t k = 1; k < n; k++) { a = t[k] < a ? t[k] : a; b = t[k] > b ? t[k] : b; }
+        mn = a / 65535.0 < mn ? a / 65535.0 : mn;
+        mx = b / 65535.0 > mx ? b / 65535.0 : mx;
+    } else {
+        const float *t = (const float *)v->texels + i;
+        float a = t[0], b = t[0];
+        for (uint32_t k = 1; k < n; k++) { a = t[k] < a ? t[k] : a; b = t[k] > b ? t[k] : b; }
+        mn = a < mn ? a : mn;
+        mx = b > mx ? b : mx;
+    }
+    *lo = mn;
+    *hi = mx;
+}
+
+/* Copies brick b with its ghost into dst; out-of-volume voxels take the
+ * nearest edge voxel, as clamp-to-edge sampling of one texture does. */
 static void gather(const vxl_volume *v, const vxl_pages *pg, const uint32_t b[3], uint8_t *dst, double *lo,
                    double *hi)
 {
     const uint32_t e = vxl_page_edge(pg), bpv = pg->bytes_per_voxel;
     const uint8_t *src = v->texels;
+    const int64_t x0 = (int64_t)b[0] * pg->brick - VXL_PAGE_GHOST;
+    /* the run of x inside the volume, copied in one go */
+    const uint32_t in0 = clampi(x0, v->dims[0]), in1 = clampi(x0 + e - 1, v->dims[0]);
+    const uint32_t pre = (uint32_t)((int64_t)in0 - x0), run = in1 - in0 + 1;
     *lo = 1e300;
     *hi = -1e300;
     for (uint32_t z = 0; z < e; z++) {
         uint32_t vz = clampi((int64_t)b[2] * pg->brick + z - VXL_PAGE_GHOST, v->dims[2]);
-        for (uint32_t y = 0; y < e; y++) {
+        for (uint32_t y = 0; y < e; y++, dst += (size_t)e * bpv) {
             uint32_t vy = clampi((int64_t)b[1] * pg->brick + y - VXL_PAGE_GHOST, v->dims[1]);
             size_t row = (size_t)v->dims[0] * (vy + (size_t)v->dims[1] * vz);
-            for (uint32_t x = 0; x < e; x++) {
-                uint32_t vx = clampi((int64_t)b[0] * pg->brick + x - VXL_PAGE_GHOST, v->dims[0]);
-                memcpy(dst, src + (row + vx) * bpv, bpv);
-                dst += bpv;
-                double t = vxl_volume_texel(v, row + vx);
-                *lo = t < *lo ? t : *lo;
-                *hi = t > *hi ? t : *hi;
-            }
+            for (uint32_t x = 0; x < pre; x++) memcpy(dst + (size_t)x * bpv, src + (row + in0) * bpv, bpv);
+            memcpy(dst + (size_t)pre * bpv, src + (row + in0) * bpv, (size_t)run * bpv);
+            for (uint32_t x = pre + run; x < e; x++) memcpy(dst + (size_t)x * bpv, src + (row + in1) * bpv, bpv);
+            row_range(v, row + in0, run, lo, hi); /* the clamped copies repeat the run's ends */
         }
     }
 }
@@ -103,11 +131,7 @@ int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl
         double mn = 1e300, mx = -1e300;
         for (uint32_t z = lo[2]; z <= hi[2]; z++)
             for (uint32_t y = lo[1]; y <= hi[1]; y++)
-                for (uint32_t x = lo[0]; x <= hi[0]; x++) {
-                    double t = vxl_volume_texel(v, x + (size_t)v->dims[0] * (y + (size_t)v->dims[1] * z));
-                    mn = t < mn ? t : mn;
-                    mx = t > mx ? t : mx;
-                }
+                row_range(v, lo[0] + (size_t)v->dims[0] * (y + (size_t)v->dims[1] * z), hi[0] - lo[0] + 1, &mn, &mx);
         b->minmax[2 * i] = (float)mn;
         b->minmax[2 * i + 1] = (float)mx;
     }

@@ -315,7 +315,9 @@ VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, con
 #define VXL_PHANTOM_NOISY_BLOB 4     /* smooth Gaussian blob plus Gaussian noise */
 #define VXL_PHANTOM_SPARSE_BALLS 5   /* Gaussian balls on 5% of an 8^3 lattice (empty-space skipping) */
 #define VXL_PHANTOM_DENSE_BALLS 6    /* its dense twin: a ball on every lattice site */
-#define VXL_PHANTOM_COUNT 7
+#define VXL_PHANTOM_LARGE_SPARSE 7  /* 8-bit Gaussian ellipsoids on 30% of a 12x8x2 lattice; default
+                                        2500x1500x400 (over every 2048 texture limit, for bricking) */
+#define VXL_PHANTOM_COUNT 8
 
 typedef struct vxl_phantom_desc {
     uint32_t struct_size;

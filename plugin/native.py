@@ -88,6 +88,14 @@ class VolumeInfo(ctypes.Structure):
                 ("affine_source", ctypes.c_uint32)]
 
 
+class PhantomDesc(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("kind", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("seed", ctypes.c_uint32),
+                ("noise_sigma", ctypes.c_double)]
+
+
 class RendererOptions(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("backend", ctypes.c_uint32),
@@ -236,6 +244,8 @@ def _declare(lib):
         "vxl_volume_histogram": (ctypes.c_int, [vp, ctypes.c_uint32, ctypes.c_double,
                                                 ctypes.c_double, P(ctypes.c_uint64)]),
         "vxl_volume_destroy": (None, [vp]),
+        "vxl_phantom_name": (ctypes.c_char_p, [ctypes.c_uint32]),
+        "vxl_phantom_create": (ctypes.c_int, [P(PhantomDesc), P(vp)]),
         "vxl_renderer_create": (ctypes.c_int, [P(RendererOptions), P(vp)]),
         "vxl_renderer_destroy": (None, [vp]),
         "vxl_renderer_error": (ctypes.c_char_p, [vp]),
@@ -435,6 +445,35 @@ class Volume:
         h = ctypes.c_void_p()
         # The library's message already names the file.
         lib.check(lib.cdll.vxl_volume_load(os.fsencode(path), ctypes.byref(opt), ctypes.byref(h)))
+        return cls(lib, h)
+
+    @classmethod
+    def phantom(cls, spec, lib=None):
+        """A generated analytic phantom from "phantom:NAME[:WxHxD]" (the
+        CLI's syntax), e.g. "phantom:large-sparse" (2500x1500x400)."""
+        lib = lib or load_library()
+        parts = spec.split(":")
+        if parts[0] != "phantom" or len(parts) not in (2, 3):
+            raise VoxlightError("not a phantom spec: %r (phantom:NAME[:WxHxD])" % spec)
+        names = {}
+        k = 1
+        while lib.cdll.vxl_phantom_name(k):
+            names[lib.cdll.vxl_phantom_name(k).decode()] = k
+            k += 1
+        if parts[1] not in names:
+            raise VoxlightError("unknown phantom %r (%s)" % (parts[1], ", ".join(names)))
+        d = _sized(PhantomDesc)
+        d.kind = names[parts[1]]
+        if len(parts) == 3:
+            try:
+                dims = [int(n) for n in parts[2].split("x")]
+            except ValueError:
+                dims = []
+            if len(dims) != 3 or min(dims) < 2:
+                raise VoxlightError("bad phantom size %r: use WxHxD" % parts[2])
+            d.dims[:] = dims
+        h = ctypes.c_void_p()
+        lib.check(lib.cdll.vxl_phantom_create(ctypes.byref(d), ctypes.byref(h)), what="phantom")
         return cls(lib, h)
 
     @classmethod

@@ -127,6 +127,17 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
                              frame["brick_size"]))
             else:
                 col.label(text="Empty-space skipping off")
+            col.label(text=storage_text(frame))
+
+
+def storage_text(frame):
+    """How the volume is held on the GL side, from the last frame's stats."""
+    mib = frame.get("resident_bytes", 0) / 1048576.0
+    if not frame.get("pages_total"):
+        return "Storage: %s, %.1f MiB" % (frame.get("storage_name", "dense"), mib)
+    return "Storage: %s, %.1f MiB (%d of %d bricks resident, %d constant)" % (
+        frame["storage_name"], mib, frame["pages_resident"], frame["pages_total"],
+        frame["pages_constant"])
 
 
 class VOXLIGHT_PT_scene(bpy.types.Panel):

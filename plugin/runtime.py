@@ -193,6 +193,15 @@ _entries = {}   # absolute path -> VolumeEntry
 _failures = {}  # absolute path -> (mtime, message): do not retry a broken file every redraw
 
 
+def is_phantom(path):
+    """"phantom:NAME[:WxHxD]" names a generated volume instead of a file."""
+    return str(path).startswith("phantom:")
+
+
+def _key(path):
+    return path if is_phantom(path) else os.path.abspath(path)
+
+
 def _mtime(path):
     try:
         return os.stat(path).st_mtime
@@ -203,9 +212,9 @@ def _mtime(path):
 def load_volume(path, backend="auto", progress=None):
     """Load `path` into a fresh renderer. Raises native.VoxlightError.
     progress(fraction) is called between the slow steps."""
-    path = os.path.abspath(path)
+    path = _key(path)
     lib = native.load_library()
-    vol = native.Volume.load(path, lib=lib)
+    vol = native.Volume.phantom(path, lib=lib) if is_phantom(path) else native.Volume.load(path, lib=lib)
     if progress:
         progress(0.4)
     try:
@@ -234,7 +243,7 @@ def load_volume(path, backend="auto", progress=None):
 def get_entry(path, backend="auto"):
     """The live entry for `path`, loading it on first use or when the file
     changed on disk. Raises native.VoxlightError (remembered per mtime)."""
-    path = os.path.abspath(path)
+    path = _key(path)
     entry = _entries.get(path)
     mtime = _mtime(path)
     if entry is not None and entry.mtime == mtime:
@@ -251,11 +260,11 @@ def get_entry(path, backend="auto"):
 
 def find_entry(path):
     """The live entry for `path` or None; never loads."""
-    return _entries.get(os.path.abspath(path))
+    return _entries.get(_key(path))
 
 
 def last_failure(path):
-    f = _failures.get(os.path.abspath(path))
+    f = _failures.get(_key(path))
     return f[1] if f else ""
 
 

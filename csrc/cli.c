@@ -272,6 +272,11 @@ static int cmd_render(int argc, char **argv)
     else
         fprintf(stderr, "voxlight: storage %s, %.1f MiB resident; frame %.3f s\n", vxl_storage_name(st.storage),
                 st.resident_bytes / 1048576.0, secs);
+    if (st.lod_level) /* never silently coarser */
+        fprintf(stderr, "voxlight: LOD fallback: level %u (%ux coarser per axis): the visible bricks need %.1f MiB at full "
+                "resolution, over the memory budget of %.1f MiB\n", st.lod_level, 1u << st.lod_level,
+                st.lod_wanted_bytes / 1048576.0,
+                (a.ro.memory_budget_bytes ? a.ro.memory_budget_bytes : 2ull << 30) / 1048576.0);
     status = 0;
 done:
     free(rgba);

@@ -20,7 +20,10 @@ void vxl_paged_release(vxl_renderer *r)
     if (r->pool_tex) r->gl.DeleteTextures(1, &r->pool_tex);
     if (r->page_tex) r->gl.DeleteTextures(1, &r->page_tex);
     r->pool_tex = r->page_tex = 0;
-    vxl_pages_free(&r->pages);
+    for (int k = 0; k < VXL_LOD_LEVELS; k++) vxl_pages_free(&r->levels[k]);
+    memset(r->level_dims, 0, sizeof r->level_dims);
+    r->n_levels = r->level = 0;
+    r->lod_wanted_bytes = 0;
     free(r->resident);
     free(r->page_entries);
     r->resident = NULL;
@@ -51,12 +54,12 @@ static uint64_t pool_bytes_for(const vxl_pages *pg, const uint32_t slots[3])
     return slots[0] * e * slots[1] * e * slots[2] * e * pg->bytes_per_voxel;
 }
 
-/* Builds the pool from the bricks marked in need[] and uploads the page
- * table. Refuses, naming the budget, when they do not fit. */
-static int upload_pool(vxl_renderer *r, const uint8_t *need)
+/* Builds the pool from the bricks of `level` marked in need[] and uploads
+ * the page table. Refuses, naming the budget, when they do not fit. */
+static int upload_pool(vxl_renderer *r, uint32_t level, const uint8_t *need)
 {
     vxl_gl *gl = &r->gl;
-    vxl_pages *pg = &r->pages;
+    vxl_pages *pg = &r->levels[level];
     const uint64_t n = vxl_page_count(pg);
     uint32_t count = 0, slots[3];
     for (uint64_t i = 0; i < n; i++) count += need[i];
@@ -103,6 +106,7 @@ static int upload_pool(vxl_renderer *r, const uint8_t *need)
     r->pages_resident = count;
     r->pages_constant = constant;
     r->pool_bytes = bytes;
+    r->level = level;
     return VXL_OK;
 }
 
@@ -114,54 +118,86 @@ static uint64_t resident_bytes_for(const vxl_renderer *r, const vxl_pages *pg, u
     return pool_layout(r, pg, n, slots) ? pool_bytes_for(pg, slots) + page_table_bytes(pg) : UINT64_MAX;
 }
 
+static void plan_free(vxl_paged_volume *pv)
+{
+    for (int k = 0; k < VXL_LOD_LEVELS; k++) vxl_pages_free(&pv->levels[k]);
+    vxl_bricks_free(&pv->bricks);
+}
+
+/* Sparse storage keeps coarser levels for the LOD fallback: each a 2x
+ * downsampled copy, cut into bricks the same way. */
+static int plan_levels(vxl_renderer *r, const vxl_volume *v, uint32_t brick, vxl_paged_volume *out)
+{
+    const vxl_volume *src = v;
+    vxl_volume *coarse = NULL;
+    int rc = VXL_OK;
+    for (uint32_t k = 1; k < VXL_LOD_LEVELS && !rc; k++) {
+        vxl_volume *next = NULL;
+        if ((rc = vxl_volume_downsample2(src, &next, &r->err))) break;
+        vxl_volume_destroy(coarse);
+        coarse = next;
+        src = coarse;
+        rc = vxl_pages_build(&out->levels[k], coarse, brick, &r->err);
+        memcpy(out->level_dims[k], coarse->dims, sizeof out->level_dims[k]);
+        if (!rc) out->n_levels = k + 1;
+    }
+    vxl_volume_destroy(coarse);
+    return rc;
+}
+
 int vxl_paged_plan(vxl_renderer *r, const vxl_volume *v, uint32_t storage, vxl_paged_volume *out)
 {
     memset(out, 0, sizeof *out);
     uint32_t brick = r->page_brick_request ? r->page_brick_request : VXL_DEFAULT_PAGE_BRICK;
-    int rc = vxl_pages_build(&out->pages, v, brick, &r->err);
+    vxl_pages *pg = &out->levels[0];
+    int rc = vxl_pages_build(pg, v, brick, &r->err);
     if (!rc) rc = vxl_bricks_minmax_cpu(&out->bricks, v, vxl_skip_brick_size(), &r->err);
-    if (rc) {
-        vxl_pages_free(&out->pages);
-        vxl_bricks_free(&out->bricks);
-        return rc;
-    }
-    uint64_t all = resident_bytes_for(r, &out->pages, out->pages.n_data), none = resident_bytes_for(r, &out->pages, 0);
+    memcpy(out->level_dims[0], v->dims, sizeof out->level_dims[0]);
+    out->n_levels = 1;
     if (storage == VXL_STORAGE_AUTO) storage = VXL_STORAGE_BRICKED; /* dense did not fit */
     out->storage = storage;
+    if (!rc && storage == VXL_STORAGE_SPARSE) rc = plan_levels(r, v, brick, out);
+    if (rc) {
+        plan_free(out);
+        return rc;
+    }
+    uint64_t all = resident_bytes_for(r, pg, pg->n_data), none = resident_bytes_for(r, pg, 0);
     uint64_t need = storage == VXL_STORAGE_BRICKED ? all : none;
     if (need > r->budget) {
         const char *hint = storage == VXL_STORAGE_BRICKED ? "; sparse storage keeps only the visible bricks" : "";
         rc = need == UINT64_MAX
                  ? vxl_fail(&r->err, VXL_ERR_LIMIT, "%u bricks of %u^3 voxels do not fit a pool texture within the 3D texture limit of %d%s",
-                            out->pages.n_data, vxl_page_edge(&out->pages), r->info.max_3d_texture_size, hint)
+                            pg->n_data, vxl_page_edge(pg), r->info.max_3d_texture_size, hint)
                  : vxl_fail(&r->err, VXL_ERR_LIMIT,
                             "%s storage of %ux%ux%u needs %.1f MiB, over the renderer's memory budget of %.1f MiB%s",
                             vxl_storage_name(storage), v->dims[0], v->dims[1], v->dims[2], need / 1048576.0,
                             r->budget / 1048576.0, hint);
-        vxl_pages_free(&out->pages);
-        vxl_bricks_free(&out->bricks);
+        plan_free(out);
     }
     return rc;
 }
 
 int vxl_paged_install(vxl_renderer *r, vxl_paged_volume *pv)
 {
-    r->pages = pv->pages;
+    memcpy(r->levels, pv->levels, sizeof r->levels);
+    memcpy(r->level_dims, pv->level_dims, sizeof r->level_dims);
+    r->n_levels = pv->n_levels;
+    r->level = 0;
     r->bricks = pv->bricks;
     r->storage = pv->storage;
     memset(pv, 0, sizeof *pv);
-    const uint64_t n = vxl_page_count(&r->pages);
+    const uint64_t n = vxl_page_count(&r->levels[0]); /* the finest level has the most bricks */
     r->resident = calloc(n, 1);
     r->page_entries = malloc(n * 4 * sizeof(float));
     if (!r->resident || !r->page_entries) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
     if (r->storage == VXL_STORAGE_SPARSE) return VXL_OK; /* the pool follows the first frame's classification */
     uint8_t *need = malloc(n);
     if (!need) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
-    for (uint64_t i = 0; i < n; i++) need[i] = r->pages.data_index[i] >= 0;
-    int rc = upload_pool(r, need);
+    for (uint64_t i = 0; i < n; i++) need[i] = r->levels[0].data_index[i] >= 0;
+    int rc = upload_pool(r, 0, need);
     free(need);
-    free(r->pages.data); /* on the GL side now; BRICKED never uploads again */
-    r->pages.data = NULL;
+    free(r->levels[0].data); /* on the GL side now; BRICKED never uploads again */
+    r->levels[0].data = NULL;
     return rc;
 }
 
@@ -179,18 +215,38 @@ int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify)
                     what, vxl_storage_name(r->storage), r->dims[0], r->dims[1], r->dims[2]);
 }
 
+/* Sparse: the finest level whose visible bricks fit the budget. Falls back
+ * to coarser levels (reported in the stats) and fails naming the budget
+ * only when even the coarsest does not fit. */
 int vxl_paged_prepare(vxl_renderer *r, const vxl_frame *f)
 {
     if (r->storage != VXL_STORAGE_SPARSE) return VXL_OK;
     /* gradient taps reach sample_distance voxels per axis, trilinear one more */
     uint32_t reach = f ? (uint32_t)ceilf(f->sample_distance) + 1 : 0;
-    const uint64_t n = vxl_page_count(&r->pages);
-    uint8_t *need = malloc(n);
+    const int all = !f || f->gopacity == VXL_GOPACITY_ISO;
+    const uint64_t n0 = vxl_page_count(&r->levels[0]);
+    uint8_t *need = malloc(n0);
     if (!need) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
-    vxl_pages_needed(&r->pages, &r->bricks, reach, !f || f->gopacity == VXL_GOPACITY_ISO, need);
-    int grow = !r->pool_tex;
+    uint64_t wanted = 0, bytes = UINT64_MAX;
+    uint32_t level = 0;
+    for (; level < r->n_levels; level++) { /* f == NULL (probes): full resolution only */
+        uint32_t count = vxl_pages_needed(&r->levels[level], &r->bricks, reach, 1u << level, all, need);
+        bytes = resident_bytes_for(r, &r->levels[level], count);
+        if (level == 0) wanted = bytes;
+        if (bytes <= r->budget || !f) break;
+    }
+    if (level == r->n_levels) {
+        free(need);
+        return vxl_fail(&r->err, VXL_ERR_LIMIT,
+                        "the visible bricks need %.1f MiB at full resolution and still %.1f MiB at %ux coarser, over "
+                        "the renderer's memory budget of %.1f MiB",
+                        wanted / 1048576.0, bytes / 1048576.0, 1u << (r->n_levels - 1), r->budget / 1048576.0);
+    }
+    const uint64_t n = vxl_page_count(&r->levels[level]);
+    int grow = !r->pool_tex || level != r->level;
     for (uint64_t i = 0; i < n && !grow; i++) grow = need[i] && !r->resident[i];
-    int rc = grow ? upload_pool(r, need) : VXL_OK;
+    int rc = grow ? upload_pool(r, level, need) : VXL_OK;
+    if (!rc) r->lod_wanted_bytes = level ? wanted : 0;
     free(need);
     return rc;
 }

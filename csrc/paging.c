@@ -138,21 +138,27 @@ int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl
     return VXL_OK;
 }
 
-void vxl_pages_needed(const vxl_pages *pg, const vxl_bricks *b, uint32_t reach, int all, uint8_t *need)
+uint32_t vxl_pages_needed(const vxl_pages *pg, const vxl_bricks *b, uint32_t reach, uint32_t scale, int all,
+                          uint8_t *need)
 {
     const uint64_t n = vxl_page_count(pg);
+    /* a coarse trilinear footprint reaches one more coarse voxel */
+    const int64_t reach_k = scale > 1 ? (reach + scale - 1) / scale + 1 : reach;
+    uint32_t count = 0;
     for (uint64_t i = 0; i < n; i++) {
         need[i] = 0;
         if (pg->data_index[i] < 0) continue;
         if (all) {
             need[i] = 1;
+            count++;
             continue;
         }
         const uint32_t c[3] = {(uint32_t)(i % pg->grid[0]), (uint32_t)(i / pg->grid[0] % pg->grid[1]),
                                (uint32_t)(i / ((uint64_t)pg->grid[0] * pg->grid[1]))};
         uint32_t lo[3], hi[3]; /* skip bricks covering the page's voxels widened by reach */
         for (int a = 0; a < 3; a++) {
-            int64_t v0 = (int64_t)c[a] * pg->brick - reach, v1 = (int64_t)c[a] * pg->brick + pg->brick - 1 + reach;
+            int64_t v0 = ((int64_t)c[a] * pg->brick - reach_k) * scale,
+                    v1 = ((int64_t)c[a] * pg->brick + pg->brick + reach_k) * scale - 1;
             lo[a] = clampi(v0 < 0 ? 0 : v0 / b->size, b->dims[a]);
             hi[a] = clampi(v1 / b->size, b->dims[a]);
         }
@@ -163,5 +169,7 @@ void vxl_pages_needed(const vxl_pages *pg, const vxl_bricks *b, uint32_t reach, 
                         need[i] = 1;
                         break;
                     }
+        count += need[i];
     }
+    return count;
 }

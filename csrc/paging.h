@@ -45,9 +45,12 @@ void vxl_pages_free(vxl_pages *pg);
 int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl_err *e);
 
 /* need[i] = 1 for every data brick a frame can read under the occupancy in b
- * (b->distance, 0 = occupied): a brick within `reach` voxels of an occupied
- * skip brick, since gradient taps reach that far from a visible sample.
- * all != 0 marks every data brick (classifications occupancy cannot bound). */
-void vxl_pages_needed(const vxl_pages *pg, const vxl_bricks *b, uint32_t reach, int all, uint8_t *need);
+ * (b->distance, 0 = occupied, on the full-resolution grid): a brick within
+ * `reach` full-resolution voxels of an occupied skip brick, since gradient
+ * taps reach that far from a visible sample. pg may be a coarser level whose
+ * voxels cover `scale` full-resolution voxels per axis. all != 0 marks every
+ * data brick (classifications occupancy cannot bound). Returns the count. */
+uint32_t vxl_pages_needed(const vxl_pages *pg, const vxl_bricks *b, uint32_t reach, uint32_t scale, int all,
+                          uint8_t *need);
 
 #endif

@@ -65,10 +65,14 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
         gl->ActiveTexture(GL_TEXTURE0 + VXL_PAGE_UNIT);
         gl->BindTexture(GL_TEXTURE_3D, r->page_tex);
         vxl_uniform_i(r, prog, "u_page", VXL_PAGE_UNIT);
-        vxl_uniform_f(r, prog, "u_page_brick", (float)r->pages.brick);
+        vxl_uniform_f(r, prog, "u_page_brick", (float)r->levels[r->level].brick);
+        vxl_uniform_f(r, prog, "u_lod_scale", (float)(1u << r->level));
+        const uint32_t *ld = r->level_dims[r->level];
         float pd[3] = {(float)r->pool_dims[0], (float)r->pool_dims[1], (float)r->pool_dims[2]};
-        GLint ploc = gl->GetUniformLocation(prog, "u_pool_dims");
+        float lv[3] = {(float)ld[0], (float)ld[1], (float)ld[2]};
+        GLint ploc = gl->GetUniformLocation(prog, "u_pool_dims"), lloc = gl->GetUniformLocation(prog, "u_page_dims");
         if (ploc >= 0) gl->Uniform3fv(ploc, 1, pd);
+        if (lloc >= 0) gl->Uniform3fv(lloc, 1, lv);
     }
     gl->ActiveTexture(GL_TEXTURE0);
     gl->BindTexture(GL_TEXTURE_3D, r->pool_tex ? r->pool_tex : r->volume_tex);
@@ -248,8 +252,10 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     r->stats.storage = r->storage;
     r->stats.resident_bytes = r->volume_tex ? r->volume_bytes : r->pool_bytes;
     if (!r->volume_tex) {
-        r->stats.page_brick = r->pages.brick;
-        r->stats.pages_total = (uint32_t)vxl_page_count(&r->pages);
+        r->stats.page_brick = r->levels[r->level].brick;
+        r->stats.pages_total = (uint32_t)vxl_page_count(&r->levels[r->level]);
+        r->stats.lod_level = r->level;
+        r->stats.lod_wanted_bytes = r->lod_wanted_bytes;
         r->stats.pages_resident = r->pages_resident;
         r->stats.pages_constant = r->pages_constant;
     }

@@ -11,6 +11,7 @@
 #include "error.h"
 #include "gl_funcs.h"
 #include "gl_thread.h"
+#include "lod.h"
 #include "frame.h"
 #include "voxlight.h"
 
@@ -59,7 +60,10 @@ struct vxl_renderer {
     uint32_t storage;
     uint32_t page_brick_request;  /* from the options; 0 = default */
     uint32_t storage_request;     /* VXL_STORAGE_* asked for */
-    vxl_pages pages;
+    vxl_pages levels[VXL_LOD_LEVELS]; /* [0] full resolution; coarser ones only when sparse */
+    uint32_t level_dims[VXL_LOD_LEVELS][3];
+    uint32_t n_levels, level;         /* level in the pool now (0 unless the budget forced a fallback) */
+    uint64_t lod_wanted_bytes;        /* what full resolution would need when level > 0 */
     GLuint pool_tex, page_tex;
     uint32_t pool_dims[3];
     uint8_t *resident;            /* per page brick: 1 if its data is in the pool */
@@ -123,7 +127,9 @@ void vxl_skipping_release(vxl_renderer *r);
 /* A volume cut into bricks on the CPU, checked against the budget and the
  * texture limit before the renderer lets go of its current volume. */
 typedef struct vxl_paged_volume {
-    vxl_pages pages;
+    vxl_pages levels[VXL_LOD_LEVELS];
+    uint32_t level_dims[VXL_LOD_LEVELS][3];
+    uint32_t n_levels;
     vxl_bricks bricks;
     uint32_t storage;   /* BRICKED or SPARSE */
 } vxl_paged_volume;

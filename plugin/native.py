@@ -183,7 +183,9 @@ class RenderStats(ctypes.Structure):
                 ("page_brick", ctypes.c_uint32),
                 ("pages_total", ctypes.c_uint32),
                 ("pages_resident", ctypes.c_uint32),
-                ("pages_constant", ctypes.c_uint32)]
+                ("pages_constant", ctypes.c_uint32),
+                ("lod_level", ctypes.c_uint32),
+                ("lod_wanted_bytes", ctypes.c_uint64)]
 
 
 def _sized(struct_type):
@@ -730,7 +732,8 @@ def _empty_stats():
     return {"samples": 0, "rays": 0, "max_ray_samples": 0, "sample_bound": 0,
             "effective_step": 0.0, "bricks_total": 0, "bricks_occupied": 0,
             "brick_size": 0, "calls": 0, "seconds": 0.0, "storage_name": "", "resident_bytes": 0,
-            "pages_total": 0, "pages_resident": 0, "pages_constant": 0}
+            "pages_total": 0, "pages_resident": 0, "pages_constant": 0, "lod_level": 0,
+            "lod_wanted_bytes": 0}
 
 
 def _merge_stats(acc, s):
@@ -739,7 +742,8 @@ def _merge_stats(acc, s):
     acc["max_ray_samples"] = max(acc["max_ray_samples"], s["max_ray_samples"])
     acc["sample_bound"] = max(acc["sample_bound"], s["sample_bound"])
     for k in ("effective_step", "bricks_total", "bricks_occupied", "brick_size", "storage_name",
-              "resident_bytes", "pages_total", "pages_resident", "pages_constant"):
+              "resident_bytes", "pages_total", "pages_resident", "pages_constant", "lod_level",
+              "lod_wanted_bytes"):
         acc[k] = s[k]
     return acc
 

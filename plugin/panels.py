@@ -128,6 +128,8 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
             else:
                 col.label(text="Empty-space skipping off")
             col.label(text=storage_text(frame))
+            if frame.get("lod_level"):
+                col.label(text=lod_text(frame), icon="ERROR")
 
 
 def storage_text(frame):
@@ -138,6 +140,15 @@ def storage_text(frame):
     return "Storage: %s, %.1f MiB (%d of %d bricks resident, %d constant)" % (
         frame["storage_name"], mib, frame["pages_resident"], frame["pages_total"],
         frame["pages_constant"])
+
+
+def lod_text(frame):
+    """The level-of-detail fallback, said out loud (empty at full resolution)."""
+    k = frame.get("lod_level", 0)
+    if not k:
+        return ""
+    return "LOD fallback: %dx coarser, full resolution needs %.1f MiB (over budget)" % (
+        1 << k, frame["lod_wanted_bytes"] / 1048576.0)
 
 
 class VOXLIGHT_PT_scene(bpy.types.Panel):

@@ -18,14 +18,19 @@ float sample_value(vec3 p) { return textureLod(u_volume, voxel_to_tex(p), 0.0).r
 // classification). Every tap is translated on its own, so any filter
 // footprint reads the right bricks; the ghost border keeps the trilinear
 // footprint of a position inside its brick.
+// u_lod_scale > 1: a coarser level (LOD fallback) of u_page_dims voxels,
+// each the mean of u_lod_scale^3 full-resolution ones.
 uniform sampler3D u_page;
 uniform vec3 u_pool_dims;
+uniform vec3 u_page_dims;
 uniform float u_page_brick;
+uniform float u_lod_scale;
 
 float sample_value(vec3 p)
 {
+    if (u_lod_scale > 1.0) p = (p + 0.5) / u_lod_scale - 0.5; // coarse voxel k covers fine k*s .. k*s+s-1
     // clamping to the voxel centres reproduces clamp-to-edge of one texture
-    vec3 q = clamp(p, vec3(0.0), u_dims - 1.0);
+    vec3 q = clamp(p, vec3(0.0), u_page_dims - 1.0);
     ivec3 b = ivec3(floor((q + 0.5) / u_page_brick));
     vec4 e = texelFetch(u_page, b, 0);
     if (e.w >= 0.0) return e.w;

@@ -104,7 +104,8 @@ extern "C" {
 #define VXL_STORAGE_DENSE 1   /* one 3D texture */
 #define VXL_STORAGE_BRICKED 2 /* bricks with a ghost border in a pool texture, a page table maps them;
                                  constant bricks cost nothing */
-#define VXL_STORAGE_SPARSE 3  /* bricked, and only the bricks the classification can see are resident */
+#define VXL_STORAGE_SPARSE 3  /* bricked, and only the bricks the classification can see are resident;
+                                 over the budget, a 2x/4x/8x coarser level (stats.lod_level) */
 #define VXL_STORAGE_COUNT 4
 
 #define VXL_MAX_LIGHTS 8
@@ -286,6 +287,11 @@ typedef struct vxl_render_stats {
     uint32_t pages_total;       /* bricks of the page table */
     uint32_t pages_resident;    /* bricks with data in the pool */
     uint32_t pages_constant;    /* bricks stored as one value (no pool space) */
+    /* Level-of-detail fallback (sparse storage): 0 = full resolution; k > 0:
+     * the visible bricks did not fit the memory budget, so the frame used
+     * voxels 2^k times coarser per axis. The page counts above are of that level. */
+    uint32_t lod_level;
+    uint64_t lod_wanted_bytes;  /* what full resolution would have needed (0 when lod_level is 0) */
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);

@@ -45,3 +45,17 @@ def test_bad_storage_options(tmp_path):
                        "--page-brick")
     assert_clean_error(run("render", "phantom:nothing", "-o", tmp_path / "x.png"), "phantom")
     assert_clean_error(run("render", "phantom:sphere:2x", "-o", tmp_path / "x.png"), "phantom size")
+
+
+def test_lod_fallback_is_reported(tmp_path):
+    """Sparse storage over its budget renders a coarser level and says so."""
+    base = ["render", OVER_LIMIT, "-o", tmp_path / "x.png", "--size", "64x32", "--storage", "sparse",
+            "--window", "0.001:0.01", "--page-brick", "16"]
+    full = run(*base)
+    assert full.returncode == 0, full.stderr
+    assert "LOD fallback" not in full.stderr
+    _, mib, _ = storage_line(full.stderr)
+    res = run(*base, "--memory-budget", "%dK" % int(mib * 1024 * 0.5))
+    assert res.returncode == 0, res.stderr
+    m = re.search(r"LOD fallback: level (\d+) \((\d+)x coarser per axis\): the visible bricks need ([0-9.]+) MiB", res.stderr)
+    assert m and int(m.group(1)) >= 1 and abs(float(m.group(3)) - mib) < 0.2, res.stderr

@@ -92,7 +92,8 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
     lights = params.scene_lights(scene, depsgraph, for_render)
     layers = []
     for ob, mw in vols:
-        entry = runtime.get_entry(bpy.path.abspath(ob.voxlight.filepath), backend)
+        opts = dict(runtime.options_of(scene.voxlight), backend=backend)
+        entry = runtime.get_entry(bpy.path.abspath(ob.voxlight.filepath), **opts)
         v2l = np.array(ob.voxlight.voxel_to_local, np.float64).reshape(4, 4).T
         p = native.make_params(width=width, height=height, view=view, proj=proj,
                                model=mw @ v2l, scene_depth=zbuf, lights=lights,

@@ -40,8 +40,8 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         try:
             wm.progress_update(0.05)
             try:
-                entry = runtime.load_volume(path, backend=context.scene.voxlight.backend,
-                                            progress=wm.progress_update)
+                entry = runtime.load_volume(path, progress=wm.progress_update,
+                                            **runtime.options_of(context.scene.voxlight))
             except (native.VoxlightError, OSError) as e:
                 # Nothing has been created yet, so a failure leaves no trace.
                 self.report({"ERROR"}, "Voxlight: cannot import %s: %s"
@@ -110,7 +110,8 @@ class VOXLIGHT_OT_reload_volume(bpy.types.Operator):
     def execute(self, context):
         p = context.object.voxlight
         try:
-            runtime.load_volume(bpy.path.abspath(p.filepath), backend=context.scene.voxlight.backend)
+            runtime.load_volume(bpy.path.abspath(p.filepath),
+                                **runtime.options_of(context.scene.voxlight))
         except native.VoxlightError as e:
             self.report({"ERROR"}, "Voxlight: %s" % e)
             return {"CANCELLED"}

@@ -175,6 +175,8 @@ class VOXLIGHT_PT_scene(bpy.types.Panel):
         col.prop(s, "render_occlusion")
         layout.prop(s, "use_scene_lights")
         layout.prop(s, "backend")
+        layout.prop(s, "storage")
+        layout.prop(s, "memory_budget_mib")
 
 
 _classes = (VOXLIGHT_PT_volume, VOXLIGHT_PT_scene)

@@ -158,8 +158,17 @@ class Worker:
             self._thread.join()
 
 
+def options_of(settings):
+    """Renderer options from the scene's Voxlight settings (duck-typed, so
+    this module stays free of bpy)."""
+    return {"backend": getattr(settings, "backend", "auto"),
+            "storage": getattr(settings, "storage", "auto"),
+            "memory_budget": int(getattr(settings, "memory_budget_mib", 0)) << 20}
+
+
 class VolumeEntry:
-    def __init__(self, path, renderer, info):
+    def __init__(self, path, renderer, info, options=None):
+        self.options = options or {}
         self.path = path
         self.renderer = renderer
         self.info = info
@@ -209,7 +218,7 @@ def _mtime(path):
         return None
 
 
-def load_volume(path, backend="auto", progress=None):
+def load_volume(path, backend="auto", progress=None, storage="auto", memory_budget=0):
     """Load `path` into a fresh renderer. Raises native.VoxlightError.
     progress(fraction) is called between the slow steps."""
     path = _key(path)
@@ -218,7 +227,8 @@ def load_volume(path, backend="auto", progress=None):
     if progress:
         progress(0.4)
     try:
-        renderer = native.Renderer(backend=backend, lib=lib)
+        renderer = native.Renderer(backend=backend, lib=lib, storage=storage,
+                                   memory_budget=memory_budget)
         if progress:
             progress(0.6)
         try:
@@ -231,7 +241,8 @@ def load_volume(path, backend="auto", progress=None):
         vol.close()  # the renderer holds its own copy on the GL side
     if progress:
         progress(0.9)
-    entry = VolumeEntry(path, renderer, info)
+    entry = VolumeEntry(path, renderer, info,
+                        {"storage": storage, "memory_budget": memory_budget})
     old = _entries.pop(path, None)
     if old is not None:
         old.close()
@@ -240,21 +251,22 @@ def load_volume(path, backend="auto", progress=None):
     return entry
 
 
-def get_entry(path, backend="auto"):
+def get_entry(path, backend="auto", storage="auto", memory_budget=0):
     """The live entry for `path`, loading it on first use or when the file
     changed on disk. Raises native.VoxlightError (remembered per mtime)."""
     path = _key(path)
     entry = _entries.get(path)
     mtime = _mtime(path)
-    if entry is not None and entry.mtime == mtime:
+    wanted = {"storage": storage, "memory_budget": memory_budget}
+    if entry is not None and entry.mtime == mtime and entry.options == wanted:
         return entry
     failed = _failures.get(path)
-    if failed is not None and failed[0] == mtime:
+    if failed is not None and failed[0] == (mtime, wanted):
         raise native.VoxlightError(failed[1])
     try:
-        return load_volume(path, backend)
+        return load_volume(path, backend, storage=storage, memory_budget=memory_budget)
     except native.VoxlightError as e:
-        _failures[path] = (mtime, str(e))
+        _failures[path] = ((mtime, wanted), str(e))
         raise
 
 

@@ -326,7 +326,8 @@ def _draw():
             moving = (now - st.moved_at) < s.settle_time
             moving_any |= moving
             try:
-                entry = runtime.get_entry(bpy.path.abspath(ob.voxlight.filepath), s.backend)
+                entry = runtime.get_entry(bpy.path.abspath(ob.voxlight.filepath),
+                                          **runtime.options_of(s))
             except native.VoxlightError as e:
                 _report(e)
                 continue

@@ -291,6 +291,21 @@ def large_phantom_renders_bricked_within_the_budget():
     assert frame["pages_constant"] > 0 and frame["pages_resident"] < frame["pages_total"]
     text = vx.panels.storage_text(frame)
     assert text.startswith("Storage: bricked") and "constant" in text, text
+    assert vx.panels.lod_text(frame) == ""
+    # sparse storage under half the memory it wants: a coarser level, said in the panel
+    s = bpy.context.scene.voxlight
+    s.storage = "sparse"
+    vx.render_volume(ob, resolution=(96, 48))
+    frame = vx.runtime.find_entry(spec).last_frame
+    assert frame["storage_name"] == "sparse" and frame["lod_level"] == 0, frame
+    s.memory_budget_mib = max(1, int(frame["resident_bytes"] / 2 / 1048576))
+    img = vx.render_volume(ob, resolution=(96, 48))
+    frame = vx.runtime.find_entry(spec).last_frame
+    assert frame["lod_level"] >= 1 and frame["resident_bytes"] <= s.memory_budget_mib << 20, frame
+    assert vx.panels.lod_text(frame).startswith("LOD fallback"), frame
+    assert img[..., 3].max() > 0.05
+    s.storage = "auto"
+    s.memory_budget_mib = 2048
     before = set(bpy.data.objects)
     try:
         bpy.ops.voxlight.import_volume(filepath="phantom:no-such-thing")

@@ -108,6 +108,16 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     case VXL_PROG_CLASSIFY_VOLUME:
         rc = compile(r, GL_COMPUTE_SHADER, "classify_volume.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_PAGED_BLUR:
+        rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_PAGED_GRAD_MAX:
+        rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", "#define MAX_PASS 1\n", &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_PAGED_GRAD_STORE:
+        snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
+        rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", defines, &a);
+        return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
         rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);

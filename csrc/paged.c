@@ -35,10 +35,15 @@ void vxl_paged_release(vxl_renderer *r)
 
 static uint64_t page_table_bytes(const vxl_pages *pg) { return vxl_page_count(pg) * 16; }
 
-/* Slots per axis for n bricks within the texture limit; 0 if they cannot fit. */
 static int pool_layout(const vxl_renderer *r, const vxl_pages *pg, uint32_t n, uint32_t slots[3])
 {
-    const uint32_t e = vxl_page_edge(pg), m = (uint32_t)r->info.max_3d_texture_size / e;
+    return vxl_pool_layout(r, n, vxl_page_edge(pg), slots);
+}
+
+/* Slots per axis for n bricks of edge e within the texture limit; 0 if they cannot fit. */
+int vxl_pool_layout(const vxl_renderer *r, uint32_t n, uint32_t e, uint32_t slots[3])
+{
+    const uint32_t m = (uint32_t)r->info.max_3d_texture_size / e;
     if (m == 0) return 0;
     n = n ? n : 1;
     slots[0] = n < m ? n : m;
@@ -204,14 +209,16 @@ int vxl_paged_install(vxl_renderer *r, vxl_paged_volume *pv)
 int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify)
 {
     if (!r->storage || r->storage == VXL_STORAGE_DENSE) return VXL_OK;
-    const char *what = filter == VXL_FILTER_PRECOMPUTED ? "the precomputed gradient filter"
+    const char *what = filter == VXL_FILTER_PRECOMPUTED && r->storage != VXL_STORAGE_BRICKED
+                           ? "the precomputed gradient filter with sparse storage"
                        : filter == VXL_FILTER_CUBIC     ? "the cubic gradient filter"
                        : classify == VXL_CLASSIFY_PRE   ? "pre-classification"
                                                         : NULL;
     if (!what) return VXL_OK;
     return vxl_fail(&r->err, VXL_ERR_STATE,
                     "%s needs the volume as one texture, but it is stored %s (%ux%ux%u); use central, forward3, "
-                    "sobel8, sobel14 or sobel26 with post- or pre-integrated classification",
+                    "sobel8, sobel14 or sobel26 (or precomputed with bricked storage) with post- or pre-integrated "
+                    "classification",
                     what, vxl_storage_name(r->storage), r->dims[0], r->dims[1], r->dims[2]);
 }
 

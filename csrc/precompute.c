@@ -10,7 +10,8 @@ static const uint32_t store_bytes[] = {4, 8, 16};
 void vxl_gradients_release(vxl_renderer *r)
 {
     if (r->gradient_tex) r->gl.DeleteTextures(1, &r->gradient_tex);
-    r->gradient_tex = 0;
+    if (r->gpage_tex) r->gl.DeleteTextures(1, &r->gpage_tex);
+    r->gradient_tex = r->gpage_tex = 0;
     r->gradient_bytes = 0;
 }
 

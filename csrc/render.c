@@ -50,8 +50,14 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
 {
     vxl_gl *gl = &r->gl;
     if (filter == VXL_FILTER_PRECOMPUTED) {
-        int rc = vxl_gradients_ensure(r, store);
+        if (store < 0 || store > VXL_GRADIENT_STORE_32F)
+            return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown gradient_store %d", store);
+        int rc = r->volume_tex ? vxl_gradients_ensure(r, store) : vxl_paged_gradients_ensure(r, store);
         if (rc) return rc;
+        if (r->gpage_tex) {
+            gl->ActiveTexture(GL_TEXTURE0 + VXL_GPAGE_UNIT);
+            gl->BindTexture(GL_TEXTURE_3D, r->gpage_tex);
+        }
         gl->ActiveTexture(GL_TEXTURE1);
         gl->BindTexture(GL_TEXTURE_3D, r->gradient_tex);
     } else if (filter == VXL_FILTER_CUBIC) {
@@ -73,6 +79,10 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
         GLint ploc = gl->GetUniformLocation(prog, "u_pool_dims"), lloc = gl->GetUniformLocation(prog, "u_page_dims");
         if (ploc >= 0) gl->Uniform3fv(ploc, 1, pd);
         if (lloc >= 0) gl->Uniform3fv(lloc, 1, lv);
+        vxl_uniform_i(r, prog, "u_gpage", VXL_GPAGE_UNIT);
+        float gd[3] = {(float)r->gpool_dims[0], (float)r->gpool_dims[1], (float)r->gpool_dims[2]};
+        GLint gloc = gl->GetUniformLocation(prog, "u_gpool_dims");
+        if (gloc >= 0) gl->Uniform3fv(gloc, 1, gd);
     }
     gl->ActiveTexture(GL_TEXTURE0);
     gl->BindTexture(GL_TEXTURE_3D, r->pool_tex ? r->pool_tex : r->volume_tex);

@@ -30,6 +30,9 @@
 #define VXL_PROG_BSPLINE_AXIS 6
 #define VXL_PROG_BRICK_MINMAX 7
 #define VXL_PROG_CLASSIFY_VOLUME 8
+#define VXL_PROG_PAGED_BLUR 9
+#define VXL_PROG_PAGED_GRAD_MAX 10
+#define VXL_PROG_PAGED_GRAD_STORE 11
 
 typedef struct vxl_program_entry {
     uint32_t key;
@@ -75,6 +78,8 @@ struct vxl_renderer {
     /* Precomputed gradients depend only on the volume data and the storage
      * format: rebuilt on set_volume or a format change, never per frame. */
     GLuint gradient_tex;
+    GLuint gpage_tex;          /* bricked: the gradient pool's page table */
+    uint32_t gpool_dims[3];
     int gradient_store;        /* VXL_GRADIENT_STORE_* of gradient_tex */
     uint64_t gradient_bytes;
 
@@ -139,6 +144,9 @@ int vxl_paged_prepare(vxl_renderer *r, const vxl_frame *f); /* f NULL: every dat
 int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify);
 void vxl_paged_release(vxl_renderer *r);
 uint32_t vxl_skip_brick_size(void);
+int vxl_paged_gradients_ensure(vxl_renderer *r, int store); /* paged_gradients.c */
+int vxl_pool_layout(const vxl_renderer *r, uint32_t n, uint32_t edge, uint32_t slots[3]);
+#define VXL_GPAGE_UNIT 9 /* texture unit of the gradient pool's page table */
 #define VXL_PAGE_UNIT 8 /* texture unit of the page table */
 #define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
 

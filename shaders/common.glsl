@@ -36,4 +36,15 @@ float sample_value(vec3 p)
     if (e.w >= 0.0) return e.w;
     return textureLod(u_volume, (e.xyz + q - vec3(b) * u_page_brick + 0.5) / u_pool_dims, 0.0).r;
 }
+
+// The stored value of voxel c (inside the volume, full resolution): what
+// texelFetch of one texture returns.
+float paged_fetch(ivec3 c)
+{
+    int n = int(u_page_brick);
+    ivec3 b = c / n;
+    vec4 e = texelFetch(u_page, b, 0);
+    if (e.w >= 0.0) return e.w;
+    return texelFetch(u_volume, ivec3(e.xyz) + c - b * n, 0).r;
+}
 #endif

@@ -92,12 +92,16 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     case VXL_PROG_GRAD_BLUR:
         rc = compile(r, GL_COMPUTE_SHADER, "gradient_blur.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
-    case VXL_PROG_GRAD_MAX:
-        rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
+    case VXL_PROG_GRAD_MAX: /* the Sobel passes of the dense and the bricked texture */
+    case VXL_PROG_PAGED_GRAD_MAX:
+        rc = compile(r, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_MAX ? "gradient_sobel.comp" : "paged_gradient.comp",
+                     "#define MAX_PASS 1\n", &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_GRAD_STORE:
+    case VXL_PROG_PAGED_GRAD_STORE:
         snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
-        rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", defines, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_STORE ? "gradient_sobel.comp" : "paged_gradient.comp",
+                     defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BSPLINE_COPY:
         rc = compile(r, GL_COMPUTE_SHADER, "bspline_prefilter.comp", "#define COPY_PASS 1\n", &a);
@@ -110,13 +114,6 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_PAGED_BLUR:
         rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
-        return rc ? rc : link(r, a, 0, out);
-    case VXL_PROG_PAGED_GRAD_MAX:
-        rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", "#define MAX_PASS 1\n", &a);
-        return rc ? rc : link(r, a, 0, out);
-    case VXL_PROG_PAGED_GRAD_STORE:
-        snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
-        rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
         rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", NULL, &a);

@@ -85,21 +85,13 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     const uint64_t gbytes = (uint64_t)gslots[0] * gslots[1] * gslots[2] * eg * eg * eg * store_bytes[store],
                    bbytes = (uint64_t)bslots[0] * bslots[1] * bslots[2] * eb * eb * eb * 4,
                    need = r->pool_bytes + gbytes + bbytes + vxl_page_count(pg) * 16;
-    if (need > r->budget) {
-        free(list);
-        return vxl_fail(&r->err, VXL_ERR_LIMIT,
-                        "precomputed gradients of the bricked volume need %.1f MiB in all, over the memory budget of "
-                        "%.1f MiB; use an on-the-fly filter or the 8-bit store",
-                        need / 1048576.0, r->budget / 1048576.0);
-    }
-    GLuint blur_prog, max_prog, store_prog;
-    int rc = vxl_program_get(r, VXL_PROG_PAGED_BLUR, 0, 0, &blur_prog);
-    if (!rc) rc = vxl_program_get(r, VXL_PROG_PAGED_GRAD_MAX, 0, 0, &max_prog);
-    if (!rc) rc = vxl_program_get(r, VXL_PROG_PAGED_GRAD_STORE, 0, (uint32_t)store, &store_prog);
+    GLuint progs[3];
+    int rc = vxl_gradient_programs(r, 1, store, need, progs);
     if (rc) {
         free(list);
         return rc;
     }
+    const GLuint blur_prog = progs[0], max_prog = progs[1], store_prog = progs[2];
     gl->GetError();
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[1]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(count ? count : 1) * 4 * (GLsizeiptr)sizeof(GLint), list,

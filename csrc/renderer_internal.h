@@ -116,6 +116,9 @@ void vxl_programs_delete(vxl_renderer *r);
 
 /* precompute.c */
 int vxl_gradients_ensure(vxl_renderer *r, int store);
+/* The blur, max and store programs of precomputed gradients (paged: bricked
+ * storage), after checking that `need` bytes in all fit the budget. */
+int vxl_gradient_programs(vxl_renderer *r, int paged, int store, uint64_t need, GLuint progs[3]);
 void vxl_gradients_release(vxl_renderer *r);
 int vxl_bspline_ensure(vxl_renderer *r);
 void vxl_bspline_release(vxl_renderer *r);

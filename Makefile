@@ -24,7 +24,7 @@ OBJ := $(LIB_C:csrc/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:csrc/%.cpp=$(BUILD)/obj/%.o)
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
-all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(TESTS)
+all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(TESTS)
 
 $(BUILD)/obj/%.o: csrc/%.c $(wildcard csrc/*.h csrc/include/*.h) | $(BUILD)/obj
 	$(CC) $(CFLAGS) -c $< -o $@
@@ -51,7 +51,10 @@ $(BUILD)/voxlight: csrc/cli.c $(BUILD)/libvoxlight.so
 $(BUILD)/voxlight-bench: bench/bench.c $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
-$(BUILD)/voxlight-skipbench: bench/skip_study.c $(BUILD)/libvoxlight.so
+$(BUILD)/voxlight-skipbench: bench/skip_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
+$(BUILD)/voxlight-storagebench: bench/storage_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h tests/fuzz/*.h) $(BUILD)/libvoxlight.so | $(BUILD)/tests

@@ -143,6 +143,8 @@ case "$cmd" in
         mkdir -p bench/out
         ./build/voxlight-bench "$mode" --out bench/results.csv --scene-dir bench/out
         ./build/voxlight-skipbench $([ "$mode" = --quick ] && echo --quick) --out bench/skipping.csv
+        ./build/voxlight-storagebench $([ "$mode" = --quick ] && echo --quick) \
+            --out "$([ "$mode" = --quick ] && echo bench/out/storage.csv || echo bench/storage.csv)"
         steps=$([ "$mode" = --quick ] && echo 0.5 || echo 1,0.5,0.25)
         xvfb-run -a -s "-screen 0 1024x768x24" /usr/bin/python3 bench/vtk_peer.py bench/out/scene_ch2better.json \
             --out bench/results.csv --steps "$steps"

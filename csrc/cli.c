@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <time.h>
 
 #include "voxlight.h"
 
@@ -17,11 +18,17 @@ static const char usage[] =
     "                  [--gradient-store 8bit|16f|32f] [--classify post|pre|preint] [--no-jitter] [--no-skip]\n"
     "                  [--gradient-opacity off|boundary|iso] [--gradient-ref G] [--iso VALUE] [--iso-thickness R]\n"
     "                  [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
+    "                  [--storage auto|dense|bricked|sparse] [--page-brick 8|16|32|64]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
     "--voxel-size (mm) is for inputs without geometry (TIFF/PNG stacks); one value sets all three\n"
-    "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic; presets: auto gray bone hot mri ct\n";
+    "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic; presets: auto gray bone hot mri ct\n"
+    "storage: auto = one texture when it fits the texture limit and --memory-budget, else bricked;\n"
+    "         sparse keeps only the bricks the transfer function can show (bricked/sparse: the five\n"
+    "         on-the-fly filters, post or preint classification)\n"
+    "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of marschner-lobb sphere ramp\n"
+    "         noisy-blob sparse-balls dense-balls large-sparse (default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
 
 static int die(const char *fmt, ...)
 {
@@ -142,6 +149,30 @@ static uint32_t print_dicom_series(const char *path)
     return n;
 }
 
+/* "phantom:NAME[:WxHxD]" generates an analytic phantom, anything else is a
+ * file. Returns 0 or the library's error code (message in vxl_last_error). */
+static int load_input(const char *input, const vxl_load_options *lo, vxl_volume **v)
+{
+    if (strncmp(input, "phantom:", 8)) return vxl_volume_load(input, lo, v);
+    char name[64];
+    const char *colon = strchr(input + 8, ':');
+    size_t len = colon ? (size_t)(colon - input - 8) : strlen(input + 8);
+    if (len >= sizeof name) len = sizeof name - 1;
+    memcpy(name, input + 8, len);
+    name[len] = '\0';
+    vxl_phantom_desc d = {.struct_size = sizeof d};
+    for (uint32_t k = 1; k < VXL_PHANTOM_COUNT; k++)
+        if (!strcmp(vxl_phantom_name(k), name)) d.kind = k;
+    if (!d.kind) return die("unknown phantom '%s' (see voxlight --help)", name), VXL_ERR_INVALID_ARGUMENT;
+    char extra;
+    if (colon && (sscanf(colon + 1, "%ux%ux%u%c", &d.dims[0], &d.dims[1], &d.dims[2], &extra) != 3 || !d.dims[0] ||
+                  !d.dims[1] || !d.dims[2]))
+        return die("bad phantom size '%s': use WxHxD", colon + 1), VXL_ERR_INVALID_ARGUMENT;
+    int rc = vxl_phantom_create(&d, v);
+    if (rc) die("%s", vxl_last_error());
+    return rc;
+}
+
 static int cmd_info(int argc, char **argv)
 {
     vxl_load_options lo = {.struct_size = sizeof lo};
@@ -162,7 +193,7 @@ static int cmd_info(int argc, char **argv)
         return 0;
     }
     vxl_volume *v = NULL;
-    if (vxl_volume_load(input, &lo, &v)) return die("%s", vxl_last_error());
+    if (load_input(input, &lo, &v)) return strncmp(input, "phantom:", 8) ? die("%s", vxl_last_error()) : 1;
     vxl_volume_info in = {.struct_size = sizeof in};
     vxl_volume_get_info(v, &in);
     /* NIfTI names its two affines; other formats store one (reported as 2) */
@@ -274,6 +305,15 @@ static int parse_render(int argc, char **argv, render_args *a)
             NEED_VALUE();
             if (!parse_size(val, &a->ro.memory_budget_bytes)) return die("bad --memory-budget '%s': e.g. 2G or 512M", val);
             a->lo.memory_budget_bytes = a->ro.memory_budget_bytes;
+        } else if (!strcmp(o, "--storage")) {
+            NEED_VALUE();
+            if (vxl_storage_from_name(val, &a->ro.storage)) return die("unknown storage '%s' (auto, dense, bricked, sparse)", val);
+        } else if (!strcmp(o, "--page-brick")) {
+            NEED_VALUE();
+            char *end;
+            long b = strtol(val, &end, 10);
+            if (*end || (b != 8 && b != 16 && b != 32 && b != 64)) return die("bad --page-brick '%s': 8, 16, 32 or 64", val);
+            a->ro.page_brick = (uint32_t)b;
         } else if ((r = parse_input_option(argc, argv, &i, &a->lo)) != 0) {
             if (r < 0) return 1;
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
@@ -299,7 +339,10 @@ static int cmd_render(int argc, char **argv)
     vxl_renderer *r = NULL;
     float *rgba = NULL, *depth = NULL;
     int status = 1;
-    if (vxl_volume_load(a.input, &a.lo, &v)) { die("%s", vxl_last_error()); goto done; }
+    if (load_input(a.input, &a.lo, &v)) {
+        if (strncmp(a.input, "phantom:", 8)) die("%s", vxl_last_error());
+        goto done;
+    }
     if (vxl_renderer_create(&a.ro, &r)) { die("%s", vxl_last_error()); goto done; }
     if (vxl_renderer_set_volume(r, v)) { die("%s", vxl_renderer_error(r)); goto done; }
     vxl_volume_destroy(v);
@@ -307,11 +350,29 @@ static int cmd_render(int argc, char **argv)
     rgba = malloc((size_t)w * h * 4 * sizeof *rgba);
     depth = malloc((size_t)w * h * sizeof *depth);
     if (!rgba || !depth) { die("out of memory for a %ux%u image", w, h); goto done; }
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     if (vxl_render(r, &a.p, rgba, depth)) { die("%s", vxl_renderer_error(r)); goto done; }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
     if (vxl_write_image(a.output, rgba, depth, w, h)) { die("%s", vxl_last_error()); goto done; }
     vxl_renderer_info ri = {.struct_size = sizeof ri};
     vxl_renderer_get_info(r, &ri);
     fprintf(stderr, "voxlight: wrote %s (%ux%u, %s, %s)\n", a.output, w, h, ri.backend_name, ri.gl_renderer);
+    vxl_render_stats st = {.struct_size = sizeof st};
+    vxl_renderer_get_stats(r, &st);
+    double secs = (double)(t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9;
+    if (st.page_brick)
+        fprintf(stderr, "voxlight: storage %s, %.1f MiB resident, %u of %u bricks of %u^3 in the pool, %u constant; frame %.3f s\n",
+                vxl_storage_name(st.storage), st.resident_bytes / 1048576.0, st.pages_resident, st.pages_total,
+                st.page_brick, st.pages_constant, secs);
+    else
+        fprintf(stderr, "voxlight: storage %s, %.1f MiB resident; frame %.3f s\n", vxl_storage_name(st.storage),
+                st.resident_bytes / 1048576.0, secs);
+    if (st.lod_level) /* never silently coarser */
+        fprintf(stderr, "voxlight: LOD fallback: level %u (%ux coarser per axis): the visible bricks need %.1f MiB at full "
+                "resolution, over the memory budget of %.1f MiB\n", st.lod_level, 1u << st.lod_level,
+                st.lod_wanted_bytes / 1048576.0,
+                (a.ro.memory_budget_bytes ? a.ro.memory_budget_bytes : 2ull << 30) / 1048576.0);
     status = 0;
 done:
     free(rgba);

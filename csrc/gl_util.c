@@ -12,7 +12,8 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
     "#define FILTER_CUBIC 1\n"};
 
 /* flags bits for RAYCAST: 1 shading, 2 reuse gradients, bits 2-3 the
- * classify mode, bits 4-5 the gradient-opacity mode; for GRAD_STORE: the store format */
+ * classify mode, bits 4-5 the gradient-opacity mode, bit 6 (also PROBE)
+ * bricked storage; for GRAD_STORE: the store format */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
 
 static int compile(vxl_renderer *r, GLenum type, const char *file, const char *defines, GLuint *out)
@@ -65,11 +66,12 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
 {
     char defines[256] = "";
     const char *fdef = filter < VXL_FILTER_COUNT ? filter_defines[filter] : filter_defines[0];
+    const char *paged = (flags & VXL_FLAG_PAGED) ? "#define PAGED 1\n" : "";
     GLuint a = 0, b = 0;
     int rc;
     switch (kind) {
     case VXL_PROG_RAYCAST:
-        snprintf(defines, sizeof defines, "%s#define GOPACITY %u\n%s%s%s", fdef, (flags >> 4) & 3,
+        snprintf(defines, sizeof defines, "%s%s#define GOPACITY %u\n%s%s%s", paged, fdef, (flags >> 4) & 3,
                  (flags & 1) ? "#define SHADING 1\n" : "",
                  (flags & 2) ? "#define REUSE_GRADIENTS 1\n" : "",
                  ((flags >> 2) & 3) == VXL_CLASSIFY_PRE      ? "#define CLASSIFY_PRE 1\n"
@@ -84,17 +86,22 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
         }
         return link(r, a, b, out);
     case VXL_PROG_PROBE:
-        rc = compile(r, GL_COMPUTE_SHADER, "probe.comp", fdef, &a);
+        snprintf(defines, sizeof defines, "%s%s", paged, fdef);
+        rc = compile(r, GL_COMPUTE_SHADER, "probe.comp", defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_GRAD_BLUR:
         rc = compile(r, GL_COMPUTE_SHADER, "gradient_blur.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
-    case VXL_PROG_GRAD_MAX:
-        rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
+    case VXL_PROG_GRAD_MAX: /* the Sobel passes of the dense and the bricked texture */
+    case VXL_PROG_PAGED_GRAD_MAX:
+        rc = compile(r, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_MAX ? "gradient_sobel.comp" : "paged_gradient.comp",
+                     "#define MAX_PASS 1\n", &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_GRAD_STORE:
+    case VXL_PROG_PAGED_GRAD_STORE:
         snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
-        rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", defines, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_STORE ? "gradient_sobel.comp" : "paged_gradient.comp",
+                     defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BSPLINE_COPY:
         rc = compile(r, GL_COMPUTE_SHADER, "bspline_prefilter.comp", "#define COPY_PASS 1\n", &a);
@@ -104,6 +111,9 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_CLASSIFY_VOLUME:
         rc = compile(r, GL_COMPUTE_SHADER, "classify_volume.comp", NULL, &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_PAGED_BLUR:
+        rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
         rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);

@@ -5,13 +5,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "phantom_large.h"
 #include "volume.h"
 
 #define ML_FM 6.0
 #define ML_ALPHA 0.25
 
 static const char *const names[VXL_PHANTOM_COUNT] = {NULL,         "marschner-lobb", "sphere",      "ramp",
-                                                     "noisy-blob", "sparse-balls",   "dense-balls"};
+                                                     "noisy-blob", "sparse-balls",   "dense-balls",
+                                                     "large-sparse"};
 
 #define LATTICE 8
 #define BALL_SIGMA 0.06
@@ -55,8 +57,9 @@ static int resolve(const vxl_phantom_desc *d, uint32_t dims[3], vxl_err *e)
     if (!d) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "phantom description is NULL");
     if (d->kind == 0 || d->kind >= VXL_PHANTOM_COUNT)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown phantom kind %u", d->kind);
+    const uint32_t large[3] = VXL_LARGE_SPARSE_DIMS;
     for (int a = 0; a < 3; a++) {
-        dims[a] = d->dims[a] ? d->dims[a] : 64;
+        dims[a] = d->dims[a] ? d->dims[a] : d->kind == VXL_PHANTOM_LARGE_SPARSE ? large[a] : 64;
         if (dims[a] < 2) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "phantoms need at least 2 voxels per axis");
     }
     return VXL_OK;
@@ -94,6 +97,8 @@ static double field(uint32_t kind, const double u[3], double g[3])
     case VXL_PHANTOM_SPARSE_BALLS:
     case VXL_PHANTOM_DENSE_BALLS:
         return balls(kind, u, g);
+    case VXL_PHANTOM_LARGE_SPARSE:
+        return vxl_large_sparse_field(u, g);
     default: { /* NOISY_BLOB: Gaussian blob, sigma 0.4 */
         double r2 = x * x + y * y + z * z, s2 = 0.16, v = exp(-r2 / (2 * s2));
         g[0] = -x / s2 * v;
@@ -134,8 +139,15 @@ int vxl_phantom_create(const vxl_phantom_desc *d, vxl_volume **out)
     if (!out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
     *out = NULL;
     int rc = resolve(d, dims, NULL);
-    if (!rc) rc = vxl_volume_check_limits(dims, 4, NULL, NULL);
     if (rc) return rc;
+    double affine[16] = {0};
+    for (int a = 0; a < 3; a++) {
+        affine[a * 4 + a] = 2.0 / (dims[a] - 1);
+        affine[12 + a] = -1.0;
+    }
+    affine[15] = 1;
+    if (d->kind == VXL_PHANTOM_LARGE_SPARSE) return vxl_large_sparse_create(dims, affine, out);
+    if ((rc = vxl_volume_check_limits(dims, 4, NULL, NULL))) return rc;
     size_t n = (size_t)dims[0] * dims[1] * dims[2];
     float *data = malloc(n * sizeof *data);
     if (!data) return vxl_fail(NULL, VXL_ERR_NO_MEMORY, "out of memory for the phantom");
@@ -149,12 +161,6 @@ int vxl_phantom_create(const vxl_phantom_desc *d, vxl_volume **out)
                 if (d->kind == VXL_PHANTOM_NOISY_BLOB) v += sigma * gaussian(&seed);
                 data[i + (size_t)dims[0] * (j + (size_t)dims[1] * k)] = (float)v;
             }
-    double affine[16] = {0};
-    for (int a = 0; a < 3; a++) {
-        affine[a * 4 + a] = 2.0 / (dims[a] - 1);
-        affine[12 + a] = -1.0;
-    }
-    affine[15] = 1;
     double spacing[3] = {affine[0], affine[5], affine[10]};
     rc = vxl_volume_build(data, VXL_DTYPE_F32, dims, spacing, affine, 0, 0, NULL, out, NULL);
     free(data);

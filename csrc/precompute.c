@@ -10,7 +10,8 @@ static const uint32_t store_bytes[] = {4, 8, 16};
 void vxl_gradients_release(vxl_renderer *r)
 {
     if (r->gradient_tex) r->gl.DeleteTextures(1, &r->gradient_tex);
-    r->gradient_tex = 0;
+    if (r->gpage_tex) r->gl.DeleteTextures(1, &r->gpage_tex);
+    r->gradient_tex = r->gpage_tex = 0;
     r->gradient_bytes = 0;
 }
 
@@ -19,6 +20,19 @@ static GLuint groups(uint32_t n) { return (n + 3) / 4; }
 static void dispatch_volume(vxl_renderer *r)
 {
     r->gl.DispatchCompute(groups(r->dims[0]), groups(r->dims[1]), groups(r->dims[2]));
+}
+
+int vxl_gradient_programs(vxl_renderer *r, int paged, int store, uint64_t need, GLuint progs[3])
+{
+    if (need > r->budget)
+        return vxl_fail(&r->err, VXL_ERR_LIMIT,
+                        "precomputed gradients%s need %.1f MiB in all, over the memory budget of %.1f MiB; "
+                        "use an on-the-fly filter or the 8-bit store",
+                        paged ? " of the bricked volume" : "", need / 1048576.0, r->budget / 1048576.0);
+    int rc = vxl_program_get(r, paged ? VXL_PROG_PAGED_BLUR : VXL_PROG_GRAD_BLUR, 0, 0, &progs[0]);
+    if (!rc) rc = vxl_program_get(r, paged ? VXL_PROG_PAGED_GRAD_MAX : VXL_PROG_GRAD_MAX, 0, 0, &progs[1]);
+    if (!rc) rc = vxl_program_get(r, paged ? VXL_PROG_PAGED_GRAD_STORE : VXL_PROG_GRAD_STORE, 0, (uint32_t)store, &progs[2]);
+    return rc;
 }
 
 int vxl_gradients_ensure(vxl_renderer *r, int store)
@@ -30,16 +44,10 @@ int vxl_gradients_ensure(vxl_renderer *r, int store)
     vxl_gl *gl = &r->gl;
     uint64_t n = (uint64_t)r->dims[0] * r->dims[1] * r->dims[2];
     uint64_t need = r->volume_bytes + n * store_bytes[store] + n * 4 /* transient blur */;
-    if (need > r->budget)
-        return vxl_fail(&r->err, VXL_ERR_LIMIT,
-                        "precomputed gradients need %.1f MiB in all, over the memory budget of %.1f MiB; "
-                        "use an on-the-fly filter or the 8-bit store",
-                        need / 1048576.0, r->budget / 1048576.0);
-    GLuint blur_prog, max_prog, store_prog;
-    int rc = vxl_program_get(r, VXL_PROG_GRAD_BLUR, 0, 0, &blur_prog);
-    if (!rc) rc = vxl_program_get(r, VXL_PROG_GRAD_MAX, 0, 0, &max_prog);
-    if (!rc) rc = vxl_program_get(r, VXL_PROG_GRAD_STORE, 0, (uint32_t)store, &store_prog);
+    GLuint progs[3];
+    int rc = vxl_gradient_programs(r, 0, store, need, progs);
     if (rc) return rc;
+    const GLuint blur_prog = progs[0], max_prog = progs[1], store_prog = progs[2];
     gl->GetError();
 
     /* pass 1: blur into a transient float texture */

@@ -50,8 +50,14 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
 {
     vxl_gl *gl = &r->gl;
     if (filter == VXL_FILTER_PRECOMPUTED) {
-        int rc = vxl_gradients_ensure(r, store);
+        if (store < 0 || store > VXL_GRADIENT_STORE_32F)
+            return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown gradient_store %d", store);
+        int rc = r->volume_tex ? vxl_gradients_ensure(r, store) : vxl_paged_gradients_ensure(r, store);
         if (rc) return rc;
+        if (r->gpage_tex) {
+            gl->ActiveTexture(GL_TEXTURE0 + VXL_GPAGE_UNIT);
+            gl->BindTexture(GL_TEXTURE_3D, r->gpage_tex);
+        }
         gl->ActiveTexture(GL_TEXTURE1);
         gl->BindTexture(GL_TEXTURE_3D, r->gradient_tex);
     } else if (filter == VXL_FILTER_CUBIC) {
@@ -61,8 +67,25 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
         gl->BindTexture(GL_TEXTURE_3D, r->bspline_tex);
     }
     gl->UseProgram(prog);
+    if (r->pool_tex) { /* bricked: the pool stands in for the volume, the page table translates */
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_PAGE_UNIT);
+        gl->BindTexture(GL_TEXTURE_3D, r->page_tex);
+        vxl_uniform_i(r, prog, "u_page", VXL_PAGE_UNIT);
+        vxl_uniform_f(r, prog, "u_page_brick", (float)r->levels[r->level].brick);
+        vxl_uniform_f(r, prog, "u_lod_scale", (float)(1u << r->level));
+        const uint32_t *ld = r->level_dims[r->level];
+        float pd[3] = {(float)r->pool_dims[0], (float)r->pool_dims[1], (float)r->pool_dims[2]};
+        float lv[3] = {(float)ld[0], (float)ld[1], (float)ld[2]};
+        GLint ploc = gl->GetUniformLocation(prog, "u_pool_dims"), lloc = gl->GetUniformLocation(prog, "u_page_dims");
+        if (ploc >= 0) gl->Uniform3fv(ploc, 1, pd);
+        if (lloc >= 0) gl->Uniform3fv(lloc, 1, lv);
+        vxl_uniform_i(r, prog, "u_gpage", VXL_GPAGE_UNIT);
+        float gd[3] = {(float)r->gpool_dims[0], (float)r->gpool_dims[1], (float)r->gpool_dims[2]};
+        GLint gloc = gl->GetUniformLocation(prog, "u_gpool_dims");
+        if (gloc >= 0) gl->Uniform3fv(gloc, 1, gd);
+    }
     gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
+    gl->BindTexture(GL_TEXTURE_3D, r->pool_tex ? r->pool_tex : r->volume_tex);
     vxl_uniform_i(r, prog, "u_volume", 0);
     vxl_uniform_i(r, prog, "u_gradient", 1);
     vxl_uniform_i(r, prog, "u_bspline", 1);
@@ -164,16 +187,19 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     vxl_gl *gl = &r->gl;
     GLuint prog;
     uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2) |
-                     (f->gopacity << 4);
+                     (f->gopacity << 4) | (r->volume_tex ? 0u : VXL_FLAG_PAGED);
     /* rays that never evaluate gradients: one program serves every filter */
     uint32_t filter = f->shading || f->gopacity ? f->filter : VXL_FILTER_CENTRAL;
-    int rc = vxl_program_get(r, VXL_PROG_RAYCAST, filter, flags, &prog);
+    int rc = vxl_paged_check_filter(r, filter, f->classify);
+    if (!rc) rc = vxl_program_get(r, VXL_PROG_RAYCAST, filter, flags, &prog);
     if (!rc) rc = ensure_framebuffer(r, f->width, f->height);
     if (rc) return rc;
     gl->GetError();
     upload_tf(r, f);
     if (f->scene_depth) upload_scene_depth(r, f);
-    if (f->skip && (rc = vxl_skipping_prepare(r, f))) return rc;
+    /* bricked storage derives its resident set from the skipping grid */
+    if ((f->skip || !r->volume_tex) && (rc = vxl_skipping_prepare(r, f))) return rc;
+    if ((rc = vxl_paged_prepare(r, f))) return rc;
     if ((rc = vxl_classification_prepare(r, f))) return rc;
     rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
     if (rc) return rc;
@@ -233,6 +259,16 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
         r->stats.bricks_total = r->bricks.dims[0] * r->bricks.dims[1] * r->bricks.dims[2];
         r->stats.bricks_occupied = r->bricks.occupied;
         r->stats.brick_size = r->bricks.size;
+    }
+    r->stats.storage = r->storage;
+    r->stats.resident_bytes = r->volume_tex ? r->volume_bytes : r->pool_bytes;
+    if (!r->volume_tex) {
+        r->stats.page_brick = r->levels[r->level].brick;
+        r->stats.pages_total = (uint32_t)vxl_page_count(&r->levels[r->level]);
+        r->stats.lod_level = r->level;
+        r->stats.lod_wanted_bytes = r->lod_wanted_bytes;
+        r->stats.pages_resident = r->pages_resident;
+        r->stats.pages_constant = r->pages_constant;
     }
     return VXL_OK;
 }

@@ -1,5 +1,6 @@
 /* renderer.c - renderer lifecycle and volume upload. Every GL call runs on
  * the renderer's thread through vxl_gl_thread_call. */
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -64,6 +65,7 @@ static int job_close(void *p)
         vxl_bspline_release(r);
         vxl_skipping_release(r);
         vxl_classification_release(r);
+        vxl_paged_release(r);
         delete_texture(r, &r->volume_tex);
         delete_texture(r, &r->color_tex);
         delete_texture(r, &r->depth_tex);
@@ -86,6 +88,14 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     vxl_renderer *r = calloc(1, sizeof *r);
     if (!r) return vxl_fail(NULL, VXL_ERR_NO_MEMORY, "out of memory for the renderer");
     r->budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
+    if (opt && opt->struct_size >= offsetof(vxl_renderer_options, page_brick) + sizeof opt->page_brick) {
+        if (opt->storage >= VXL_STORAGE_COUNT) {
+            free(r);
+            return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "unknown storage %u", opt->storage);
+        }
+        r->storage_request = opt->storage;
+        r->page_brick_request = opt->page_brick;
+    }
     const char *dir = (opt && opt->shader_dir) ? opt->shader_dir : getenv("VOXLIGHT_SHADER_DIR");
     if (dir && *dir && !(r->shader_dir = strdup(dir))) {
         free(r);
@@ -125,7 +135,12 @@ typedef struct stats_job {
 static int job_stats(void *p)
 {
     stats_job *j = p;
-    *j->out = j->r->stats;
+    /* a caller built against an older header has a shorter struct: copy
+     * only what its struct_size covers (0: the whole of this header's) */
+    size_t n = j->out->struct_size && j->out->struct_size < sizeof *j->out ? j->out->struct_size : sizeof *j->out;
+    uint32_t asked = j->out->struct_size;
+    memcpy(j->out, &j->r->stats, n);
+    if (asked) j->out->struct_size = asked;
     return VXL_OK;
 }
 
@@ -153,34 +168,68 @@ typedef struct volume_job {
 static const GLenum internal_formats[] = {GL_R8, GL_R16, GL_R32F};
 static const GLenum texel_types[] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_SHORT, GL_FLOAT};
 
-static int job_set_volume(void *p)
+/* DENSE when asked, or (AUTO) when one texture fits the limit and budget. */
+static uint32_t choose_storage(const vxl_renderer *r, const vxl_volume *v)
 {
-    volume_job *j = p;
-    vxl_renderer *r = j->r;
-    const vxl_volume *v = j->v;
+    if (r->storage_request != VXL_STORAGE_AUTO) return r->storage_request;
+    for (int a = 0; a < 3; a++)
+        if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size) return VXL_STORAGE_AUTO;
+    return v->storage_bytes > r->budget ? VXL_STORAGE_AUTO : VXL_STORAGE_DENSE;
+}
+
+static int upload_dense(vxl_renderer *r, const vxl_volume *v)
+{
     for (int a = 0; a < 3; a++)
         if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size)
             return vxl_fail(&r->err, VXL_ERR_LIMIT,
-                            "volume %ux%ux%u exceeds this backend's 3D texture limit of %d per axis",
+                            "volume %ux%ux%u exceeds this backend's 3D texture limit of %d per axis (bricked "
+                            "storage has no such limit)",
                             v->dims[0], v->dims[1], v->dims[2], r->info.max_3d_texture_size);
     if (v->storage_bytes > r->budget)
         return vxl_fail(&r->err, VXL_ERR_LIMIT, "volume needs %.1f MiB, over the renderer's memory budget of %.1f MiB",
                         v->storage_bytes / 1048576.0, r->budget / 1048576.0);
-    /* Everything derived from the old volume goes: the data changed. */
-    vxl_gradients_release(r);
-    vxl_bspline_release(r);
-    vxl_skipping_release(r);
-    vxl_classification_release(r);
-    delete_texture(r, &r->volume_tex);
-    r->has_volume = 0;
     int fi = v->texture_bits == 8 ? 0 : v->texture_bits == 16 ? 1 : 2;
     r->gl.GetError();
     r->volume_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
     r->gl.TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)v->dims[0], (GLsizei)v->dims[1],
                      (GLsizei)v->dims[2], 0, GL_RED, texel_types[fi], v->texels);
     int rc = vxl_gl_check(r, "uploading the volume");
+    if (rc) delete_texture(r, &r->volume_tex);
+    r->storage = VXL_STORAGE_DENSE;
+    return rc;
+}
+
+static int job_set_volume(void *p)
+{
+    volume_job *j = p;
+    vxl_renderer *r = j->r;
+    const vxl_volume *v = j->v;
+    uint32_t storage = choose_storage(r, v);
+    vxl_paged_volume pv;
+    /* refuse before anything is released: a failed set_volume loses nothing */
+    if (storage == VXL_STORAGE_DENSE) {
+        for (int a = 0; a < 3; a++)
+            if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size || v->storage_bytes > r->budget)
+                return upload_dense(r, v);
+    } else {
+        int rc = vxl_paged_plan(r, v, storage, &pv);
+        if (rc) return rc;
+    }
+    /* Everything derived from the old volume goes: the data changed. */
+    vxl_gradients_release(r);
+    vxl_bspline_release(r);
+    vxl_skipping_release(r);
+    vxl_classification_release(r);
+    vxl_paged_release(r);
+    delete_texture(r, &r->volume_tex);
+    r->has_volume = 0;
+    r->storage = 0;
+    int rc = storage == VXL_STORAGE_DENSE ? upload_dense(r, v) : vxl_paged_install(r, &pv);
     if (rc) {
+        vxl_skipping_release(r);
+        vxl_paged_release(r);
         delete_texture(r, &r->volume_tex);
+        r->storage = 0;
         return rc;
     }
     memcpy(r->dims, v->dims, sizeof r->dims);
@@ -189,7 +238,7 @@ static int job_set_volume(void *p)
     r->value_min = v->value_min;
     r->value_max = v->value_max;
     memcpy(r->affine, v->affine, sizeof r->affine);
-    r->volume_bytes = v->storage_bytes;
+    r->volume_bytes = storage == VXL_STORAGE_DENSE ? v->storage_bytes : r->pool_bytes;
     r->has_volume = 1;
     return VXL_OK;
 }

@@ -6,14 +6,16 @@
 #include <stdint.h>
 
 #include "bricks.h"
+#include "paging.h"
 #include "context.h"
 #include "error.h"
 #include "gl_funcs.h"
 #include "gl_thread.h"
+#include "lod.h"
 #include "frame.h"
 #include "voxlight.h"
 
-#define VXL_MAX_PROGRAMS 512 /* every raycast variant (7*4*3*3) plus compute programs */
+#define VXL_MAX_PROGRAMS 1024 /* every raycast variant (7*4*3*3, dense and paged) plus compute programs */
 #define VXL_MAX_SAMPLES_PER_RAY 16384 /* bounds every ray, whatever the step */
 #define VXL_MAX_IMAGE_SIDE 16384
 #define VXL_SCRATCH_UNIT 7 /* texture unit used only to create and fill textures */
@@ -28,6 +30,9 @@
 #define VXL_PROG_BSPLINE_AXIS 6
 #define VXL_PROG_BRICK_MINMAX 7
 #define VXL_PROG_CLASSIFY_VOLUME 8
+#define VXL_PROG_PAGED_BLUR 9
+#define VXL_PROG_PAGED_GRAD_MAX 10
+#define VXL_PROG_PAGED_GRAD_STORE 11
 
 typedef struct vxl_program_entry {
     uint32_t key;
@@ -51,9 +56,30 @@ struct vxl_renderer {
     GLuint volume_tex;
     uint64_t volume_bytes;
 
+    /* Bricked storage (paged.c): storage is the VXL_STORAGE_* in use. When
+     * bricked, volume_tex is 0 and samples go through the page table into
+     * the pool. SPARSE keeps the CPU bricks (pages.data) to make bricks
+     * resident when the classification changes. */
+    uint32_t storage;
+    uint32_t page_brick_request;  /* from the options; 0 = default */
+    uint32_t storage_request;     /* VXL_STORAGE_* asked for */
+    vxl_pages levels[VXL_LOD_LEVELS]; /* [0] full resolution; coarser ones only when sparse */
+    uint32_t level_dims[VXL_LOD_LEVELS][3];
+    uint32_t n_levels, level;         /* level in the pool now (0 unless the budget forced a fallback) */
+    uint64_t lod_wanted_bytes;        /* what full resolution would need when level > 0 */
+    GLuint pool_tex, page_tex;
+    uint32_t pool_dims[3];
+    uint8_t *resident;            /* per page brick: 1 if its data is in the pool */
+    float *page_entries;          /* RGBA per page brick, as uploaded */
+    uint32_t pages_resident, pages_constant;
+    uint64_t pool_bytes;
+    uint32_t pool_reach;          /* the tap reach (voxels) the resident set was derived for */
+
     /* Precomputed gradients depend only on the volume data and the storage
      * format: rebuilt on set_volume or a format change, never per frame. */
     GLuint gradient_tex;
+    GLuint gpage_tex;          /* bricked: the gradient pool's page table */
+    uint32_t gpool_dims[3];
     int gradient_store;        /* VXL_GRADIENT_STORE_* of gradient_tex */
     float gradient_max;        /* largest |gradient| (value per voxel): gradient_tex holds g / gradient_max */
     uint64_t gradient_bytes;
@@ -91,6 +117,9 @@ void vxl_programs_delete(vxl_renderer *r);
 
 /* precompute.c */
 int vxl_gradients_ensure(vxl_renderer *r, int store);
+/* The blur, max and store programs of precomputed gradients (paged: bricked
+ * storage), after checking that `need` bytes in all fit the budget. */
+int vxl_gradient_programs(vxl_renderer *r, int paged, int store, uint64_t need, GLuint progs[3]);
 void vxl_gradients_release(vxl_renderer *r);
 int vxl_bspline_ensure(vxl_renderer *r);
 void vxl_bspline_release(vxl_renderer *r);
@@ -102,6 +131,28 @@ void vxl_classification_release(vxl_renderer *r);
 /* skipping.c */
 int vxl_skipping_prepare(vxl_renderer *r, const vxl_frame *f);
 void vxl_skipping_release(vxl_renderer *r);
+
+/* paged.c: bricked storage on the GL side */
+/* A volume cut into bricks on the CPU, checked against the budget and the
+ * texture limit before the renderer lets go of its current volume. */
+typedef struct vxl_paged_volume {
+    vxl_pages levels[VXL_LOD_LEVELS];
+    uint32_t level_dims[VXL_LOD_LEVELS][3];
+    uint32_t n_levels;
+    vxl_bricks bricks;
+    uint32_t storage;   /* BRICKED or SPARSE */
+} vxl_paged_volume;
+int vxl_paged_plan(vxl_renderer *r, const vxl_volume *v, uint32_t storage, vxl_paged_volume *out);
+int vxl_paged_install(vxl_renderer *r, vxl_paged_volume *pv); /* takes pv's storage */
+int vxl_paged_prepare(vxl_renderer *r, const vxl_frame *f); /* f NULL: every data brick (probes) */
+int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify);
+void vxl_paged_release(vxl_renderer *r);
+uint32_t vxl_skip_brick_size(void);
+int vxl_paged_gradients_ensure(vxl_renderer *r, int store); /* paged_gradients.c */
+int vxl_pool_layout(const vxl_renderer *r, uint32_t n, uint32_t edge, uint32_t slots[3]);
+#define VXL_GPAGE_UNIT 9 /* texture unit of the gradient pool's page table */
+#define VXL_PAGE_UNIT 8 /* texture unit of the page table */
+#define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
 
 /* render.c helpers shared with probe.c */
 int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store);

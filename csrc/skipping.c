@@ -7,7 +7,7 @@
 
 #include "renderer_internal.h"
 
-static uint32_t brick_size(void)
+uint32_t vxl_skip_brick_size(void)
 {
     const char *env = getenv("VOXLIGHT_BRICK_SIZE");
     long v = env ? strtol(env, NULL, 10) : 0;
@@ -53,7 +53,7 @@ static int brick_pass(vxl_renderer *r, uint32_t apron, float *out)
 static int build_minmax(vxl_renderer *r)
 {
     vxl_bricks *b = &r->bricks;
-    b->size = brick_size();
+    b->size = vxl_skip_brick_size();
     for (int a = 0; a < 3; a++) b->dims[a] = (r->dims[a] + b->size - 1) / b->size;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     b->minmax = malloc(n * 2 * sizeof(float));
@@ -63,12 +63,15 @@ static int build_minmax(vxl_renderer *r)
 
 /* Iso-surface skipping needs a gradient bound over the taps' reach; built on
  * first use and rebuilt only for a wider reach. Reaches beyond a brick's edge
- * are not bounded (the pass would read (3 bricks)^3 per brick): no leaps. */
+ * are not bounded (the pass would read (3 bricks)^3 per brick): no leaps.
+ * Nor is bricked storage (the pass reads the one volume texture): there
+ * every brick counts as occupied in iso mode. */
 static int ensure_gradient_bound(vxl_renderer *r, const vxl_frame *f)
 {
     vxl_bricks *b = &r->bricks;
     uint32_t need = vxl_bricks_gradient_apron(f);
-    if (f->gopacity != VXL_GOPACITY_ISO || !need || need > b->size || (b->gbound && b->gbound_apron >= need))
+    if (f->gopacity != VXL_GOPACITY_ISO || !need || need > b->size || !r->volume_tex ||
+        (b->gbound && b->gbound_apron >= need))
         return VXL_OK;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     float *tmp = malloc(n * 2 * sizeof *tmp);

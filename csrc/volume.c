@@ -256,6 +256,13 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
     return VXL_OK;
 }
 
+double vxl_volume_texel(const vxl_volume *v, size_t i)
+{
+    if (v->texture_bits == 8) return ((const uint8_t *)v->texels)[i] / 255.0;
+    if (v->texture_bits == 16) return ((const uint16_t *)v->texels)[i] / 65535.0;
+    return ((const float *)v->texels)[i];
+}
+
 int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double hi, uint64_t *counts)
 {
     if (!v || !counts || bins == 0)
@@ -268,10 +275,7 @@ int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double h
     const double span = v->tex_hi - v->tex_lo, scale = bins / (hi - lo);
     const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
     for (uint64_t i = 0; i < n; i++) {
-        double t;
-        if (v->texture_bits == 8) t = ((const uint8_t *)v->texels)[i] / 255.0;
-        else if (v->texture_bits == 16) t = ((const uint16_t *)v->texels)[i] / 65535.0;
-        else t = ((const float *)v->texels)[i];
+        double t = vxl_volume_texel(v, (size_t)i);
         double b = (v->tex_lo + t * span - lo) * scale;
         if (b >= 0 && b <= bins) counts[b >= bins ? bins - 1 : (uint32_t)b]++;
     }

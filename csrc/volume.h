@@ -3,6 +3,7 @@
 #ifndef VXL_VOLUME_H
 #define VXL_VOLUME_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "error.h"
@@ -33,6 +34,9 @@ struct vxl_volume {
  * bytes_per_voxel is what the texture will cost. */
 int vxl_volume_check_limits(const uint32_t dims[3], uint32_t bytes_per_voxel,
                             const vxl_load_options *opt, vxl_err *e);
+
+/* The stored normalised value of voxel i (x fastest), as the GL texture reads it. */
+double vxl_volume_texel(const vxl_volume *v, size_t i);
 
 /* Texture bits used for a source dtype. */
 uint32_t vxl_texture_bits_for(uint32_t dtype);

@@ -41,11 +41,14 @@ class ImportJob:
     then `entry` (an unregistered runtime.VolumeEntry) or `error` (the
     library's message, which names the file) is set."""
 
-    def __init__(self, path, backend="auto", voxel_size=None, start=True, series=""):
+    def __init__(self, path, voxel_size=None, start=True, series="", backend="auto", storage="auto",
+                 memory_budget=0):
         self.path = path
         self.backend = backend
         self.voxel_size = voxel_size
         self.series = series
+        self.storage = storage
+        self.memory_budget = memory_budget
         self.progress = 0.0
         self.entry = None
         self.error = None
@@ -72,7 +75,8 @@ class ImportJob:
         """The work; called on the thread, or directly for a blocking import."""
         try:
             entry = runtime.open_volume(self.path, self.backend, self._set_progress, self.voxel_size,
-                                        cancelled=self._cancelled.is_set, series=self.series)
+                                        cancelled=self._cancelled.is_set, series=self.series,
+                                        storage=self.storage, memory_budget=self.memory_budget)
         except (native.VoxlightError, OSError) as e:
             self.error = str(e)
             entry = None

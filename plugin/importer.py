@@ -28,6 +28,8 @@ def _to_matrix(a):
 def resolve_path(filepath, directory):
     """The file, or the folder when no file was picked (the browser then
     gives a filepath ending in a separator, or only the directory)."""
+    if runtime.is_phantom(filepath):  # a generated volume, named, not a file
+        return filepath
     path = bpy.path.abspath(filepath) if filepath else ""
     if (not path or path.endswith(os.sep)) and directory:
         path = bpy.path.abspath(directory)
@@ -90,15 +92,15 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         path = resolve_path(self.filepath, self.directory)
-        backend = context.scene.voxlight.backend
+        opts = runtime.options_of(context.scene.voxlight)  # backend, storage, memory budget
         if self.use_modal and context.window is not None:
-            self._job = import_job.ImportJob(path, backend, tuple(self.voxel_size), series=self.series)
+            self._job = import_job.ImportJob(path, tuple(self.voxel_size), series=self.series, **opts)
             wm = context.window_manager
             wm.progress_begin(0.0, 1.0)
             self._timer = wm.event_timer_add(0.1, window=context.window)
             wm.modal_handler_add(self)
             return {"RUNNING_MODAL"}
-        job = import_job.ImportJob(path, backend, tuple(self.voxel_size), start=False, series=self.series)
+        job = import_job.ImportJob(path, tuple(self.voxel_size), start=False, series=self.series, **opts)
         job.run()
         return self._finish(context, job)
 

@@ -32,6 +32,7 @@ LIBRARY_NAME = "libvoxlight.so"
 FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed", "cubic")
 PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
 BACKENDS = ("auto", "osmesa", "egl")
+STORAGES = ("auto", "dense", "bricked", "sparse")  # VXL_STORAGE_*
 MAX_LIGHTS = 8
 # VXL_CLASSIFY_* and VXL_GOPACITY_* order.
 CLASSIFY_MODES = ("post", "pre", "preint")
@@ -106,11 +107,21 @@ class VolumeInfo(ctypes.Structure):
                 ("frame", ctypes.c_uint32)]
 
 
+class PhantomDesc(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("kind", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("seed", ctypes.c_uint32),
+                ("noise_sigma", ctypes.c_double)]
+
+
 class RendererOptions(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("backend", ctypes.c_uint32),
                 ("memory_budget_bytes", ctypes.c_uint64),
-                ("shader_dir", ctypes.c_char_p)]
+                ("shader_dir", ctypes.c_char_p),
+                ("storage", ctypes.c_uint32),
+                ("page_brick", ctypes.c_uint32)]
 
 
 class RendererInfo(ctypes.Structure):
@@ -185,7 +196,15 @@ class RenderStats(ctypes.Structure):
                 ("effective_step", ctypes.c_float),
                 ("bricks_total", ctypes.c_uint32),
                 ("bricks_occupied", ctypes.c_uint32),
-                ("brick_size", ctypes.c_uint32)]
+                ("brick_size", ctypes.c_uint32),
+                ("storage", ctypes.c_uint32),
+                ("resident_bytes", ctypes.c_uint64),
+                ("page_brick", ctypes.c_uint32),
+                ("pages_total", ctypes.c_uint32),
+                ("pages_resident", ctypes.c_uint32),
+                ("pages_constant", ctypes.c_uint32),
+                ("lod_level", ctypes.c_uint32),
+                ("lod_wanted_bytes", ctypes.c_uint64)]
 
 
 def _sized(struct_type):
@@ -248,6 +267,8 @@ def _declare(lib):
         "vxl_volume_destroy": (None, [vp]),
         "vxl_dicom_list_series": (ctypes.c_int, [ctypes.c_char_p, P(DicomSeries), ctypes.c_uint32,
                                                  P(ctypes.c_uint32)]),
+        "vxl_phantom_name": (ctypes.c_char_p, [ctypes.c_uint32]),
+        "vxl_phantom_create": (ctypes.c_int, [P(PhantomDesc), P(vp)]),
         "vxl_renderer_create": (ctypes.c_int, [P(RendererOptions), P(vp)]),
         "vxl_renderer_destroy": (None, [vp]),
         "vxl_renderer_error": (ctypes.c_char_p, [vp]),
@@ -457,6 +478,35 @@ class Volume:
         h = ctypes.c_void_p()
         # The library's message already names the file.
         lib.check(lib.cdll.vxl_volume_load(os.fsencode(path), ctypes.byref(opt), ctypes.byref(h)))
+        return cls(lib, h)
+
+    @classmethod
+    def phantom(cls, spec, lib=None):
+        """A generated analytic phantom from "phantom:NAME[:WxHxD]" (the
+        CLI's syntax), e.g. "phantom:large-sparse" (2500x1500x400)."""
+        lib = lib or load_library()
+        parts = spec.split(":")
+        if parts[0] != "phantom" or len(parts) not in (2, 3):
+            raise VoxlightError("not a phantom spec: %r (phantom:NAME[:WxHxD])" % spec)
+        names = {}
+        k = 1
+        while lib.cdll.vxl_phantom_name(k):
+            names[lib.cdll.vxl_phantom_name(k).decode()] = k
+            k += 1
+        if parts[1] not in names:
+            raise VoxlightError("unknown phantom %r (%s)" % (parts[1], ", ".join(names)))
+        d = _sized(PhantomDesc)
+        d.kind = names[parts[1]]
+        if len(parts) == 3:
+            try:
+                dims = [int(n) for n in parts[2].split("x")]
+            except ValueError:
+                dims = []
+            if len(dims) != 3 or min(dims) < 2:
+                raise VoxlightError("bad phantom size %r: use WxHxD" % parts[2])
+            d.dims[:] = dims
+        h = ctypes.c_void_p()
+        lib.check(lib.cdll.vxl_phantom_create(ctypes.byref(d), ctypes.byref(h)), what="phantom")
         return cls(lib, h)
 
     @classmethod
@@ -734,7 +784,9 @@ def tile_params(params, x0, y0, x1, y1):
 def _empty_stats():
     return {"samples": 0, "rays": 0, "max_ray_samples": 0, "sample_bound": 0,
             "effective_step": 0.0, "bricks_total": 0, "bricks_occupied": 0,
-            "brick_size": 0, "calls": 0, "seconds": 0.0}
+            "brick_size": 0, "calls": 0, "seconds": 0.0, "storage_name": "", "resident_bytes": 0,
+            "pages_total": 0, "pages_resident": 0, "pages_constant": 0, "lod_level": 0,
+            "lod_wanted_bytes": 0}
 
 
 def _merge_stats(acc, s):
@@ -742,7 +794,9 @@ def _merge_stats(acc, s):
     acc["rays"] += s["rays"]
     acc["max_ray_samples"] = max(acc["max_ray_samples"], s["max_ray_samples"])
     acc["sample_bound"] = max(acc["sample_bound"], s["sample_bound"])
-    for k in ("effective_step", "bricks_total", "bricks_occupied", "brick_size"):
+    for k in ("effective_step", "bricks_total", "bricks_occupied", "brick_size", "storage_name",
+              "resident_bytes", "pages_total", "pages_resident", "pages_constant", "lod_level",
+              "lod_wanted_bytes"):
         acc[k] = s[k]
     return acc
 
@@ -753,11 +807,14 @@ class Renderer:
     """One library renderer: its own GL context on its own thread, holding
     one volume. Safe to call from any Python thread."""
 
-    def __init__(self, backend="auto", memory_budget=0, shader_dir=None, lib=None):
+    def __init__(self, backend="auto", memory_budget=0, shader_dir=None, lib=None,
+                 storage="auto", page_brick=0):
         self.lib = lib or load_library()
         opt = _sized(RendererOptions)
         opt.backend = BACKENDS.index(backend) if isinstance(backend, str) else int(backend)
         opt.memory_budget_bytes = memory_budget
+        opt.storage = STORAGES.index(storage) if isinstance(storage, str) else int(storage)
+        opt.page_brick = page_brick
         opt.shader_dir = os.fsencode(shader_dir) if shader_dir else None
         h = ctypes.c_void_p()
         self.lib.check(self.lib.cdll.vxl_renderer_create(ctypes.byref(opt), ctypes.byref(h)),
@@ -806,7 +863,9 @@ class Renderer:
         """What the last render did (vxl_renderer_get_stats) as a dict."""
         st = _sized(RenderStats)
         self._check(self.lib.cdll.vxl_renderer_get_stats(self.handle, ctypes.byref(st)), "stats")
-        return {k: getattr(st, k) for k, _t in RenderStats._fields_ if k != "struct_size"}
+        d = {k: getattr(st, k) for k, _t in RenderStats._fields_ if k != "struct_size"}
+        d["storage_name"] = STORAGES[d["storage"]] if d["storage"] < len(STORAGES) else "?"
+        return d
 
     def render_tiled(self, params, rect=None, rows=None, target_seconds=0.05,
                      should_stop=None):

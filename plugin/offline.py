@@ -92,8 +92,9 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
     lights = params.scene_lights(scene, depsgraph, for_render)
     layers = []
     for ob, mw in vols:
+        opts = dict(runtime.options_of(scene.voxlight), backend=backend)
         entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
-                                  scene.frame_current, backend)
+                                  scene.frame_current, **opts)
         v2l = np.array(ob.voxlight.voxel_to_local, np.float64).reshape(4, 4).T
         p = native.make_params(width=width, height=height, view=view, proj=proj,
                                model=mw @ v2l, scene_depth=zbuf, lights=lights,

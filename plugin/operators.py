@@ -18,8 +18,8 @@ class VOXLIGHT_OT_reload_volume(bpy.types.Operator):
     def execute(self, context):
         p = context.object.voxlight
         try:
-            runtime.load_volume(bpy.path.abspath(p.filepath), backend=context.scene.voxlight.backend,
-                                series=p.series)
+            runtime.load_volume(bpy.path.abspath(p.filepath), series=p.series,
+                                **runtime.options_of(context.scene.voxlight))
         except native.VoxlightError as e:
             self.report({"ERROR"}, "Voxlight: %s" % e)
             return {"CANCELLED"}

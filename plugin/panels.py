@@ -134,6 +134,28 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
                              frame["brick_size"]))
             else:
                 col.label(text="Empty-space skipping off")
+            col.label(text=storage_text(frame))
+            if frame.get("lod_level"):
+                col.label(text=lod_text(frame), icon="ERROR")
+
+
+def storage_text(frame):
+    """How the volume is held on the GL side, from the last frame's stats."""
+    mib = frame.get("resident_bytes", 0) / 1048576.0
+    if not frame.get("pages_total"):
+        return "Storage: %s, %.1f MiB" % (frame.get("storage_name", "dense"), mib)
+    return "Storage: %s, %.1f MiB (%d of %d bricks resident, %d constant)" % (
+        frame["storage_name"], mib, frame["pages_resident"], frame["pages_total"],
+        frame["pages_constant"])
+
+
+def lod_text(frame):
+    """The level-of-detail fallback, said out loud (empty at full resolution)."""
+    k = frame.get("lod_level", 0)
+    if not k:
+        return ""
+    return "LOD fallback: %dx coarser, full resolution needs %.1f MiB (over budget)" % (
+        1 << k, frame["lod_wanted_bytes"] / 1048576.0)
 
 
 class VOXLIGHT_PT_scene(bpy.types.Panel):
@@ -160,6 +182,8 @@ class VOXLIGHT_PT_scene(bpy.types.Panel):
         col.prop(s, "render_occlusion")
         layout.prop(s, "use_scene_lights")
         layout.prop(s, "backend")
+        layout.prop(s, "storage")
+        layout.prop(s, "memory_budget_mib")
 
 
 _classes = (VOXLIGHT_PT_volume, VOXLIGHT_PT_scene)

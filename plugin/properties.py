@@ -201,6 +201,20 @@ class VoxlightSceneProperties(bpy.types.PropertyGroup):
                                                "them in F12 renders")
     backend: EnumProperty(name="Backend", items=BACKEND_ITEMS, default="auto",
                           description="OpenGL backend for new renderers")
+    storage: EnumProperty(name="Storage", default="auto",
+                          items=[("auto", "Auto", "One texture when it fits the texture limit and "
+                                  "the budget, else bricked"),
+                                 ("dense", "Dense", "One 3D texture"),
+                                 ("bricked", "Bricked", "Bricks in a pool texture; constant bricks "
+                                  "cost nothing"),
+                                 ("sparse", "Sparse", "Only the bricks the transfer function can "
+                                  "show; a coarser level when even they exceed the budget")],
+                          description="How volumes are held on the GPU (volumes reload when "
+                                      "this changes)")
+    memory_budget_mib: IntProperty(name="Memory Budget (MiB)", default=2048, min=1,
+                                   max=1 << 20,
+                                   description="GPU memory a volume may use (volumes reload "
+                                               "when this changes)")
 
 
 _classes = (VoxlightVolumeProperties, VoxlightSceneProperties)

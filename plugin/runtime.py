@@ -162,8 +162,17 @@ class Worker:
 frame_cache = frames.FrameCache()
 
 
+def options_of(settings):
+    """Renderer options from the scene's Voxlight settings (duck-typed, so
+    this module stays free of bpy)."""
+    return {"backend": getattr(settings, "backend", "auto"),
+            "storage": getattr(settings, "storage", "auto"),
+            "memory_budget": int(getattr(settings, "memory_budget_mib", 0)) << 20}
+
+
 class VolumeEntry:
-    def __init__(self, path, renderer, info, series=""):
+    def __init__(self, path, renderer, info, series="", options=None):
+        self.options = options or {}   # storage and budget the renderer was made with
         self.path = path
         self.series = series     # DICOM: the chosen series ("" = the only one)
         self.renderer = renderer
@@ -220,6 +229,15 @@ _entries = {}   # (absolute path, DICOM series) -> VolumeEntry
 _failures = {}  # (absolute path, series) -> (mtime, message): do not retry a broken file every redraw
 
 
+def is_phantom(path):
+    """"phantom:NAME[:WxHxD]" names a generated volume instead of a file."""
+    return str(path).startswith("phantom:")
+
+
+def _key(path):
+    return path if is_phantom(path) else os.path.abspath(path)
+
+
 def _mtime(path):
     try:
         return os.stat(path).st_mtime
@@ -227,28 +245,33 @@ def _mtime(path):
         return None
 
 
-def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=None, series="", frame=0):
+def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=None, series="", frame=0,
+                storage="auto", memory_budget=0):
     """Load `path` (frame `frame` of a 4D file; series `series` of a DICOM
-    folder) into a fresh renderer that is not registered yet (safe on a
+    folder; "phantom:NAME[:WxHxD]" a generated volume) into a fresh renderer
+    with the given storage and memory budget, not registered yet (safe on a
     worker thread: it touches no shared state). Raises native.VoxlightError.
     progress(fraction) is called between the slow steps; cancelled() is asked
     between them too, and when it says yes everything made so far is closed
     and None returned. voxel_size (mm) is for inputs without geometry; it only
     changes info["affine"], which the importer bakes into the object, so later
     reloads need not repeat it."""
-    path = os.path.abspath(path)
+    path = _key(path)
     series = series or ""
     stop = cancelled or (lambda: False)
     lib = native.load_library()
-    vol = native.Volume.load(path, voxel_size=voxel_size, lib=lib, frame=frame, series=series or None)
-    keep = vol.info["frame_count"] > 1  # 4D: adopt() puts the frame shown into the cache
+    if is_phantom(path):
+        vol = native.Volume.phantom(path, lib=lib)
+    else:
+        vol = native.Volume.load(path, voxel_size=voxel_size, lib=lib, frame=frame, series=series or None)
+    keep = vol.info.get("frame_count", 1) > 1  # 4D: adopt() puts the frame shown into the cache
     renderer = entry = None
     try:
         if stop():
             return None
         if progress:
             progress(0.4)
-        renderer = native.Renderer(backend=backend, lib=lib)
+        renderer = native.Renderer(backend=backend, lib=lib, storage=storage, memory_budget=memory_budget)
         if progress:
             progress(0.6)
         if stop():
@@ -257,7 +280,8 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
         info = dict(vol.info, histogram=vol.histogram(32))  # for the panel, from any format
         if stop():
             return None
-        entry, renderer = VolumeEntry(path, renderer, info, series), None
+        entry = VolumeEntry(path, renderer, info, series, {"storage": storage, "memory_budget": memory_budget})
+        renderer = None
         if keep:
             entry.pending_frame = vol
     finally:
@@ -286,35 +310,38 @@ def adopt(entry):
     return entry
 
 
-def load_volume(path, backend="auto", progress=None, voxel_size=None, series="", frame=0):
+def load_volume(path, backend="auto", progress=None, voxel_size=None, series="", frame=0, storage="auto",
+                memory_budget=0):
     """open_volume + adopt: load `path` and make it the live entry."""
-    return adopt(open_volume(path, backend, progress, voxel_size, series=series, frame=frame))
+    return adopt(open_volume(path, backend, progress, voxel_size, series=series, frame=frame, storage=storage,
+                             memory_budget=memory_budget))
 
 
-def get_entry(path, backend="auto", series=""):
-    """The live entry for `path` (and DICOM series), loading it on first use
-    or when the file changed on disk. Raises native.VoxlightError
-    (remembered per mtime)."""
-    path = os.path.abspath(path)
+def get_entry(path, backend="auto", series="", storage="auto", memory_budget=0):
+    """The live entry for `path` (and DICOM series), loading it on first use,
+    when the file changed on disk or when the storage options changed.
+    Raises native.VoxlightError (remembered per mtime and options)."""
+    path = _key(path)
     key = (path, series or "")
     entry = _entries.get(key)
     mtime = _mtime(path)
-    if entry is not None and entry.mtime == mtime:
+    wanted = {"storage": storage, "memory_budget": memory_budget}
+    if entry is not None and entry.mtime == mtime and entry.options == wanted:
         return entry
     failed = _failures.get(key)
-    if failed is not None and failed[0] == mtime:
+    if failed is not None and failed[0] == (mtime, wanted):
         raise native.VoxlightError(failed[1])
     try:
-        return load_volume(path, backend, series=series)
+        return load_volume(path, backend, series=series, storage=storage, memory_budget=memory_budget)
     except native.VoxlightError as e:
-        _failures[key] = (mtime, str(e))
+        _failures[key] = ((mtime, wanted), str(e))
         raise
 
 
-def entry_for(path, props, scene_frame, backend="auto"):
+def entry_for(path, props, scene_frame, backend="auto", storage="auto", memory_budget=0):
     """The entry of a volume object (props: Object.voxlight, read by name so
     no bpy is needed) showing the volume frame that `scene_frame` maps to."""
-    entry = get_entry(path, backend, props.series)
+    entry = get_entry(path, backend, props.series, storage, memory_budget)
     entry.show_frame(frames.volume_frame(scene_frame, entry.frame_count, props.frame_mode,
                                          props.frame_offset, props.fixed_frame))
     return entry
@@ -322,11 +349,11 @@ def entry_for(path, props, scene_frame, backend="auto"):
 
 def find_entry(path, series=""):
     """The live entry for `path` (and series) or None; never loads."""
-    return _entries.get((os.path.abspath(path), series or ""))
+    return _entries.get((_key(path), series or ""))
 
 
 def last_failure(path, series=""):
-    f = _failures.get((os.path.abspath(path), series or ""))
+    f = _failures.get((_key(path), series or ""))
     return f[1] if f else ""
 
 

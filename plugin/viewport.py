@@ -327,7 +327,7 @@ def _draw():
             moving_any |= moving
             try:
                 entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
-                                          scene.frame_current, s.backend)
+                                          scene.frame_current, **runtime.options_of(s))
             except native.VoxlightError as e:
                 _report(e)
                 continue

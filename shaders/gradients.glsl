@@ -9,6 +9,22 @@ uniform float u_sample_distance; // tap offset d, in voxels
 #ifdef FILTER_PRECOMPUTED
 uniform sampler3D u_gradient; // raw gradient / global max, interpolated then used
 uniform float u_gradient_scale; // that global max: magnitudes in value per voxel like every filter
+#ifdef PAGED
+// Bricked storage: u_gradient is a pool of its own, u_gpage its page table
+// (w < 0 in the pool, else a brick whose whole neighbourhood is one value:
+// zero gradient). Paged like sample_value, see paged_gradient.comp.
+uniform sampler3D u_gpage;
+uniform vec3 u_gpool_dims;
+
+vec3 paged_gradient(vec3 p)
+{
+    vec3 q = clamp(p, vec3(0.0), u_page_dims - 1.0);
+    ivec3 b = ivec3(floor((q + 0.5) / u_page_brick));
+    vec4 e = texelFetch(u_gpage, b, 0);
+    if (e.w >= 0.0) return vec3(0.0);
+    return textureLod(u_gradient, (e.xyz + q - vec3(b) * u_page_brick + 0.5) / u_gpool_dims, 0.0).xyz;
+}
+#endif
 #endif
 
 #ifdef FILTER_CUBIC
@@ -98,6 +114,8 @@ vec3 gradient_at(vec3 p, float centre)
                 g += o * vec3(h.y * h.z, h.x * h.z, h.x * h.y) * TAP(d * o);
             }
     return g / (32.0 * d);
+#elif defined(FILTER_PRECOMPUTED) && defined(PAGED)
+    return paged_gradient(p) * u_gradient_scale;
 #elif defined(FILTER_PRECOMPUTED)
     return textureLod(u_gradient, voxel_to_tex(p), 0.0).xyz * u_gradient_scale;
 #elif defined(FILTER_CUBIC)

@@ -98,6 +98,16 @@ extern "C" {
 #define VXL_GRADIENT_STORE_16F 1   /* RGBA16F, same scaling */
 #define VXL_GRADIENT_STORE_32F 2   /* RGBA32F, same scaling: exact, for tests and references */
 
+/* ---- volume storage on the GL side (vxl_renderer_options.storage) ---- */
+#define VXL_STORAGE_AUTO 0    /* one texture when it fits the texture limit and budget, else bricked,
+                                 else sparse */
+#define VXL_STORAGE_DENSE 1   /* one 3D texture */
+#define VXL_STORAGE_BRICKED 2 /* bricks with a ghost border in a pool texture, a page table maps them;
+                                 constant bricks cost nothing */
+#define VXL_STORAGE_SPARSE 3  /* bricked, and only the bricks the classification can see are resident;
+                                 over the budget, a 2x/4x/8x coarser level (stats.lod_level) */
+#define VXL_STORAGE_COUNT 4
+
 #define VXL_MAX_LIGHTS 8
 
 typedef struct vxl_volume vxl_volume;
@@ -200,6 +210,9 @@ typedef struct vxl_renderer_options {
     uint64_t memory_budget_bytes; /* GPU storage budget; 0 = 2 GiB */
     const char *shader_dir;       /* developer override: load shaders from disk.
                                      NULL = embedded (env VOXLIGHT_SHADER_DIR overrides) */
+    /* Appended (issue 8); read only when struct_size covers them. */
+    uint32_t storage;             /* VXL_STORAGE_*; 0 = AUTO */
+    uint32_t page_brick;          /* voxels per brick edge when bricked: 8, 16, 32 or 64; 0 = 32 */
 } vxl_renderer_options;
 
 typedef struct vxl_renderer_info {
@@ -303,6 +316,18 @@ typedef struct vxl_render_stats {
     uint32_t bricks_total;      /* bricks of the skipping grid (0 when skipping is off) */
     uint32_t bricks_occupied;   /* bricks that can be visible under the classification */
     uint32_t brick_size;        /* voxels per brick edge */
+    /* Appended (issue 8): how the volume is stored on the GL side. */
+    uint32_t storage;           /* VXL_STORAGE_* in use (never AUTO) */
+    uint64_t resident_bytes;    /* GL memory of the volume: texture, or pool + page table */
+    uint32_t page_brick;        /* voxels per page brick edge (0 when dense) */
+    uint32_t pages_total;       /* bricks of the page table */
+    uint32_t pages_resident;    /* bricks with data in the pool */
+    uint32_t pages_constant;    /* bricks stored as one value (no pool space) */
+    /* Level-of-detail fallback (sparse storage): 0 = full resolution; k > 0:
+     * the visible bricks did not fit the memory budget, so the frame used
+     * voxels 2^k times coarser per axis. The page counts above are of that level. */
+    uint32_t lod_level;
+    uint64_t lod_wanted_bytes;  /* what full resolution would have needed (0 when lod_level is 0) */
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);
@@ -332,7 +357,9 @@ VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, con
 #define VXL_PHANTOM_NOISY_BLOB 4     /* smooth Gaussian blob plus Gaussian noise */
 #define VXL_PHANTOM_SPARSE_BALLS 5   /* Gaussian balls on 5% of an 8^3 lattice (empty-space skipping) */
 #define VXL_PHANTOM_DENSE_BALLS 6    /* its dense twin: a ball on every lattice site */
-#define VXL_PHANTOM_COUNT 7
+#define VXL_PHANTOM_LARGE_SPARSE 7  /* 8-bit Gaussian ellipsoids on 30% of a 12x8x2 lattice; default
+                                        2500x1500x400 (over every 2048 texture limit, for bricking) */
+#define VXL_PHANTOM_COUNT 8
 
 typedef struct vxl_phantom_desc {
     uint32_t struct_size;
@@ -377,6 +404,8 @@ VXL_API const char *vxl_error_name(int code);
 VXL_API const char *vxl_filter_name(uint32_t filter);   /* NULL if out of range */
 VXL_API int vxl_filter_from_name(const char *name, uint32_t *out);
 VXL_API const char *vxl_preset_name(uint32_t preset);
+VXL_API const char *vxl_storage_name(uint32_t storage); /* NULL if out of range */
+VXL_API int vxl_storage_from_name(const char *name, uint32_t *out);
 VXL_API int vxl_preset_from_name(const char *name, uint32_t *out);
 
 /* Writes premultiplied RGBA (row 0 = bottom) to .png (straight alpha, 8 bit)

@@ -48,3 +48,21 @@ def test_quick_skip_study(tmp_path):
     # skipping removes samples; the image is the skip-off one up to early termination
     assert all(int(r["samples_skip"]) < int(r["samples_noskip"]) for r in rows if r["workload"] != "dense-balls")
     assert all(float(r["psnr_skip_vs_noskip_db"]) > 40 for r in rows)
+
+
+def test_quick_storage_study(tmp_path):
+    out = tmp_path / "storage.csv"
+    res = subprocess.run([str(BUILD / "voxlight-storagebench"), "--quick", "--out", str(out)],
+                         capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr
+    rows = list(csv.DictReader(out.open()))
+    by = {(r["workload"], r["storage"], r["page_brick"]): r for r in rows}
+    # bricked and sparse storage render what one texture renders
+    for key in [("ch2better", "bricked", "32"), ("ch2better", "sparse", "16")]:
+        assert float(by[key]["psnr_vs_dense_db"]) >= 60, by[key]
+    # the phantom over the texture limit: dense refuses, bricked holds it, sparse holds less
+    assert "texture limit" in by[("large-sparse", "dense", "0")]["note"]
+    bricked, sparse = by[("large-sparse", "bricked", "32")], by[("large-sparse", "sparse", "32")]
+    assert float(sparse["resident_mib"]) < float(bricked["resident_mib"])
+    assert float(sparse["psnr_vs_dense_db"]) >= 60  # against the bricked image
+    assert float(bricked["psnr_vs_reference_db"]) > 40

@@ -276,6 +276,46 @@ def survives_save_and_reload():
 
 
 @test
+def large_phantom_renders_bricked_within_the_budget():
+    """A generated volume over the 2048 texture limit imports by name,
+    renders bricked under the default 2 GiB budget, and the panel's storage
+    line says so (the full 2500x1500x400 run is in docs/storage.md)."""
+    u.reset_scene()
+    spec = "phantom:large-sparse:2200x300x90"
+    ob = u.import_volume(spec)
+    assert ob.voxlight.filepath == spec and tuple(ob.voxlight.dims) == (2200, 300, 90)
+    img = vx.render_volume(ob, resolution=(96, 48))
+    assert img[..., 3].max() > 0.1, img[..., 3].max()
+    frame = vx.runtime.find_entry(spec).last_frame
+    assert frame["storage_name"] == "bricked" and 0 < frame["resident_bytes"] < 2 << 30, frame
+    assert frame["pages_constant"] > 0 and frame["pages_resident"] < frame["pages_total"]
+    text = vx.panels.storage_text(frame)
+    assert text.startswith("Storage: bricked") and "constant" in text, text
+    assert vx.panels.lod_text(frame) == ""
+    # sparse storage under half the memory it wants: a coarser level, said in the panel
+    s = bpy.context.scene.voxlight
+    s.storage = "sparse"
+    vx.render_volume(ob, resolution=(96, 48))
+    frame = vx.runtime.find_entry(spec).last_frame
+    assert frame["storage_name"] == "sparse" and frame["lod_level"] == 0, frame
+    s.memory_budget_mib = max(1, int(frame["resident_bytes"] / 2 / 1048576))
+    img = vx.render_volume(ob, resolution=(96, 48))
+    frame = vx.runtime.find_entry(spec).last_frame
+    assert frame["lod_level"] >= 1 and frame["resident_bytes"] <= s.memory_budget_mib << 20, frame
+    assert vx.panels.lod_text(frame).startswith("LOD fallback"), frame
+    assert img[..., 3].max() > 0.05
+    s.storage = "auto"
+    s.memory_budget_mib = 2048
+    before = set(bpy.data.objects)
+    try:
+        bpy.ops.voxlight.import_volume(filepath="phantom:no-such-thing")
+        raise AssertionError("an unknown phantom imported")
+    except RuntimeError as e:
+        assert "unknown phantom" in str(e), e
+    assert set(bpy.data.objects) == before
+
+
+@test
 def unregister_and_register_again():
     import addon_utils
     bpy.ops.preferences.addon_disable(module="voxlight")

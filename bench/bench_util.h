@@ -1,0 +1,46 @@
+/* bench_util.h - timing and image error shared by the study programs. */
+#ifndef VXL_BENCH_UTIL_H
+#define VXL_BENCH_UTIL_H
+
+#include <math.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "voxlight.h"
+
+static inline double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
+
+static inline int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Median of `frames` (<= 32) renders after one warm-up that builds grids and programs. */
+static inline double median_ms(vxl_renderer *r, const vxl_render_params *p, float *img, int frames)
+{
+    double t[32];
+    if (vxl_render(r, p, img, NULL)) return -1;
+    for (int i = 0; i < frames; i++) {
+        double s = now_ms();
+        if (vxl_render(r, p, img, NULL)) return -1;
+        t[i] = now_ms() - s;
+    }
+    qsort(t, (size_t)frames, sizeof *t, cmp_d);
+    return t[frames / 2];
+}
+
+static inline double psnr(const float *a, const float *b, size_t n)
+{
+    double s = 0;
+    for (size_t i = 0; i < n; i++) s += ((double)a[i] - b[i]) * ((double)a[i] - b[i]);
+    s = sqrt(s / n);
+    return s > 0 ? 20 * log10(1 / s) : 200;
+}
+
+#endif

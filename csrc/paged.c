@@ -1,0 +1,259 @@
+/* paged.c - bricked storage on the GL side: the pool texture (an atlas of
+ * page bricks with their ghost borders) and the page table (RGBA32F, one
+ * texel per brick: xyz = where the brick's voxel 0 lies in the pool, w < 0
+ * resident, w >= 0 the brick's value when it is not in the pool). BRICKED
+ * makes every non-constant brick resident at set_volume; SPARSE makes
+ * resident only the bricks the frame's classification can see, re-derived
+ * from the skipping grid when the classification changes. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "renderer_internal.h"
+
+static const GLenum internal_formats[] = {GL_R8, GL_R16, 0, GL_R32F};
+static const GLenum texel_types[] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_SHORT, 0, GL_FLOAT};
+
+void vxl_paged_release(vxl_renderer *r)
+{
+    if (r->pool_tex) r->gl.DeleteTextures(1, &r->pool_tex);
+    if (r->page_tex) r->gl.DeleteTextures(1, &r->page_tex);
+    r->pool_tex = r->page_tex = 0;
+    for (int k = 0; k < VXL_LOD_LEVELS; k++) vxl_pages_free(&r->levels[k]);
+    memset(r->level_dims, 0, sizeof r->level_dims);
+    r->n_levels = r->level = 0;
+    r->lod_wanted_bytes = 0;
+    free(r->resident);
+    free(r->page_entries);
+    r->resident = NULL;
+    r->page_entries = NULL;
+    r->pages_resident = r->pages_constant = 0;
+    r->pool_bytes = 0;
+    memset(r->pool_dims, 0, sizeof r->pool_dims);
+}
+
+static uint64_t page_table_bytes(const vxl_pages *pg) { return vxl_page_count(pg) * 16; }
+
+static int pool_layout(const vxl_renderer *r, const vxl_pages *pg, uint32_t n, uint32_t slots[3])
+{
+    return vxl_pool_layout(r, n, vxl_page_edge(pg), slots);
+}
+
+/* Slots per axis for n bricks of edge e within the texture limit; 0 if they cannot fit. */
+int vxl_pool_layout(const vxl_renderer *r, uint32_t n, uint32_t e, uint32_t slots[3])
+{
+    const uint32_t m = (uint32_t)r->info.max_3d_texture_size / e;
+    if (m == 0) return 0;
+    n = n ? n : 1;
+    slots[0] = n < m ? n : m;
+    uint32_t rows = (n + slots[0] - 1) / slots[0];
+    slots[1] = rows < m ? rows : m;
+    slots[2] = (rows + slots[1] - 1) / slots[1];
+    return slots[2] <= m;
+}
+
+static uint64_t pool_bytes_for(const vxl_pages *pg, const uint32_t slots[3])
+{
+    const uint64_t e = vxl_page_edge(pg);
+    return slots[0] * e * slots[1] * e * slots[2] * e * pg->bytes_per_voxel;
+}
+
+/* Builds the pool from the bricks of `level` marked in need[] and uploads
+ * the page table. Refuses, naming the budget, when they do not fit. */
+static int upload_pool(vxl_renderer *r, uint32_t level, const uint8_t *need)
+{
+    vxl_gl *gl = &r->gl;
+    vxl_pages *pg = &r->levels[level];
+    const uint64_t n = vxl_page_count(pg);
+    uint32_t count = 0, slots[3];
+    for (uint64_t i = 0; i < n; i++) count += need[i];
+    if (!pool_layout(r, pg, count, slots))
+        return vxl_fail(&r->err, VXL_ERR_LIMIT, "%u bricks of %u^3 voxels do not fit a pool texture within the 3D texture limit of %d",
+                        count, vxl_page_edge(pg), r->info.max_3d_texture_size);
+    const uint64_t bytes = pool_bytes_for(pg, slots) + page_table_bytes(pg);
+    if (bytes > r->budget)
+        return vxl_fail(&r->err, VXL_ERR_LIMIT,
+                        "%u resident bricks need %.1f MiB, over the renderer's memory budget of %.1f MiB%s", count,
+                        bytes / 1048576.0, r->budget / 1048576.0,
+                        r->storage == VXL_STORAGE_BRICKED ? " (sparse storage keeps only visible bricks)" : "");
+    const uint32_t e = vxl_page_edge(pg), fi = pg->bytes_per_voxel - 1;
+    const size_t brick_bytes = (size_t)e * e * e * pg->bytes_per_voxel;
+    if (r->pool_tex) gl->DeleteTextures(1, &r->pool_tex);
+    gl->GetError();
+    r->pool_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+    for (int a = 0; a < 3; a++) r->pool_dims[a] = slots[a] * e;
+    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)r->pool_dims[0], (GLsizei)r->pool_dims[1],
+                   (GLsizei)r->pool_dims[2], 0, GL_RED, texel_types[fi], NULL);
+    uint32_t k = 0, constant = 0;
+    for (uint64_t i = 0; i < n; i++) {
+        float *pe = r->page_entries + 4 * i;
+        r->resident[i] = need[i];
+        if (!need[i]) { /* constant, or invisible: its value (the minimum) classifies as transparent */
+            pe[0] = pe[1] = pe[2] = 0;
+            pe[3] = pg->low[i];
+            constant += pg->data_index[i] < 0;
+            continue;
+        }
+        const uint32_t o[3] = {k % slots[0] * e, k / slots[0] % slots[1] * e, k / (slots[0] * slots[1]) * e};
+        gl->TexSubImage3D(GL_TEXTURE_3D, 0, (GLint)o[0], (GLint)o[1], (GLint)o[2], (GLsizei)e, (GLsizei)e, (GLsizei)e,
+                          GL_RED, texel_types[fi], pg->data + (size_t)pg->data_index[i] * brick_bytes);
+        for (int a = 0; a < 3; a++) pe[a] = (float)(o[a] + VXL_PAGE_GHOST);
+        pe[3] = -1;
+        k++;
+    }
+    if (!r->page_tex) r->page_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
+    gl->BindTexture(GL_TEXTURE_3D, r->page_tex);
+    gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA32F, (GLsizei)pg->grid[0], (GLsizei)pg->grid[1], (GLsizei)pg->grid[2], 0,
+                   GL_RGBA, GL_FLOAT, r->page_entries);
+    int rc = vxl_gl_check(r, "uploading the brick pool");
+    if (rc) return rc;
+    r->pages_resident = count;
+    r->pages_constant = constant;
+    r->pool_bytes = bytes;
+    r->level = level;
+    return VXL_OK;
+}
+
+/* Bytes of the pool holding n bricks plus the page table; UINT64_MAX when
+ * the pool cannot fit the texture limit. */
+static uint64_t resident_bytes_for(const vxl_renderer *r, const vxl_pages *pg, uint32_t n)
+{
+    uint32_t slots[3];
+    return pool_layout(r, pg, n, slots) ? pool_bytes_for(pg, slots) + page_table_bytes(pg) : UINT64_MAX;
+}
+
+static void plan_free(vxl_paged_volume *pv)
+{
+    for (int k = 0; k < VXL_LOD_LEVELS; k++) vxl_pages_free(&pv->levels[k]);
+    vxl_bricks_free(&pv->bricks);
+}
+
+/* Sparse storage keeps coarser levels for the LOD fallback: each a 2x
+ * downsampled copy, cut into bricks the same way. */
+static int plan_levels(vxl_renderer *r, const vxl_volume *v, uint32_t brick, vxl_paged_volume *out)
+{
+    const vxl_volume *src = v;
+    vxl_volume *coarse = NULL;
+    int rc = VXL_OK;
+    for (uint32_t k = 1; k < VXL_LOD_LEVELS && !rc; k++) {
+        vxl_volume *next = NULL;
+        if ((rc = vxl_volume_downsample2(src, &next, &r->err))) break;
+        vxl_volume_destroy(coarse);
+        coarse = next;
+        src = coarse;
+        rc = vxl_pages_build(&out->levels[k], coarse, brick, &r->err);
+        memcpy(out->level_dims[k], coarse->dims, sizeof out->level_dims[k]);
+        if (!rc) out->n_levels = k + 1;
+    }
+    vxl_volume_destroy(coarse);
+    return rc;
+}
+
+int vxl_paged_plan(vxl_renderer *r, const vxl_volume *v, uint32_t storage, vxl_paged_volume *out)
+{
+    memset(out, 0, sizeof *out);
+    uint32_t brick = r->page_brick_request ? r->page_brick_request : VXL_DEFAULT_PAGE_BRICK;
+    vxl_pages *pg = &out->levels[0];
+    int rc = vxl_pages_build(pg, v, brick, &r->err);
+    if (!rc) rc = vxl_bricks_minmax_cpu(&out->bricks, v, vxl_skip_brick_size(), &r->err);
+    memcpy(out->level_dims[0], v->dims, sizeof out->level_dims[0]);
+    out->n_levels = 1;
+    if (storage == VXL_STORAGE_AUTO) storage = VXL_STORAGE_BRICKED; /* dense did not fit */
+    out->storage = storage;
+    if (!rc && storage == VXL_STORAGE_SPARSE) rc = plan_levels(r, v, brick, out);
+    if (rc) {
+        plan_free(out);
+        return rc;
+    }
+    uint64_t all = resident_bytes_for(r, pg, pg->n_data), none = resident_bytes_for(r, pg, 0);
+    uint64_t need = storage == VXL_STORAGE_BRICKED ? all : none;
+    if (need > r->budget) {
+        const char *hint = storage == VXL_STORAGE_BRICKED ? "; sparse storage keeps only the visible bricks" : "";
+        rc = need == UINT64_MAX
+                 ? vxl_fail(&r->err, VXL_ERR_LIMIT, "%u bricks of %u^3 voxels do not fit a pool texture within the 3D texture limit of %d%s",
+                            pg->n_data, vxl_page_edge(pg), r->info.max_3d_texture_size, hint)
+                 : vxl_fail(&r->err, VXL_ERR_LIMIT,
+                            "%s storage of %ux%ux%u needs %.1f MiB, over the renderer's memory budget of %.1f MiB%s",
+                            vxl_storage_name(storage), v->dims[0], v->dims[1], v->dims[2], need / 1048576.0,
+                            r->budget / 1048576.0, hint);
+        plan_free(out);
+    }
+    return rc;
+}
+
+int vxl_paged_install(vxl_renderer *r, vxl_paged_volume *pv)
+{
+    memcpy(r->levels, pv->levels, sizeof r->levels);
+    memcpy(r->level_dims, pv->level_dims, sizeof r->level_dims);
+    r->n_levels = pv->n_levels;
+    r->level = 0;
+    r->bricks = pv->bricks;
+    r->storage = pv->storage;
+    memset(pv, 0, sizeof *pv);
+    const uint64_t n = vxl_page_count(&r->levels[0]); /* the finest level has the most bricks */
+    r->resident = calloc(n, 1);
+    r->page_entries = malloc(n * 4 * sizeof(float));
+    if (!r->resident || !r->page_entries) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
+    if (r->storage == VXL_STORAGE_SPARSE) return VXL_OK; /* the pool follows the first frame's classification */
+    uint8_t *need = malloc(n);
+    if (!need) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
+    for (uint64_t i = 0; i < n; i++) need[i] = r->levels[0].data_index[i] >= 0;
+    int rc = upload_pool(r, 0, need);
+    free(need);
+    free(r->levels[0].data); /* on the GL side now; BRICKED never uploads again */
+    r->levels[0].data = NULL;
+    return rc;
+}
+
+int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify)
+{
+    if (!r->storage || r->storage == VXL_STORAGE_DENSE) return VXL_OK;
+    const char *what = filter == VXL_FILTER_PRECOMPUTED && r->storage != VXL_STORAGE_BRICKED
+                           ? "the precomputed gradient filter with sparse storage"
+                       : filter == VXL_FILTER_CUBIC     ? "the cubic gradient filter"
+                       : classify == VXL_CLASSIFY_PRE   ? "pre-classification"
+                                                        : NULL;
+    if (!what) return VXL_OK;
+    return vxl_fail(&r->err, VXL_ERR_STATE,
+                    "%s needs the volume as one texture, but it is stored %s (%ux%ux%u); use central, forward3, "
+                    "sobel8, sobel14 or sobel26 (or precomputed with bricked storage) with post- or pre-integrated "
+                    "classification",
+                    what, vxl_storage_name(r->storage), r->dims[0], r->dims[1], r->dims[2]);
+}
+
+/* Sparse: the finest level whose visible bricks fit the budget. Falls back
+ * to coarser levels (reported in the stats) and fails naming the budget
+ * only when even the coarsest does not fit. */
+int vxl_paged_prepare(vxl_renderer *r, const vxl_frame *f)
+{
+    if (r->storage != VXL_STORAGE_SPARSE) return VXL_OK;
+    /* gradient taps reach sample_distance voxels per axis, trilinear one more */
+    uint32_t reach = f ? (uint32_t)ceilf(f->sample_distance) + 1 : 0;
+    const int all = !f || f->gopacity == VXL_GOPACITY_ISO;
+    const uint64_t n0 = vxl_page_count(&r->levels[0]);
+    uint8_t *need = malloc(n0);
+    if (!need) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
+    uint64_t wanted = 0, bytes = UINT64_MAX;
+    uint32_t level = 0;
+    for (; level < r->n_levels; level++) { /* f == NULL (probes): full resolution only */
+        uint32_t count = vxl_pages_needed(&r->levels[level], &r->bricks, reach, 1u << level, all, need);
+        bytes = resident_bytes_for(r, &r->levels[level], count);
+        if (level == 0) wanted = bytes;
+        if (bytes <= r->budget || !f) break;
+    }
+    if (level == r->n_levels) {
+        free(need);
+        return vxl_fail(&r->err, VXL_ERR_LIMIT,
+                        "the visible bricks need %.1f MiB at full resolution and still %.1f MiB at %ux coarser, over "
+                        "the renderer's memory budget of %.1f MiB",
+                        wanted / 1048576.0, bytes / 1048576.0, 1u << (r->n_levels - 1), r->budget / 1048576.0);
+    }
+    const uint64_t n = vxl_page_count(&r->levels[level]);
+    int grow = !r->pool_tex || level != r->level;
+    for (uint64_t i = 0; i < n && !grow; i++) grow = need[i] && !r->resident[i];
+    int rc = grow ? upload_pool(r, level, need) : VXL_OK;
+    if (!rc) r->lod_wanted_bytes = level ? wanted : 0;
+    free(need);
+    return rc;
+}

@@ -1,0 +1,175 @@
+/* paged_gradients.c - the precomputed gradient filter with bricked storage:
+ * the same blur + Sobel + global-max scaling as precompute.c, computed per
+ * brick into a gradient pool with its own page table (shaders/
+ * paged_gradient.comp). A brick needs gradient data unless it and its 26
+ * neighbours all hold one value (then its gradient is exactly zero: the
+ * blur and the Sobel reach 2 voxels, a brick is at least 8). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "renderer_internal.h"
+
+static const GLenum store_internal[] = {GL_RGBA8_SNORM, GL_RGBA16F, GL_RGBA32F};
+static const uint32_t store_bytes[] = {4, 8, 16};
+
+/* Bricks whose gradient is not zero everywhere, as (x, y, z, 0) each. */
+static GLint *derived_bricks(const vxl_pages *pg, uint32_t *count)
+{
+    const uint64_t n = vxl_page_count(pg);
+    GLint *out = malloc(n * 4 * sizeof *out);
+    if (!out) return NULL;
+    *count = 0;
+    for (uint64_t i = 0; i < n; i++) {
+        const int c[3] = {(int)(i % pg->grid[0]), (int)(i / pg->grid[0] % pg->grid[1]),
+                          (int)(i / ((uint64_t)pg->grid[0] * pg->grid[1]))};
+        int flat = 1;
+        for (int k = 0; k < 27 && flat; k++) {
+            int q[3] = {c[0] + k % 3 - 1, c[1] + k / 3 % 3 - 1, c[2] + k / 9 - 1};
+            if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= (int)pg->grid[0] || q[1] >= (int)pg->grid[1] ||
+                q[2] >= (int)pg->grid[2])
+                continue; /* beyond the volume: its edge repeats, which the brick itself holds */
+            size_t j = (size_t)q[0] + pg->grid[0] * ((size_t)q[1] + (size_t)pg->grid[1] * q[2]);
+            flat = pg->data_index[j] < 0 && pg->low[j] == pg->low[i];
+        }
+        if (flat) continue;
+        GLint *o = out + 4 * (size_t)*count;
+        o[0] = c[0];
+        o[1] = c[1];
+        o[2] = c[2];
+        o[3] = 0;
+        (*count)++;
+    }
+    return out;
+}
+
+static GLuint groups(uint32_t n) { return (n + 3) / 4; }
+
+/* Runs prog over every derived brick of edge e, in chunks the dispatch limit allows. */
+static void dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t count, uint32_t e)
+{
+    const uint32_t per = 65535u * 4u / e; /* bricks per dispatch: z groups <= 65535 */
+    for (uint32_t first = 0; first < count; first += per) {
+        uint32_t n = count - first < per ? count - first : per;
+        vxl_uniform_i(r, prog, "u_first", (int)first);
+        r->gl.DispatchCompute(groups(e), groups(e), groups(n * e));
+    }
+}
+
+static void set_common(vxl_renderer *r, GLuint prog, uint32_t count, const uint32_t slots[3])
+{
+    vxl_gl *gl = &r->gl;
+    gl->UseProgram(prog);
+    vxl_uniform_i(r, prog, "u_brick", (int)r->levels[0].brick);
+    vxl_uniform_f(r, prog, "u_page_brick", (float)r->levels[0].brick);
+    vxl_uniform_i(r, prog, "u_count", (int)count);
+    float dims[3] = {(float)r->dims[0], (float)r->dims[1], (float)r->dims[2]};
+    gl->Uniform3fv(gl->GetUniformLocation(prog, "u_dims"), 1, dims);
+    gl->Uniform3i(gl->GetUniformLocation(prog, "u_slots"), (GLint)slots[0], (GLint)slots[1], (GLint)slots[2]);
+}
+
+int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
+{
+    if (r->gradient_tex && r->gradient_store == store) return VXL_OK;
+    vxl_gradients_release(r);
+    vxl_gl *gl = &r->gl;
+    const vxl_pages *pg = &r->levels[0];
+    const uint32_t pb = pg->brick, eb = pb + 4, eg = pb + 2;
+    uint32_t count = 0, bslots[3], gslots[3];
+    GLint *list = derived_bricks(pg, &count);
+    if (!list) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the gradient bricks");
+    if (!vxl_pool_layout(r, count, eb, bslots) || !vxl_pool_layout(r, count, eg, gslots)) {
+        free(list);
+        return vxl_fail(&r->err, VXL_ERR_LIMIT, "%u gradient bricks do not fit a pool within the 3D texture limit of %d",
+                        count, r->info.max_3d_texture_size);
+    }
+    const uint64_t gbytes = (uint64_t)gslots[0] * gslots[1] * gslots[2] * eg * eg * eg * store_bytes[store],
+                   bbytes = (uint64_t)bslots[0] * bslots[1] * bslots[2] * eb * eb * eb * 4,
+                   need = r->pool_bytes + gbytes + bbytes + vxl_page_count(pg) * 16;
+    GLuint progs[3];
+    int rc = vxl_gradient_programs(r, 1, store, need, progs);
+    if (rc) {
+        free(list);
+        return rc;
+    }
+    const GLuint blur_prog = progs[0], max_prog = progs[1], store_prog = progs[2];
+    gl->GetError();
+    gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[1]);
+    gl->BufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(count ? count : 1) * 4 * (GLsizeiptr)sizeof(GLint), list,
+                   GL_STATIC_DRAW);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, r->ssbo[1]);
+    /* pass 1: blur every derived brick plus its 2-voxel border, through the data pool */
+    GLuint blur = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
+    gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R32F, (GLsizei)(bslots[0] * eb), (GLsizei)(bslots[1] * eb),
+                   (GLsizei)(bslots[2] * eb), 0, GL_RED, GL_FLOAT, NULL);
+    set_common(r, blur_prog, count, bslots);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_PAGE_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, r->page_tex);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_3D, r->pool_tex);
+    vxl_uniform_i(r, blur_prog, "u_volume", 0);
+    vxl_uniform_i(r, blur_prog, "u_page", VXL_PAGE_UNIT);
+    gl->BindImageTexture(0, blur, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    dispatch_bricks(r, blur_prog, count, eb);
+    gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    /* pass 2: the global maximum magnitude */
+    const GLuint zero = 0;
+    gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[0]);
+    gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zero, &zero, GL_DYNAMIC_READ);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r->ssbo[0]);
+    set_common(r, max_prog, count, gslots);
+    gl->Uniform3i(gl->GetUniformLocation(max_prog, "u_blur_slots"), (GLint)bslots[0], (GLint)bslots[1], (GLint)bslots[2]);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_3D, blur);
+    vxl_uniform_i(r, max_prog, "u_blur", 0);
+    dispatch_bricks(r, max_prog, count, eg);
+    gl->MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    union { GLuint u; float f; } max_mag = {0};
+    gl->GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof max_mag.u, &max_mag.u);
+    /* pass 3: scaled raw gradient into the gradient pool */
+    r->gradient_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+    for (int a = 0; a < 3; a++) r->gpool_dims[a] = gslots[a] * eg;
+    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)store_internal[store], (GLsizei)r->gpool_dims[0], (GLsizei)r->gpool_dims[1],
+                   (GLsizei)r->gpool_dims[2], 0, GL_RGBA, GL_FLOAT, NULL);
+    set_common(r, store_prog, count, gslots);
+    gl->Uniform3i(gl->GetUniformLocation(store_prog, "u_blur_slots"), (GLint)bslots[0], (GLint)bslots[1],
+                  (GLint)bslots[2]);
+    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_3D, blur);
+    vxl_uniform_i(r, store_prog, "u_blur", 0);
+    vxl_uniform_f(r, store_prog, "u_inv_max", max_mag.f > 0 ? 1.0f / max_mag.f : 0.0f);
+    r->gradient_max = max_mag.f; /* the shader scales back to value per voxel */
+    gl->BindImageTexture(0, r->gradient_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, store_internal[store]);
+    dispatch_bricks(r, store_prog, count, eg);
+    gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    gl->DeleteTextures(1, &blur);
+    /* the gradient page table: slot origins + ghost, or zero gradient */
+    const uint64_t n = vxl_page_count(pg);
+    float *entries = calloc(n * 4, sizeof *entries);
+    if (!entries) rc = vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the gradient page table");
+    for (uint64_t i = 0; i < n && entries; i++) entries[4 * i + 3] = 0; /* zero gradient */
+    for (uint32_t k = 0; k < count && entries; k++) {
+        const GLint *c = list + 4 * (size_t)k;
+        float *e = entries + 4 * ((size_t)c[0] + pg->grid[0] * ((size_t)c[1] + (size_t)pg->grid[1] * c[2]));
+        e[0] = (float)(k % gslots[0] * eg + 1);
+        e[1] = (float)(k / gslots[0] % gslots[1] * eg + 1);
+        e[2] = (float)(k / (gslots[0] * gslots[1]) * eg + 1);
+        e[3] = -1;
+    }
+    if (entries) {
+        if (!r->gpage_tex) r->gpage_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
+        gl->BindTexture(GL_TEXTURE_3D, r->gpage_tex);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA32F, (GLsizei)pg->grid[0], (GLsizei)pg->grid[1], (GLsizei)pg->grid[2], 0,
+                       GL_RGBA, GL_FLOAT, entries);
+    }
+    free(entries);
+    free(list);
+    gl->UseProgram(0);
+    if (!rc) rc = vxl_gl_check(r, "precomputing gradients of the bricked volume");
+    if (rc) {
+        vxl_gradients_release(r);
+        return rc;
+    }
+    r->gradient_store = store;
+    r->gradient_bytes = gbytes + vxl_page_count(pg) * 16;
+    return VXL_OK;
+}

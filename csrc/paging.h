@@ -1,0 +1,56 @@
+/* paging.h - bricked storage, CPU side (pure, no GL). The volume is cut into
+ * page bricks of P^3 voxels; each brick is stored with a one-voxel ghost
+ * border copied from its neighbours (the "over-represented sub-volumes" of
+ * the table-based mapping), so hardware trilinear filtering inside a brick
+ * reads exactly what it would read in one big texture. A brick whose voxels,
+ * ghost included, all hold one value is stored as that value and nothing
+ * else. The GL side (paged.c) packs the data bricks into a pool texture and
+ * writes the page table the shader translates every sample through. */
+#ifndef VXL_PAGING_H
+#define VXL_PAGING_H
+
+#include <stdint.h>
+
+#include "bricks.h"
+#include "error.h"
+#include "volume.h"
+
+#define VXL_PAGE_GHOST 1        /* trilinear reads floor(x) and floor(x)+1 of a position in the brick */
+#define VXL_DEFAULT_PAGE_BRICK 32
+
+typedef struct vxl_pages {
+    uint32_t brick;             /* P: voxels per page brick edge, ghost excluded */
+    uint32_t grid[3];           /* page bricks per axis */
+    uint32_t bytes_per_voxel;   /* 1, 2 or 4, as the volume's texels */
+    uint32_t n_data;            /* bricks that are not constant */
+    int32_t *data_index;        /* per brick: its index in data, -1 = constant */
+    float *low;                 /* per brick: the constant value, or the minimum (ghost included) */
+    uint8_t *data;              /* n_data bricks of (P+2)^3 voxels, x fastest; NULL once dropped */
+} vxl_pages;
+
+/* Edge of a stored brick, ghost included. */
+static inline uint32_t vxl_page_edge(const vxl_pages *pg) { return pg->brick + 2 * VXL_PAGE_GHOST; }
+static inline uint64_t vxl_page_count(const vxl_pages *pg)
+{
+    return (uint64_t)pg->grid[0] * pg->grid[1] * pg->grid[2];
+}
+
+/* Cuts v into bricks of `brick` voxels (8, 16, 32 or 64). */
+int vxl_pages_build(vxl_pages *pg, const vxl_volume *v, uint32_t brick, vxl_err *e);
+void vxl_pages_free(vxl_pages *pg);
+
+/* The skipping grid's min-max (bricks of b->size voxels, one-voxel apron),
+ * computed from the CPU volume exactly as brick_minmax.comp does on a dense
+ * texture; fills b->size, b->dims and b->minmax. */
+int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl_err *e);
+
+/* need[i] = 1 for every data brick a frame can read under the occupancy in b
+ * (b->distance, 0 = occupied, on the full-resolution grid): a brick within
+ * `reach` full-resolution voxels of an occupied skip brick, since gradient
+ * taps reach that far from a visible sample. pg may be a coarser level whose
+ * voxels cover `scale` full-resolution voxels per axis. all != 0 marks every
+ * data brick (classifications occupancy cannot bound). Returns the count. */
+uint32_t vxl_pages_needed(const vxl_pages *pg, const vxl_bricks *b, uint32_t reach, uint32_t scale, int all,
+                          uint8_t *need);
+
+#endif

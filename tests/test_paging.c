@@ -1,0 +1,338 @@
+/* test_paging.c - bricked and sparse storage must render what one texture
+ * renders: every on-the-fly filter and classification mode, PSNR >= 60 dB
+ * against DENSE; no seams at brick edges on a ramp (gradients through the
+ * real shader, exact to 0.01 degrees at and across brick faces); a volume
+ * over the backend's texture limit renders bricked; budgets and unsupported
+ * combinations fail with a clear message. Small page bricks (8^3) so small
+ * volumes cross many brick edges. */
+#include <stdio.h>
+#include <string.h>
+
+#include "harness.h"
+#include "test_util.h"
+
+#define W 64
+#define H 64
+
+static vxl_renderer *make_stored(uint32_t storage, uint32_t page_brick, uint64_t budget)
+{
+    vxl_renderer_options o;
+    memset(&o, 0, sizeof o);
+    o.struct_size = sizeof o;
+    o.backend = VXL_BACKEND_OSMESA;
+    o.storage = storage;
+    o.page_brick = page_brick;
+    o.memory_budget_bytes = budget;
+    vxl_renderer *r = NULL;
+    return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
+}
+
+static vxl_render_params scene(uint32_t filter, uint32_t mode)
+{
+    vxl_render_params p = default_params(W, H);
+    p.filter = filter;
+    p.classify = mode;
+    p.preset = VXL_PRESET_BONE;
+    p.has_window = 1;
+    p.window_low = 0.35f;
+    p.window_high = 0.75f;
+    p.azimuth_deg = 20;
+    p.elevation_deg = 25;
+    return p;
+}
+
+static vxl_render_stats stats_of(vxl_renderer *r)
+{
+    vxl_render_stats s;
+    memset(&s, 0, sizeof s);
+    s.struct_size = sizeof s;
+    vxl_renderer_get_stats(r, &s);
+    return s;
+}
+
+TEST(bricked_and_sparse_equal_dense)
+{
+    vxl_renderer *rd = make_stored(VXL_STORAGE_DENSE, 0, 0), *rb = make_stored(VXL_STORAGE_BRICKED, 8, 0),
+                 *rs = make_stored(VXL_STORAGE_SPARSE, 8, 0);
+    REQUIRE(rd && rb && rs);
+    static float d[W * H * 4], b[W * H * 4], s[W * H * 4];
+    const uint32_t kinds[3] = {VXL_PHANTOM_SPARSE_BALLS, VXL_PHANTOM_MARSCHNER_LOBB, VXL_PHANTOM_NOISY_BLOB};
+    for (int k = 0; k < 3; k++) {
+        /* 45 is not a multiple of 8: partial bricks at the far faces */
+        vxl_phantom_desc pd = {.struct_size = sizeof pd, .kind = kinds[k], .dims = {45, 40, 37}, .seed = 3};
+        vxl_volume *v = NULL;
+        REQUIRE(vxl_phantom_create(&pd, &v) == VXL_OK);
+        REQUIRE(vxl_renderer_set_volume(rd, v) == VXL_OK);
+        REQUIRE(vxl_renderer_set_volume(rb, v) == VXL_OK);
+        REQUIRE(vxl_renderer_set_volume(rs, v) == VXL_OK);
+        vxl_volume_destroy(v);
+        /* the five on-the-fly filters in post-classification, pre-integration
+         * and boundary opacity with central differences, and skipping off */
+        for (uint32_t run = 0; run < 8; run++) {
+            uint32_t f = run <= VXL_FILTER_SOBEL26 ? run : VXL_FILTER_CENTRAL;
+            vxl_render_params p = scene(f, run == 5 ? VXL_CLASSIFY_PREINT : VXL_CLASSIFY_POST);
+            if (run == 6) p.gradient_opacity = VXL_GOPACITY_BOUNDARY;
+            if (run == 7) p.no_skip = 1;
+            REQUIRE(vxl_render(rd, &p, d, NULL) == VXL_OK);
+            REQUIRE(vxl_render(rb, &p, b, NULL) == VXL_OK);
+            REQUIRE(vxl_render(rs, &p, s, NULL) == VXL_OK);
+            double qb = image_psnr(b, d, W * H * 4), qs = image_psnr(s, d, W * H * 4);
+            vxl_render_stats sb = stats_of(rb), ss = stats_of(rs);
+            fprintf(stderr, "    %-15s %-8s run %u: bricked %6.1f dB (%u/%u resident), sparse %6.1f dB (%u resident)\n",
+                    vxl_phantom_name(kinds[k]), vxl_filter_name(f), run, qb, sb.pages_resident, sb.pages_total, qs,
+                    ss.pages_resident);
+            CHECKF(qb >= 60, "%s/%s run %u: bricked %.1f dB", vxl_phantom_name(kinds[k]), vxl_filter_name(f), run, qb);
+            CHECKF(qs >= 60, "%s/%s run %u: sparse %.1f dB", vxl_phantom_name(kinds[k]), vxl_filter_name(f), run, qs);
+            CHECK(alpha_sum(d, W * H) > 1);
+            CHECK(sb.storage == VXL_STORAGE_BRICKED && ss.storage == VXL_STORAGE_SPARSE);
+            CHECK(sb.page_brick == 8 && sb.pages_total == 6 * 5 * 5);
+            CHECK(ss.pages_resident <= sb.pages_resident && sb.resident_bytes > 0);
+        }
+    }
+    vxl_renderer_destroy(rd);
+    vxl_renderer_destroy(rb);
+    vxl_renderer_destroy(rs);
+}
+
+/* Three Gaussian blobs (sigma 3) in 96^3: their float tails make almost
+ * every brick non-constant, but a window shows only the cores. */
+static double three_blobs(double x, double y, double z, const double *p)
+{
+    (void)p;
+    const double c[3][3] = {{20, 24, 30}, {70, 50, 40}, {40, 80, 75}};
+    double s = 0;
+    for (int i = 0; i < 3; i++) {
+        double dx = x - c[i][0], dy = y - c[i][1], dz = z - c[i][2];
+        s += exp(-(dx * dx + dy * dy + dz * dz) / 18.0);
+    }
+    return s;
+}
+
+/* The precomputed filter's texture, derived per brick into a gradient pool
+ * of its own: every store format equals the dense texture's image. */
+TEST(precomputed_gradients_bricked_equal_dense)
+{
+    vxl_renderer *rd = make_stored(VXL_STORAGE_DENSE, 0, 0), *rb = make_stored(VXL_STORAGE_BRICKED, 8, 0);
+    REQUIRE(rd && rb);
+    static float d[W * H * 4], b[W * H * 4];
+    const uint32_t kinds[3] = {VXL_PHANTOM_SPARSE_BALLS, VXL_PHANTOM_MARSCHNER_LOBB, VXL_PHANTOM_NOISY_BLOB};
+    for (int k = 0; k < 3; k++) {
+        vxl_phantom_desc pd = {.struct_size = sizeof pd, .kind = kinds[k], .dims = {45, 40, 37}, .seed = 3};
+        vxl_volume *v = NULL;
+        REQUIRE(vxl_phantom_create(&pd, &v) == VXL_OK);
+        REQUIRE(vxl_renderer_set_volume(rd, v) == VXL_OK);
+        REQUIRE(vxl_renderer_set_volume(rb, v) == VXL_OK);
+        vxl_volume_destroy(v);
+        for (uint32_t store = 0; store <= VXL_GRADIENT_STORE_32F; store++) {
+            vxl_render_params p = scene(VXL_FILTER_PRECOMPUTED, VXL_CLASSIFY_POST);
+            p.gradient_store = store;
+            REQUIRE(vxl_render(rd, &p, d, NULL) == VXL_OK);
+            CHECKF(vxl_render(rb, &p, b, NULL) == VXL_OK, "%s", vxl_last_error());
+            double q = image_psnr(b, d, W * H * 4);
+            fprintf(stderr, "    %-15s precomputed store %u: bricked %6.1f dB\n", vxl_phantom_name(kinds[k]), store, q);
+            CHECKF(q >= 60, "%s store %u: %.1f dB", vxl_phantom_name(kinds[k]), store, q);
+        }
+    }
+    vxl_renderer_destroy(rd);
+    vxl_renderer_destroy(rb);
+}
+
+TEST(sparse_follows_the_transfer_function)
+{
+    vxl_renderer *rd = make_stored(VXL_STORAGE_DENSE, 0, 0), *rs = make_stored(VXL_STORAGE_SPARSE, 8, 0);
+    REQUIRE(rd && rs);
+    vxl_volume *v = make_volume_f32(96, 96, 96, three_blobs, NULL);
+    REQUIRE(v);
+    REQUIRE(vxl_renderer_set_volume(rd, v) == VXL_OK);
+    REQUIRE(vxl_renderer_set_volume(rs, v) == VXL_OK);
+    vxl_volume_destroy(v);
+    static float d[W * H * 4], s[W * H * 4];
+    uint32_t resident[2], data_pages = 0;
+    const float lows[2] = {0.6f, 0.02f}; /* a narrow window, then one that shows the faint tails */
+    for (int i = 0; i < 2; i++) {
+        vxl_render_params p = scene(VXL_FILTER_SOBEL26, VXL_CLASSIFY_POST);
+        p.window_low = lows[i];
+        REQUIRE(vxl_render(rd, &p, d, NULL) == VXL_OK);
+        REQUIRE(vxl_render(rs, &p, s, NULL) == VXL_OK);
+        vxl_render_stats st = stats_of(rs);
+        resident[i] = st.pages_resident;
+        data_pages = st.pages_total - st.pages_constant;
+        double q = image_psnr(s, d, W * H * 4);
+        fprintf(stderr, "    window low %.2f: %u of %u bricks resident (%u constant), %.1f dB\n", lows[i], st.pages_resident,
+                st.pages_total, st.pages_constant, q);
+        CHECKF(q >= 60, "window low %.2f: %.1f dB", lows[i], q);
+    }
+    CHECKF(resident[0] < resident[1], "resident %u then %u", resident[0], resident[1]);
+    CHECKF(resident[0] < data_pages / 2, "%u of %u data bricks resident", resident[0], data_pages);
+    vxl_renderer_destroy(rd);
+    vxl_renderer_destroy(rs);
+}
+
+/* A ramp along (1,2,3): every brick face is crossed; the gradient of every
+ * filter bricked storage serves (the on-the-fly ones and precomputed) must
+ * be the ramp's at brick faces, inside the ghost reach and in the middle of
+ * bricks, and the shaded image must equal the dense one. */
+TEST(no_seams_on_a_ramp_across_brick_edges)
+{
+    const double prm[4] = {0.01, 0.02, 0.03, 0.0}, g[3] = {0.01, 0.02, 0.03};
+    vxl_volume *v = make_volume_f32(40, 40, 24, field_ramp, prm);
+    REQUIRE(v);
+    vxl_renderer *rd = make_stored(VXL_STORAGE_DENSE, 0, 0), *rb = make_stored(VXL_STORAGE_BRICKED, 8, 0);
+    REQUIRE(rd && rb);
+    REQUIRE(vxl_renderer_set_volume(rd, v) == VXL_OK);
+    REQUIRE(vxl_renderer_set_volume(rb, v) == VXL_OK);
+    vxl_volume_destroy(v);
+    enum { N = 64 };
+    float pts[N * 3], out[N * 3];
+    for (int i = 0; i < N; i++) { /* faces at 7.5, 15.5, ...; points on, just before and after them */
+        const float offs[4] = {-0.25f, 0.0f, 0.3f, 0.5f};
+        pts[3 * i] = 7.5f + 8.0f * (i % 4) + offs[i % 4];
+        pts[3 * i + 1] = 7.5f + 8.0f * (i / 4 % 4) + offs[(i / 4) % 4];
+        pts[3 * i + 2] = 7.5f + 8.0f * (i / 16 % 2) + offs[(i / 32) % 2];
+    }
+    for (uint32_t f = 0; f <= VXL_FILTER_PRECOMPUTED; f++) {
+        vxl_render_params p = scene(f, VXL_CLASSIFY_POST);
+        p.gradient_store = VXL_GRADIENT_STORE_32F; /* precomputed: no 8-bit rounding of the direction */
+        REQUIRE(vxl_probe_gradients(rb, &p, pts, N, out) == VXL_OK);
+        double worst = 0;
+        for (int i = 0; i < N; i++) worst = fmax(worst, angle_deg(out + 3 * i, g));
+        CHECKF(worst < 0.01, "%s: %.4f degrees off the ramp at a brick edge", vxl_filter_name(f), worst);
+        static float d[W * H * 4], b[W * H * 4];
+        p.has_window = 1;
+        p.window_low = 0.3f;
+        p.window_high = 1.5f;
+        p.preset = VXL_PRESET_GRAY;
+        REQUIRE(vxl_render(rd, &p, d, NULL) == VXL_OK);
+        REQUIRE(vxl_render(rb, &p, b, NULL) == VXL_OK);
+        double q = image_psnr(b, d, W * H * 4);
+        CHECKF(q >= 60, "%s: ramp %.1f dB", vxl_filter_name(f), q);
+    }
+    vxl_renderer_destroy(rd);
+    vxl_renderer_destroy(rb);
+}
+
+static double ball_row(double x, double y, double z, const double *p)
+{
+    (void)p;
+    const double c[3] = {fmod(x, 300.0) - 150.0, y - 12, z - 12};
+    return exp(-(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) / 50.0);
+}
+
+TEST(over_the_texture_limit_renders_bricked)
+{
+    vxl_renderer *ra = make_stored(VXL_STORAGE_AUTO, 0, 0), *rd = make_stored(VXL_STORAGE_DENSE, 0, 0),
+                 *rs = make_stored(VXL_STORAGE_SPARSE, 0, 0);
+    REQUIRE(ra && rd && rs);
+    vxl_renderer_info info = {.struct_size = sizeof info};
+    vxl_renderer_get_info(ra, &info);
+    uint32_t nx = (uint32_t)info.max_3d_texture_size + 52;
+    vxl_volume *v = make_volume_f32(nx, 24, 24, ball_row, NULL);
+    REQUIRE(v);
+    CHECK(vxl_renderer_set_volume(rd, v) == VXL_ERR_LIMIT);
+    CHECKF(strstr(vxl_last_error(), "texture limit") != NULL, "%s", vxl_last_error());
+    REQUIRE(vxl_renderer_set_volume(ra, v) == VXL_OK);
+    REQUIRE(vxl_renderer_set_volume(rs, v) == VXL_OK);
+    vxl_volume_destroy(v);
+    enum { WW = 256, WH = 256 }; /* 8 voxels a pixel: each ball covers a few pixels */
+    static float a[WW * WH * 4], s[WW * WH * 4];
+    vxl_render_params p = scene(VXL_FILTER_CENTRAL, VXL_CLASSIFY_POST);
+    p.width = WW;
+    p.height = WH;
+    p.window_low = 0.3f;
+    p.window_high = 1.0f;
+    p.azimuth_deg = p.elevation_deg = 0;
+    REQUIRE(vxl_render(ra, &p, a, NULL) == VXL_OK);
+    REQUIRE(vxl_render(rs, &p, s, NULL) == VXL_OK);
+    vxl_render_stats sa = stats_of(ra), ss = stats_of(rs);
+    CHECK(sa.storage == VXL_STORAGE_BRICKED);
+    CHECK(image_is_sane(a, NULL, WW * WH));
+    CHECKF(alpha_sum(a, WW * WH) > 1, "alpha sum %g", alpha_sum(a, WW * WH));
+    double q = image_psnr(s, a, WW * WH * 4);
+    CHECKF(q >= 60, "sparse vs bricked %.1f dB", q);
+    fprintf(stderr, "    %ux24x24: bricked %u/%u bricks, %.2f MiB; sparse %u, %.2f MiB\n", nx, sa.pages_resident,
+            sa.pages_total, sa.resident_bytes / 1048576.0, ss.pages_resident, ss.resident_bytes / 1048576.0);
+    CHECK(ss.resident_bytes < sa.resident_bytes);
+    vxl_renderer_destroy(ra);
+    vxl_renderer_destroy(rd);
+    vxl_renderer_destroy(rs);
+}
+
+TEST(budgets_and_unsupported_modes_fail_clearly)
+{
+    vxl_volume *v = make_volume_f32(96, 96, 96, three_blobs, NULL);
+    REQUIRE(v);
+    /* 64 KiB cannot hold the data bricks: bricked refuses, naming the budget */
+    vxl_renderer *rb = make_stored(VXL_STORAGE_BRICKED, 8, 64 << 10);
+    REQUIRE(rb);
+    CHECK(vxl_renderer_set_volume(rb, v) == VXL_ERR_LIMIT);
+    CHECKF(strstr(vxl_last_error(), "memory budget") != NULL, "%s", vxl_last_error());
+    vxl_renderer_destroy(rb);
+    /* sparse holds what a narrow window shows and says so when a wide one
+     * overflows: the budget lies between the two, measured unbudgeted */
+    static float img[W * H * 4];
+    vxl_render_params p = scene(VXL_FILTER_CENTRAL, VXL_CLASSIFY_POST);
+    p.window_low = 0.7f;
+    vxl_renderer *rs = make_stored(VXL_STORAGE_SPARSE, 8, 0);
+    REQUIRE(rs);
+    REQUIRE(vxl_renderer_set_volume(rs, v) == VXL_OK);
+    REQUIRE(vxl_render(rs, &p, img, NULL) == VXL_OK);
+    uint64_t narrow = stats_of(rs).resident_bytes;
+    vxl_renderer_destroy(rs);
+    rs = make_stored(VXL_STORAGE_SPARSE, 8, narrow + 4096);
+    REQUIRE(rs);
+    REQUIRE(vxl_renderer_set_volume(rs, v) == VXL_OK);
+    CHECKF(vxl_render(rs, &p, img, NULL) == VXL_OK, "%s", vxl_last_error());
+    CHECK(stats_of(rs).resident_bytes == narrow);
+    CHECK(stats_of(rs).lod_level == 0 && stats_of(rs).lod_wanted_bytes == 0);
+    /* a window that shows the far tails wants more than the budget: the
+     * frame falls back to a coarser level, says so, and stays close */
+    p.window_low = 1e-6f;
+    p.window_high = 1e-5f;
+    static float coarse[W * H * 4], full[W * H * 4];
+    CHECKF(vxl_render(rs, &p, coarse, NULL) == VXL_OK, "%s", vxl_last_error());
+    vxl_render_stats sl = stats_of(rs);
+    vxl_renderer *rd = make_stored(VXL_STORAGE_DENSE, 0, 0);
+    REQUIRE(rd);
+    REQUIRE(vxl_renderer_set_volume(rd, v) == VXL_OK);
+    REQUIRE(vxl_render(rd, &p, full, NULL) == VXL_OK);
+    double q = image_psnr(coarse, full, W * H * 4);
+    fprintf(stderr, "    LOD fallback: level %u, %.1f KiB resident (full resolution wanted %.1f KiB, budget %.1f KiB), "
+            "%.1f dB against full resolution\n", sl.lod_level, sl.resident_bytes / 1024.0, sl.lod_wanted_bytes / 1024.0,
+            (narrow + 4096) / 1024.0, q);
+    CHECK(sl.lod_level >= 1 && sl.lod_wanted_bytes > narrow + 4096 && sl.resident_bytes <= narrow + 4096);
+    CHECKF(q >= 20, "LOD image %.1f dB from full resolution", q);
+    /* back to the narrow window: full resolution again */
+    p.window_low = 0.7f;
+    p.window_high = 0.75f;
+    REQUIRE(vxl_render(rs, &p, img, NULL) == VXL_OK);
+    CHECK(stats_of(rs).lod_level == 0);
+    vxl_renderer_destroy(rd);
+    /* what needs one texture says so */
+    vxl_renderer *rk = make_stored(VXL_STORAGE_BRICKED, 16, 0);
+    REQUIRE(rk);
+    REQUIRE(vxl_renderer_set_volume(rk, v) == VXL_OK);
+    const uint32_t filters[2] = {VXL_FILTER_CUBIC, VXL_FILTER_CENTRAL};
+    for (int i = 0; i < 2; i++) {
+        vxl_render_params q = scene(filters[i], i == 1 ? VXL_CLASSIFY_PRE : VXL_CLASSIFY_POST);
+        CHECK(vxl_render(rk, &q, img, NULL) == VXL_ERR_STATE);
+        CHECKF(strstr(vxl_last_error(), "one texture") != NULL, "%s", vxl_last_error());
+    }
+    vxl_render_params pq = scene(VXL_FILTER_PRECOMPUTED, VXL_CLASSIFY_POST); /* bricked: yes; sparse: no */
+    CHECKF(vxl_render(rk, &pq, img, NULL) == VXL_OK, "%s", vxl_last_error());
+    CHECK(vxl_render(rs, &pq, img, NULL) == VXL_ERR_STATE);
+    CHECKF(strstr(vxl_last_error(), "sparse") != NULL, "%s", vxl_last_error());
+    vxl_renderer_destroy(rk);
+    vxl_renderer_destroy(rs);
+    vxl_volume_destroy(v);
+}
+
+int main(void)
+{
+    RUN(bricked_and_sparse_equal_dense);
+    RUN(precomputed_gradients_bricked_equal_dense);
+    RUN(sparse_follows_the_transfer_function);
+    RUN(no_seams_on_a_ramp_across_brick_edges);
+    RUN(over_the_texture_limit_renders_bricked);
+    RUN(budgets_and_unsupported_modes_fail_clearly);
+    return TEST_SUMMARY();
+}

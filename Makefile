@@ -17,14 +17,14 @@ CXXFLAGS := -std=c++17 $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include $
 DCMTK_LIBS := -ldcmdata -loflog -lofstd
 LIBS := -ldl -lpthread -lz -lm $(shell pkg-config --libs OpenImageIO) $(DCMTK_LIBS)
 
-LIB_C := $(filter-out csrc/cli.c,$(wildcard csrc/*.c))
+LIB_C := $(filter-out csrc/cli.c csrc/vdb_helper_main.c,$(wildcard csrc/*.c))
 LIB_CXX := $(wildcard csrc/*.cpp)
 SHADERS := $(wildcard shaders/*.glsl shaders/*.vert shaders/*.frag shaders/*.comp)
 OBJ := $(LIB_C:csrc/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:csrc/%.cpp=$(BUILD)/obj/%.o) $(BUILD)/obj/shaders_embedded.o
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
-all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(TESTS)
+all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/voxlight-vdb-read $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(TESTS)
 
 $(BUILD)/obj/%.o: csrc/%.c $(wildcard csrc/*.h csrc/include/*.h) | $(BUILD)/obj
 	$(CC) $(CFLAGS) -c $< -o $@
@@ -47,6 +47,11 @@ $(BUILD)/libvoxlight.so: $(OBJ)
 
 $(BUILD)/voxlight: csrc/cli.c $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
+# The process that reads .vdb files for the library (csrc/vdb_spawn.c): the
+# library's objects linked in, so it needs no libvoxlight.so at run time.
+$(BUILD)/voxlight-vdb-read: $(BUILD)/obj/vdb_helper_main.o $(OBJ)
+	$(CXX) $(OPT) -o $@ $^ $(LIBS)
 
 $(BUILD)/voxlight-bench: bench/bench.c $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
@@ -71,7 +76,7 @@ FUZZ_SAN := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-san
 FUZZ_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include -Icsrc
 FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include -Icsrc \
 	$(shell pkg-config --cflags OpenImageIO)
-FUZZ_LIB_C := volume.c error.c nifti.c nrrd.c metaimage.c loader_util.c
+FUZZ_LIB_C := volume.c error.c nifti.c nrrd.c metaimage.c loader_util.c vdb_spawn.c
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))

@@ -15,18 +15,23 @@
 // writes scene units), not converted to mm. OpenVDB puts voxel centres at
 // integer index coordinates, as we do.
 //
+// This is the in-process read; only the helper process runs it
+// (vdb_stream.h, vdb_spawn.c), the library never does.
+//
 // Hostile input: the box comes from the header and passes the memory budget
 // before any voxel is allocated; the voxels are read one tile at a time and
 // copied into the box, so a box that disagrees with the data window or an
 // odd tile size is an error, never an out-of-bounds write. What we cannot
 // guard: OpenImageIO's open() has OpenVDB read every grid of the file (the
 // sparse tree, before the dense budget check), and Debian's OpenVDB aborts
-// on some malformed files there (tests/fuzz/upstream/README.md).
+// on some malformed files there (tests/fuzz/upstream/README.md): the reason
+// this runs in its own process.
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -34,6 +39,7 @@
 
 extern "C" {
 #include "loader_util.h"
+#include "vdb_stream.h"
 }
 
 namespace {
@@ -159,7 +165,7 @@ int read_box(OIIO::ImageInput &in, const char *path, const long long lo[3], cons
     return VXL_OK;
 }
 
-int load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+int read_dense(const char *path, const vxl_load_options *opt, vxl_vdb_grid *g, vxl_err *e)
 {
     uint64_t fsize = 0;
     int rc = vxl_regular_file(path, &fsize, e);
@@ -183,39 +189,36 @@ int load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_er
         !index_to_world(spec, itw))
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': grid '%s' has no bounding box or transform in its header", path,
                         name.c_str());
-    uint32_t dims[3];
     for (int a = 0; a < 3; a++) {
         if (bmax[a] < bmin[a]) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': grid '%s' is empty", path, name.c_str());
         long long n = bmax[a] - bmin[a] + 1;
-        dims[a] = n > UINT32_MAX ? UINT32_MAX : static_cast<uint32_t>(n);
+        g->dims[a] = n > UINT32_MAX ? UINT32_MAX : static_cast<uint32_t>(n);
     }
-    double A[16], spacing[3];
-    if (!grid_affine(itw, bmin, A, spacing))
+    if (!grid_affine(itw, bmin, g->affine, g->spacing))
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': grid '%s' has a transform that is not an invertible affine map "
                         "(frustum grids are not supported)", path, name.c_str());
     uint64_t nbytes = 0;
-    rc = vxl_plan_voxels(path, dims, VXL_DTYPE_F32, opt, &nbytes, e);
+    rc = vxl_plan_voxels(path, g->dims, VXL_DTYPE_F32, opt, &nbytes, e);
     if (rc) return rc;
-    std::vector<float> dense(static_cast<size_t>(nbytes / sizeof(float)));
-    rc = read_box(*in, path, bmin, dims, dense.data(), e);
+    std::unique_ptr<float, decltype(&std::free)> dense(static_cast<float *>(std::malloc(nbytes)), &std::free);
+    if (!dense) return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for %llu bytes of voxels", path,
+                                static_cast<unsigned long long>(nbytes));
+    rc = read_box(*in, path, bmin, g->dims, dense.get(), e);
     if (rc) return rc;
     in->close();
-    vxl_err inner = {};
-    rc = vxl_volume_build(dense.data(), VXL_DTYPE_F32, dims, spacing, A, 0.0, 0.0, opt, out, &inner);
-    if (rc) return vxl_fail_in(e, path, &inner);
-    (*out)->affine_source = 2; // a full affine from the file, as an sform
+    g->voxels = dense.release();
     return VXL_OK;
 }
 
 } // namespace
 
-extern "C" int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+extern "C" int vxl_vdb_read_dense(const char *path, const vxl_load_options *opt, vxl_vdb_grid *out, vxl_err *e)
 {
     if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
-    *out = nullptr;
+    std::memset(out, 0, sizeof *out);
     if (!path || !*path) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "path is empty");
     try {
-        return load(path, opt, out, e);
+        return read_dense(path, opt, out, e);
     } catch (const std::bad_alloc &) {
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory", path);
     } catch (const std::exception &x) {

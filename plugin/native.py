@@ -23,6 +23,8 @@ import numpy as np
 
 ABI_VERSION = 1
 LIBRARY_NAME = "libvoxlight.so"
+# The process that reads .vdb files for the library, next to it (csrc/vdb_spawn.c).
+VDB_HELPER_NAME = "voxlight-vdb-read"
 
 # The names this binding was written against (VXL_FILTER_* / VXL_PRESET_*
 # order). The library is the authority: Library.filter_names() reads
@@ -407,10 +409,26 @@ def load_library(path=None, reload=False):
             if p == path:
                 break
             continue
+        restore_execute_bit(os.path.join(os.path.dirname(p), VDB_HELPER_NAME))
         _library, _library_error = lib, None
         return lib
     _library_error = "libvoxlight not usable: " + "; ".join(errors)
     raise LibraryUnavailable(_library_error)
+
+
+def restore_execute_bit(path):
+    """Blender installs an add-on zip with zipfile.extractall, which drops
+    file modes, so the shipped helper arrives without its execute bit: give
+    it back (execute where it is readable). Returns whether path is now
+    executable; a missing or read-only helper is left to the library, whose
+    error names it when a .vdb is loaded."""
+    try:
+        mode = os.stat(path).st_mode
+        if not os.access(path, os.X_OK):
+            os.chmod(path, mode | ((mode & 0o444) >> 2))
+    except OSError:
+        return False
+    return os.access(path, os.X_OK)
 
 
 def filter_names(lib=None):

@@ -109,6 +109,20 @@ def vdb_import_is_in_scene_units():
 
 
 @test
+def openvdb_abort_is_an_error_and_blender_lives_on():
+    """libopenvdb aborts on this file (tests/fuzz/upstream/): the add-on's
+    helper process dies instead of Blender, the import reports it, and the
+    next .vdb import still works through the installed helper."""
+    u.reset_scene()
+    helper = os.path.join(os.path.dirname(vx.__file__), vx.native.VDB_HELPER_NAME)
+    assert os.access(helper, os.X_OK), helper  # zip install dropped the bit; the add-on restored it
+    repro = os.path.join(u.ROOT, "tests", "fuzz", "upstream", "openvdb_delayed_load_mask_assert.vdb")
+    _expect_failure("the OpenVDB reader crashed (signal 6: SIGABRT)", filepath=repro)
+    path = write_vdb(os.path.join(u.TMP, "after.vdb"), [{"name": "density", "array": np.ones((3, 4, 5), np.float32)}])
+    assert tuple(u.import_volume(path).voxlight.dims) == (3, 4, 5)
+
+
+@test
 def failures_leave_bpy_data_unchanged():
     u.reset_scene()
     bad = os.path.join(u.TMP, "broken.vdb")

@@ -184,3 +184,20 @@ def test_missing_slice_in_series_is_reported(tmp_path):
         write_png(tmp_path / f"s_{k:02d}.png", img)
     r = run("info", tmp_path / "s_01.png")
     assert r.returncode != 0 and "missing slices between 2" in r.stderr
+
+
+@pytest.mark.parametrize("name,needle", [
+    # libopenvdb aborts on an assertion here: only the helper process dies
+    ("openvdb_delayed_load_mask_assert.vdb", "the OpenVDB reader crashed (signal 6: SIGABRT)"),
+    ("openvdb_blosc_size_alloc.vdb", "std::bad_alloc"),
+    ("openvdb_transform_string_alloc.vdb", "is not registered"),
+])
+def test_openvdb_upstream_failures_are_one_error_line(tmp_path, name, needle):
+    """tests/fuzz/upstream/: files on which libopenvdb fails before our code
+    runs, the first one with abort() (exit 134 before the helper process)."""
+    p = ROOT / "tests" / "fuzz" / "upstream" / name
+    for cmd in (["info", p], ["render", p, "-o", tmp_path / "x.png", "--size", "16x16"]):
+        r = run(*cmd)
+        assert r.returncode == 1, (r.returncode, r.stderr)
+        lines = [l for l in r.stderr.splitlines() if l.startswith("voxlight: error:")]
+        assert len(lines) == 1 and needle in lines[0] and name in lines[0], r.stderr

@@ -23,7 +23,12 @@ static void vxl_fuzz_cleanup(void)
     if (vxl_fuzz_dir[0]) rmdir(vxl_fuzz_dir);
 }
 
-static int vxl_fuzz_load(const uint8_t *data, size_t size, const char *ext)
+/* The limits every target loads under. */
+static const vxl_load_options vxl_fuzz_options = {
+    .struct_size = sizeof(vxl_load_options), .max_dim = 4096, .memory_budget_bytes = 16u << 20};
+
+/* Writes the input to the target's file (input.EXT) and returns its path. */
+static inline const char *vxl_fuzz_write(const uint8_t *data, size_t size, const char *ext)
 {
     if (!vxl_fuzz_dir[0]) {
         /* a file per input: tmpfs (/dev/shm) where there is one, since a
@@ -40,9 +45,13 @@ static int vxl_fuzz_load(const uint8_t *data, size_t size, const char *ext)
     if (!f) abort();
     if (size && fwrite(data, 1, size, f) != size) abort();
     fclose(f);
-    vxl_load_options opt = {.struct_size = sizeof opt, .max_dim = 4096, .memory_budget_bytes = 16u << 20};
-    vxl_volume *v = NULL;
-    int rc = vxl_volume_load(vxl_fuzz_path, &opt, &v);
+    return vxl_fuzz_path;
+}
+
+/* Checks the API contract of a load result; aborts (a libFuzzer finding) on
+ * a breach, then frees the volume. */
+static inline void vxl_fuzz_check(int rc, vxl_volume *v)
+{
     if (rc == VXL_OK && !v) abort();
     if (rc != VXL_OK && (v || !vxl_last_error()[0])) abort();
     if (v) {
@@ -51,6 +60,13 @@ static int vxl_fuzz_load(const uint8_t *data, size_t size, const char *ext)
         if (info.dims[0] * (uint64_t)info.dims[1] * info.dims[2] == 0) abort();
     }
     vxl_volume_destroy(v);
+}
+
+static inline int vxl_fuzz_load(const uint8_t *data, size_t size, const char *ext)
+{
+    const char *path = vxl_fuzz_write(data, size, ext);
+    vxl_volume *v = NULL;
+    vxl_fuzz_check(vxl_volume_load(path, &vxl_fuzz_options, &v), v);
     return 0;
 }
 

@@ -13,7 +13,10 @@ shift || true
 targets=("$@")
 # vdb is not in the default list: OpenVDB (read by OpenImageIO when it opens
 # the file, before Voxlight sees a byte) aborts on an assertion within a few
-# dozen mutations (tests/fuzz/upstream/); run it by name: run.sh 60 vdb.
+# dozen mutations (tests/fuzz/upstream/). The library survives that by
+# reading .vdb files in a helper process, but fuzz_vdb runs the helper's
+# in-process read (libFuzzer only sees coverage in its own process), so the
+# abort still ends it; run it by name: run.sh 60 vdb.
 [ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom)
 
 if ! make -s -j"$(nproc)" fuzz; then

@@ -458,6 +458,34 @@ TEST(compressed_is_exact_on_8bit_levels_and_codes_cannot_be_filtered)
     vxl_renderer_destroy(rx);
 }
 
+/* Compressed storage's budget covers codes, palettes and the decode cache:
+ * too small for the codes, set_volume refuses; room for the codes but not
+ * for the visible bricks' cache, the frame fails; both name the budget. */
+TEST(compressed_budget_counts_codes_and_cache)
+{
+    vxl_renderer *rx = make_stored_in(VXL_STORAGE_COMPRESSED, 8, 0, 1), *tiny = make_stored(VXL_STORAGE_COMPRESSED, 8, 4096);
+    REQUIRE(rx && tiny);
+    vxl_renderer *const one[1] = {rx};
+    REQUIRE(set_phantom(one, 1, VXL_PHANTOM_MARSCHNER_LOBB));
+    vxl_render_params p = scene(VXL_FILTER_CENTRAL, VXL_CLASSIFY_POST);
+    static float img[W * H * 4];
+    REQUIRE(vxl_render(rx, &p, img, NULL) == VXL_OK);
+    const uint64_t codes = stats_of(rx).resident_bytes; /* codes + palettes + page table */
+    vxl_renderer *const small[1] = {tiny};
+    CHECK(!set_phantom(small, 1, VXL_PHANTOM_MARSCHNER_LOBB));
+    CHECKF(strstr(vxl_renderer_error(tiny), "memory budget") != NULL, "%s", vxl_renderer_error(tiny));
+    vxl_renderer *rc = make_stored(VXL_STORAGE_COMPRESSED, 8, codes + 8192);
+    REQUIRE(rc);
+    vxl_renderer *const mid[1] = {rc};
+    CHECKF(set_phantom(mid, 1, VXL_PHANTOM_MARSCHNER_LOBB), "%s", vxl_renderer_error(rc));
+    CHECK(vxl_render(rc, &p, img, NULL) != VXL_OK);
+    fprintf(stderr, "    codes %.1f KiB; %s\n", codes / 1024.0, vxl_renderer_error(rc));
+    CHECKF(strstr(vxl_renderer_error(rc), "memory budget") != NULL, "%s", vxl_renderer_error(rc));
+    vxl_renderer_destroy(rx);
+    vxl_renderer_destroy(tiny);
+    vxl_renderer_destroy(rc);
+}
+
 int main(void)
 {
     RUN(bricked_and_sparse_equal_dense);
@@ -468,5 +496,6 @@ int main(void)
     RUN(budgets_and_unsupported_modes_fail_clearly);
     RUN(compressed_equals_dense_within_its_palette);
     RUN(compressed_is_exact_on_8bit_levels_and_codes_cannot_be_filtered);
+    RUN(compressed_budget_counts_codes_and_cache);
     return TEST_SUMMARY();
 }

@@ -33,30 +33,72 @@ static uint32_t nearest(const float *c, uint32_t k, float v)
     return lo;
 }
 
-/* 256 centres for sorted values s[0..n): quantiles, then Lloyd iterations
- * (each value to its nearest centre, each centre to the mean of its values).
- * Integer stores keep integer centres, so the decoded cache (R8/R16) holds
- * exactly what the palette says. Returns the centres in use (ascending). */
-static uint32_t fit_levels(const float *s, uint32_t n, int integer, float *c)
+/* 256 centres for the distinct values d[0..m) (ascending, w[j] voxels
+ * each, total n): weighted quantiles, then Lloyd iterations (each value to
+ * its nearest centre, each centre to the mean of its values). Integer
+ * stores keep integer centres, so the decoded cache (R8/R16) holds exactly
+ * what the palette says. Returns the centres in use (ascending). */
+static uint32_t fit_levels(const float *d, const uint32_t *w, uint32_t m, uint32_t n, int integer, float *c)
 {
     const uint32_t k = VXL_PALETTE_SIZE;
-    for (uint32_t j = 0; j < k; j++) c[j] = s[(uint64_t)(2 * j + 1) * n / (2 * k)];
+    uint64_t seen = 0;
+    for (uint32_t j = 0, i = 0; j < k; j++) {
+        const uint64_t target = (uint64_t)(2 * j + 1) * n / (2 * k);
+        while (i + 1 < m && seen + w[i] <= target) seen += w[i++];
+        c[j] = d[i];
+    }
     for (int it = 0; it < LLOYD_ITERATIONS; it++) {
         double sum[VXL_PALETTE_SIZE] = {0};
-        uint32_t cnt[VXL_PALETTE_SIZE] = {0};
+        uint64_t cnt[VXL_PALETTE_SIZE] = {0};
         uint32_t j = 0;
-        for (uint32_t i = 0; i < n; i++) { /* s ascending: the nearest centre only moves up */
-            while (j + 1 < k && s[i] > 0.5f * (c[j] + c[j + 1])) j++;
-            sum[j] += s[i];
-            cnt[j]++;
+        for (uint32_t i = 0; i < m; i++) { /* d ascending: the nearest centre only moves up */
+            while (j + 1 < k && d[i] > 0.5f * (c[j] + c[j + 1])) j++;
+            sum[j] += (double)d[i] * w[i];
+            cnt[j] += w[i];
         }
         for (j = 0; j < k; j++)
             if (cnt[j]) c[j] = integer ? (float)(int64_t)(sum[j] / cnt[j] + 0.5) : (float)(sum[j] / cnt[j]);
         qsort(c, k, sizeof *c, cmp_float);
     }
-    uint32_t m = 1; /* drop duplicate centres so the binary search stays well defined */
+    uint32_t used = 1; /* drop duplicate centres so the binary search stays well defined */
     for (uint32_t j = 1; j < k; j++)
-        if (c[j] != c[m - 1]) c[m++] = c[j];
+        if (c[j] != c[used - 1]) c[used++] = c[j];
+    return used;
+}
+
+/* The brick's distinct values (ascending) and their counts: a histogram for
+ * 8/16-bit stores (hist: 65536 zeroed counters, left zeroed), a sort for
+ * float. Returns how many. */
+static uint32_t distinct_values(const vxl_pages *pg, const float *v, uint32_t n, uint32_t *hist, float *d,
+                                uint32_t *w)
+{
+    uint32_t m = 0;
+    if (pg->bytes_per_voxel < 4) {
+        uint32_t lo = 65535, hi = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            const uint32_t b = (uint32_t)v[i];
+            hist[b]++;
+            lo = b < lo ? b : lo;
+            hi = b > hi ? b : hi;
+        }
+        for (uint32_t b = lo; b <= hi; b++)
+            if (hist[b]) {
+                d[m] = (float)b;
+                w[m++] = hist[b];
+                hist[b] = 0;
+            }
+        return m;
+    }
+    memcpy(d, v, (size_t)n * sizeof *d);
+    qsort(d, n, sizeof *d, cmp_float);
+    for (uint32_t i = 0; i < n; i++) {
+        if (m && d[i] == d[m - 1]) {
+            w[m - 1]++;
+            continue;
+        }
+        d[m] = d[i];
+        w[m++] = 1;
+    }
     return m;
 }
 
@@ -70,27 +112,23 @@ int vxl_compress_pages(vxl_compressed *c, const vxl_pages *pg, vxl_err *e)
     c->palette = malloc((size_t)c->n * VXL_PALETTE_SIZE * sizeof *c->palette + 1);
     c->codes = malloc((size_t)c->n * n + 1);
     float *v = malloc((size_t)n * 2 * sizeof *v);
-    if (!c->palette || !c->codes || !v) {
+    uint32_t *w = malloc((size_t)n * sizeof *w), *hist = calloc(65536, sizeof *hist);
+    if (!c->palette || !c->codes || !v || !w || !hist) {
         free(v);
+        free(w);
+        free(hist);
         vxl_compressed_free(c);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for %u compressed bricks", pg->n_data);
     }
-    float *s = v + n, levels[VXL_PALETTE_SIZE];
+    float *d = v + n, levels[VXL_PALETTE_SIZE];
     for (uint32_t k = 0; k < c->n; k++) {
         raw_values(pg, pg->data + (size_t)k * n * pg->bytes_per_voxel, n, v);
-        memcpy(s, v, (size_t)n * sizeof *s);
-        qsort(s, n, sizeof *s, cmp_float);
-        uint32_t distinct = 1;
-        for (uint32_t i = 1; i < n && distinct <= VXL_PALETTE_SIZE; i++) distinct += s[i] != s[i - 1];
-        uint32_t m;
-        if (distinct <= VXL_PALETTE_SIZE) { /* exact: the brick's own values */
-            m = 1;
-            levels[0] = s[0];
-            for (uint32_t i = 1; i < n; i++)
-                if (s[i] != levels[m - 1]) levels[m++] = s[i];
+        uint32_t m = distinct_values(pg, v, n, hist, d, w);
+        if (m <= VXL_PALETTE_SIZE) { /* exact: the brick's own values */
+            memcpy(levels, d, m * sizeof *levels);
             c->exact++;
         } else {
-            m = fit_levels(s, n, pg->bytes_per_voxel < 4, levels);
+            m = fit_levels(d, w, m, n, pg->bytes_per_voxel < 4, levels);
         }
         float *pal = c->palette + (size_t)k * VXL_PALETTE_SIZE;
         for (uint32_t j = 0; j < VXL_PALETTE_SIZE; j++) pal[j] = levels[j < m ? j : m - 1] * scale;
@@ -98,6 +136,8 @@ int vxl_compress_pages(vxl_compressed *c, const vxl_pages *pg, vxl_err *e)
         for (uint32_t i = 0; i < n; i++) code[i] = (uint8_t)nearest(levels, m, v[i]);
     }
     free(v);
+    free(w);
+    free(hist);
     return VXL_OK;
 }
 

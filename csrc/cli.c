@@ -18,15 +18,16 @@ static const char usage[] =
     "                  [--gradient-store 8bit|16f|32f] [--classify post|pre|preint] [--no-jitter] [--no-skip]\n"
     "                  [--gradient-opacity off|boundary|iso] [--gradient-ref G] [--iso VALUE] [--iso-thickness R]\n"
     "                  [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
-    "                  [--storage auto|dense|bricked|sparse] [--page-brick 8|16|32|64]\n"
+    "                  [--storage auto|dense|bricked|sparse|compressed] [--page-brick 8|16|32|64]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
     "--voxel-size (mm) is for inputs without geometry (TIFF/PNG stacks); one value sets all three\n"
     "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic; presets: auto gray bone hot mri ct\n"
     "storage: auto = one texture when it fits the texture limit and --memory-budget, else bricked;\n"
-    "         sparse keeps only the bricks the transfer function can show (bricked/sparse: the five\n"
-    "         on-the-fly filters, post or preint classification)\n"
+    "         sparse keeps only the bricks the transfer function can show; compressed holds every brick\n"
+    "         as a palette of <= 256 values + 8-bit codes and decodes the visible ones into a cache\n"
+    "         (bricked/sparse/compressed: the five on-the-fly filters, post or preint classification)\n"
     "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of marschner-lobb sphere ramp\n"
     "         noisy-blob sparse-balls dense-balls large-sparse (default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
 
@@ -307,7 +308,7 @@ static int parse_render(int argc, char **argv, render_args *a)
             a->lo.memory_budget_bytes = a->ro.memory_budget_bytes;
         } else if (!strcmp(o, "--storage")) {
             NEED_VALUE();
-            if (vxl_storage_from_name(val, &a->ro.storage)) return die("unknown storage '%s' (auto, dense, bricked, sparse)", val);
+            if (vxl_storage_from_name(val, &a->ro.storage)) return die("unknown storage '%s' (auto, dense, bricked, sparse, compressed)", val);
         } else if (!strcmp(o, "--page-brick")) {
             NEED_VALUE();
             char *end;
@@ -368,6 +369,8 @@ static int cmd_render(int argc, char **argv)
     else
         fprintf(stderr, "voxlight: storage %s, %.1f MiB resident; frame %.3f s\n", vxl_storage_name(st.storage),
                 st.resident_bytes / 1048576.0, secs);
+    if (st.storage == VXL_STORAGE_COMPRESSED)
+        fprintf(stderr, "voxlight: compressed bricks decoded into the cache in %.1f ms\n", st.decode_ms);
     if (st.lod_level) /* never silently coarser */
         fprintf(stderr, "voxlight: LOD fallback: level %u (%ux coarser per axis): the visible bricks need %.1f MiB at full "
                 "resolution, over the memory budget of %.1f MiB\n", st.lod_level, 1u << st.lod_level,

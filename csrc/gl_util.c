@@ -13,8 +13,11 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
 
 /* flags bits for RAYCAST: 1 shading, 2 reuse gradients, bits 2-3 the
  * classify mode, bits 4-5 the gradient-opacity mode, bit 6 (also PROBE)
- * bricked storage; for GRAD_STORE: the store format */
+ * bricked storage, bit 7 compressed storage filtered in the compressed
+ * domain; for GRAD_STORE: the store format; for DECODE_BRICKS: the cache's
+ * bytes per voxel - 1 */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
+static const char *const cache_formats[] = {"r8", "r16", "r32f", "r32f"};
 
 static int compile(vxl_renderer *r, GLenum type, const char *file, const char *defines, GLuint *out)
 {
@@ -66,7 +69,9 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
 {
     char defines[256] = "";
     const char *fdef = filter < VXL_FILTER_COUNT ? filter_defines[filter] : filter_defines[0];
-    const char *paged = (flags & VXL_FLAG_PAGED) ? "#define PAGED 1\n" : "";
+    const char *paged = (flags & VXL_FLAG_COMPRESSED_DOMAIN) ? "#define PAGED 1\n#define COMPRESSED_DOMAIN 1\n"
+                        : (flags & VXL_FLAG_PAGED)            ? "#define PAGED 1\n"
+                                                              : "";
     GLuint a = 0, b = 0;
     int rc;
     switch (kind) {
@@ -114,6 +119,10 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_PAGED_BLUR:
         rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_DECODE_BRICKS:
+        snprintf(defines, sizeof defines, "#define CACHE_FORMAT %s\n", cache_formats[flags & 3]);
+        rc = compile(r, GL_COMPUTE_SHADER, "decode_bricks.comp", defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
         rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);

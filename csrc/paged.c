@@ -4,7 +4,11 @@
  * resident, w >= 0 the brick's value when it is not in the pool). BRICKED
  * makes every non-constant brick resident at set_volume; SPARSE makes
  * resident only the bricks the frame's classification can see, re-derived
- * from the skipping grid when the classification changes. */
+ * from the skipping grid when the classification changes. COMPRESSED keeps
+ * the codes of every data brick on the GL side (compressed_pool.c) and
+ * decodes the bricks the classification can see into the pool, which is
+ * then a linear cache (deferred filtering); filtering in the compressed
+ * domain, the code pool itself is the pool. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -17,6 +21,7 @@ static const GLenum texel_types[] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_SHORT, 0, GL_
 
 void vxl_paged_release(vxl_renderer *r)
 {
+    vxl_compressed_release(r);
     if (r->pool_tex) r->gl.DeleteTextures(1, &r->pool_tex);
     if (r->page_tex) r->gl.DeleteTextures(1, &r->page_tex);
     r->pool_tex = r->page_tex = 0;
@@ -59,6 +64,10 @@ static uint64_t pool_bytes_for(const vxl_pages *pg, const uint32_t slots[3])
     return slots[0] * e * slots[1] * e * slots[2] * e * pg->bytes_per_voxel;
 }
 
+/* Whether the pool is the code pool (compressed storage filtered in the
+ * compressed domain): every data brick, at its code slot, nothing decoded. */
+static int pool_is_codes(const vxl_renderer *r) { return r->storage == VXL_STORAGE_COMPRESSED && r->compressed_domain; }
+
 /* Builds the pool from the bricks of `level` marked in need[] and uploads
  * the page table. Refuses, naming the budget, when they do not fit. */
 static int upload_pool(vxl_renderer *r, uint32_t level, const uint8_t *need)
@@ -66,12 +75,13 @@ static int upload_pool(vxl_renderer *r, uint32_t level, const uint8_t *need)
     vxl_gl *gl = &r->gl;
     vxl_pages *pg = &r->levels[level];
     const uint64_t n = vxl_page_count(pg);
+    const int coded = r->storage == VXL_STORAGE_COMPRESSED, in_codes = pool_is_codes(r);
     uint32_t count = 0, slots[3];
     for (uint64_t i = 0; i < n; i++) count += need[i];
     if (!pool_layout(r, pg, count, slots))
         return vxl_fail(&r->err, VXL_ERR_LIMIT, "%u bricks of %u^3 voxels do not fit a pool texture within the 3D texture limit of %d",
                         count, vxl_page_edge(pg), r->info.max_3d_texture_size);
-    const uint64_t bytes = pool_bytes_for(pg, slots) + page_table_bytes(pg);
+    const uint64_t bytes = (in_codes ? 0 : pool_bytes_for(pg, slots)) + page_table_bytes(pg) + r->code_bytes;
     if (bytes > r->budget)
         return vxl_fail(&r->err, VXL_ERR_LIMIT,
                         "%u resident bricks need %.1f MiB, over the renderer's memory budget of %.1f MiB%s", count,
@@ -79,12 +89,19 @@ static int upload_pool(vxl_renderer *r, uint32_t level, const uint8_t *need)
                         r->storage == VXL_STORAGE_BRICKED ? " (sparse storage keeps only visible bricks)" : "");
     const uint32_t e = vxl_page_edge(pg), fi = pg->bytes_per_voxel - 1;
     const size_t brick_bytes = (size_t)e * e * e * pg->bytes_per_voxel;
-    if (r->pool_tex) gl->DeleteTextures(1, &r->pool_tex);
+    int32_t *source = coded ? malloc((count ? count : 1) * sizeof *source) : NULL;
+    if (coded && !source) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the decode list");
     gl->GetError();
-    r->pool_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+    if (in_codes) {
+        r->pool_tex = r->code_tex;
+        memcpy(slots, r->code_slots, sizeof slots);
+    } else {
+        if (r->pool_tex) gl->DeleteTextures(1, &r->pool_tex);
+        r->pool_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)(slots[0] * e), (GLsizei)(slots[1] * e),
+                       (GLsizei)(slots[2] * e), 0, GL_RED, texel_types[fi], NULL);
+    }
     for (int a = 0; a < 3; a++) r->pool_dims[a] = slots[a] * e;
-    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)r->pool_dims[0], (GLsizei)r->pool_dims[1],
-                   (GLsizei)r->pool_dims[2], 0, GL_RED, texel_types[fi], NULL);
     uint32_t k = 0, constant = 0;
     for (uint64_t i = 0; i < n; i++) {
         float *pe = r->page_entries + 4 * i;
@@ -95,9 +112,13 @@ static int upload_pool(vxl_renderer *r, uint32_t level, const uint8_t *need)
             constant += pg->data_index[i] < 0;
             continue;
         }
-        const uint32_t o[3] = {k % slots[0] * e, k / slots[0] % slots[1] * e, k / (slots[0] * slots[1]) * e};
-        gl->TexSubImage3D(GL_TEXTURE_3D, 0, (GLint)o[0], (GLint)o[1], (GLint)o[2], (GLsizei)e, (GLsizei)e, (GLsizei)e,
-                          GL_RED, texel_types[fi], pg->data + (size_t)pg->data_index[i] * brick_bytes);
+        const uint32_t slot = in_codes ? (uint32_t)pg->data_index[i] : k;
+        const uint32_t o[3] = {slot % slots[0] * e, slot / slots[0] % slots[1] * e, slot / (slots[0] * slots[1]) * e};
+        if (coded)
+            source[k] = pg->data_index[i];
+        else
+            gl->TexSubImage3D(GL_TEXTURE_3D, 0, (GLint)o[0], (GLint)o[1], (GLint)o[2], (GLsizei)e, (GLsizei)e,
+                              (GLsizei)e, GL_RED, texel_types[fi], pg->data + (size_t)pg->data_index[i] * brick_bytes);
         for (int a = 0; a < 3; a++) pe[a] = (float)(o[a] + VXL_PAGE_GHOST);
         pe[3] = -1;
         k++;
@@ -107,6 +128,8 @@ static int upload_pool(vxl_renderer *r, uint32_t level, const uint8_t *need)
     gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA32F, (GLsizei)pg->grid[0], (GLsizei)pg->grid[1], (GLsizei)pg->grid[2], 0,
                    GL_RGBA, GL_FLOAT, r->page_entries);
     int rc = vxl_gl_check(r, "uploading the brick pool");
+    if (!rc && coded && !in_codes) rc = vxl_compressed_decode(r, source, count, slots);
+    free(source);
     if (rc) return rc;
     r->pages_resident = count;
     r->pages_constant = constant;
@@ -168,6 +191,10 @@ int vxl_paged_plan(vxl_renderer *r, const vxl_volume *v, uint32_t storage, vxl_p
     }
     uint64_t all = resident_bytes_for(r, pg, pg->n_data), none = resident_bytes_for(r, pg, 0);
     uint64_t need = storage == VXL_STORAGE_BRICKED ? all : none;
+    if (storage == VXL_STORAGE_COMPRESSED) { /* every brick's codes, and a cache that follows the classification */
+        uint64_t codes = vxl_code_bytes_for(r, pg), rest = r->compressed_domain ? page_table_bytes(pg) : none;
+        need = codes == UINT64_MAX || rest == UINT64_MAX ? UINT64_MAX : codes + rest;
+    }
     if (need > r->budget) {
         const char *hint = storage == VXL_STORAGE_BRICKED ? "; sparse storage keeps only the visible bricks" : "";
         rc = need == UINT64_MAX
@@ -195,6 +222,10 @@ int vxl_paged_install(vxl_renderer *r, vxl_paged_volume *pv)
     r->resident = calloc(n, 1);
     r->page_entries = malloc(n * 4 * sizeof(float));
     if (!r->resident || !r->page_entries) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
+    if (r->storage == VXL_STORAGE_COMPRESSED) {
+        int rc = vxl_compressed_upload(r);
+        if (rc || !r->compressed_domain) return rc; /* the cache follows the first frame's classification */
+    }
     if (r->storage == VXL_STORAGE_SPARSE) return VXL_OK; /* the pool follows the first frame's classification */
     uint8_t *need = malloc(n);
     if (!need) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
@@ -210,7 +241,7 @@ int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify)
 {
     if (!r->storage || r->storage == VXL_STORAGE_DENSE) return VXL_OK;
     const char *what = filter == VXL_FILTER_PRECOMPUTED && r->storage != VXL_STORAGE_BRICKED
-                           ? "the precomputed gradient filter with sparse storage"
+                           ? "the precomputed gradient filter with sparse or compressed storage"
                        : filter == VXL_FILTER_CUBIC     ? "the cubic gradient filter"
                        : classify == VXL_CLASSIFY_PRE   ? "pre-classification"
                                                         : NULL;
@@ -227,7 +258,8 @@ int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify)
  * only when even the coarsest does not fit. */
 int vxl_paged_prepare(vxl_renderer *r, const vxl_frame *f)
 {
-    if (r->storage != VXL_STORAGE_SPARSE) return VXL_OK;
+    r->decode_ms = 0;
+    if (r->storage != VXL_STORAGE_SPARSE && (r->storage != VXL_STORAGE_COMPRESSED || pool_is_codes(r))) return VXL_OK;
     /* gradient taps reach sample_distance voxels per axis, trilinear one more */
     uint32_t reach = f ? (uint32_t)ceilf(f->sample_distance) + 1 : 0;
     const int all = !f || f->gopacity == VXL_GOPACITY_ISO;
@@ -239,8 +271,16 @@ int vxl_paged_prepare(vxl_renderer *r, const vxl_frame *f)
     for (; level < r->n_levels; level++) { /* f == NULL (probes): full resolution only */
         uint32_t count = vxl_pages_needed(&r->levels[level], &r->bricks, reach, 1u << level, all, need);
         bytes = resident_bytes_for(r, &r->levels[level], count);
+        if (bytes != UINT64_MAX) bytes += r->code_bytes;
         if (level == 0) wanted = bytes;
         if (bytes <= r->budget || !f) break;
+    }
+    if (level == r->n_levels && r->n_levels == 1) { /* compressed storage has no coarser levels */
+        free(need);
+        return vxl_fail(&r->err, VXL_ERR_LIMIT,
+                        "the visible bricks need %.1f MiB (codes and decode cache), over the renderer's memory budget "
+                        "of %.1f MiB",
+                        wanted / 1048576.0, r->budget / 1048576.0);
     }
     if (level == r->n_levels) {
         free(need);

@@ -44,8 +44,7 @@ static GLint *derived_bricks(const vxl_pages *pg, uint32_t *count)
 
 static GLuint groups(uint32_t n) { return (n + 3) / 4; }
 
-/* Runs prog over every derived brick of edge e, in chunks the dispatch limit allows. */
-static void dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t count, uint32_t e)
+void vxl_dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t count, uint32_t e)
 {
     const uint32_t per = 65535u * 4u / e; /* bricks per dispatch: z groups <= 65535 */
     for (uint32_t first = 0; first < count; first += per) {
@@ -109,7 +108,7 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     vxl_uniform_i(r, blur_prog, "u_volume", 0);
     vxl_uniform_i(r, blur_prog, "u_page", VXL_PAGE_UNIT);
     gl->BindImageTexture(0, blur, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
-    dispatch_bricks(r, blur_prog, count, eb);
+    vxl_dispatch_bricks(r, blur_prog, count, eb);
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     /* pass 2: the global maximum magnitude */
     const GLuint zero = 0;
@@ -121,7 +120,7 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     gl->ActiveTexture(GL_TEXTURE0);
     gl->BindTexture(GL_TEXTURE_3D, blur);
     vxl_uniform_i(r, max_prog, "u_blur", 0);
-    dispatch_bricks(r, max_prog, count, eg);
+    vxl_dispatch_bricks(r, max_prog, count, eg);
     gl->MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     union { GLuint u; float f; } max_mag = {0};
     gl->GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof max_mag.u, &max_mag.u);
@@ -139,7 +138,7 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     vxl_uniform_f(r, store_prog, "u_inv_max", max_mag.f > 0 ? 1.0f / max_mag.f : 0.0f);
     r->gradient_max = max_mag.f; /* the shader scales back to value per voxel */
     gl->BindImageTexture(0, r->gradient_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, store_internal[store]);
-    dispatch_bricks(r, store_prog, count, eg);
+    vxl_dispatch_bricks(r, store_prog, count, eg);
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     gl->DeleteTextures(1, &blur);
     /* the gradient page table: slot origins + ghost, or zero gradient */

@@ -33,7 +33,7 @@ static int job_probe(void *arg)
     GLuint prog;
     int rc = vxl_paged_check_filter(r, p->filter, VXL_CLASSIFY_POST);
     if (!rc) rc = vxl_paged_prepare(r, NULL);
-    if (!rc) rc = vxl_program_get(r, VXL_PROG_PROBE, p->filter, r->volume_tex ? 0u : VXL_FLAG_PAGED, &prog);
+    if (!rc) rc = vxl_program_get(r, VXL_PROG_PROBE, p->filter, vxl_volume_flags(r), &prog);
     if (rc) return rc;
     gl->GetError();
     rc = vxl_bind_volume_textures(r, prog, p->filter, (int)p->gradient_store);

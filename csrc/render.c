@@ -83,6 +83,13 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
         float gd[3] = {(float)r->gpool_dims[0], (float)r->gpool_dims[1], (float)r->gpool_dims[2]};
         GLint gloc = gl->GetUniformLocation(prog, "u_gpool_dims");
         if (gloc >= 0) gl->Uniform3fv(gloc, 1, gd);
+        if (r->pool_tex == r->code_tex) { /* compressed storage filtered in the compressed domain */
+            gl->ActiveTexture(GL_TEXTURE0 + VXL_PALETTE_UNIT);
+            gl->BindTexture(GL_TEXTURE_2D, r->palette_tex);
+            vxl_uniform_i(r, prog, "u_palette", VXL_PALETTE_UNIT);
+            gl->Uniform3i(gl->GetUniformLocation(prog, "u_code_slots"), (GLint)r->code_slots[0],
+                          (GLint)r->code_slots[1], (GLint)r->code_slots[2]);
+        }
     }
     gl->ActiveTexture(GL_TEXTURE0);
     gl->BindTexture(GL_TEXTURE_3D, r->pool_tex ? r->pool_tex : r->volume_tex);
@@ -187,7 +194,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     vxl_gl *gl = &r->gl;
     GLuint prog;
     uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2) |
-                     (f->gopacity << 4) | (r->volume_tex ? 0u : VXL_FLAG_PAGED);
+                     (f->gopacity << 4) | vxl_volume_flags(r);
     /* rays that never evaluate gradients: one program serves every filter */
     uint32_t filter = f->shading || f->gopacity ? f->filter : VXL_FILTER_CENTRAL;
     int rc = vxl_paged_check_filter(r, filter, f->classify);
@@ -267,6 +274,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
         r->stats.pages_total = (uint32_t)vxl_page_count(&r->levels[r->level]);
         r->stats.lod_level = r->level;
         r->stats.lod_wanted_bytes = r->lod_wanted_bytes;
+        r->stats.decode_ms = r->decode_ms;
         r->stats.pages_resident = r->pages_resident;
         r->stats.pages_constant = r->pages_constant;
     }

@@ -96,6 +96,8 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
         r->storage_request = opt->storage;
         r->page_brick_request = opt->page_brick;
     }
+    if (opt && opt->struct_size >= offsetof(vxl_renderer_options, compressed_domain) + sizeof opt->compressed_domain)
+        r->compressed_domain = opt->compressed_domain != 0;
     const char *dir = (opt && opt->shader_dir) ? opt->shader_dir : getenv("VOXLIGHT_SHADER_DIR");
     if (dir && *dir && !(r->shader_dir = strdup(dir))) {
         free(r);

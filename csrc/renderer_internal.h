@@ -33,6 +33,7 @@
 #define VXL_PROG_PAGED_BLUR 9
 #define VXL_PROG_PAGED_GRAD_MAX 10
 #define VXL_PROG_PAGED_GRAD_STORE 11
+#define VXL_PROG_DECODE_BRICKS 12 /* flags: the cache's bytes per voxel - 1 */
 
 typedef struct vxl_program_entry {
     uint32_t key;
@@ -74,6 +75,16 @@ struct vxl_renderer {
     uint32_t pages_resident, pages_constant;
     uint64_t pool_bytes;
     uint32_t pool_reach;          /* the tap reach (voxels) the resident set was derived for */
+    /* Compressed storage (compress.h): the codes of every data brick in
+     * code_tex (R8UI, slot = data index) and their palettes in palette_tex
+     * (16 rows of 256 per texel row). pool_tex is the linear cache the
+     * needed bricks are decoded into (deferred filtering), or code_tex itself
+     * when filtering in the compressed domain. */
+    GLuint code_tex, palette_tex;
+    uint32_t code_slots[3];
+    uint64_t code_bytes;          /* code pool + palettes */
+    int compressed_domain;        /* from the options */
+    double decode_ms;             /* the decode of this frame, 0 if none */
 
     /* Precomputed gradients depend only on the volume data and the storage
      * format: rebuilt on set_volume or a format change, never per frame. */
@@ -150,9 +161,28 @@ void vxl_paged_release(vxl_renderer *r);
 uint32_t vxl_skip_brick_size(void);
 int vxl_paged_gradients_ensure(vxl_renderer *r, int store); /* paged_gradients.c */
 int vxl_pool_layout(const vxl_renderer *r, uint32_t n, uint32_t edge, uint32_t slots[3]);
+/* Runs prog over `count` bricks of edge e (one invocation per voxel, groups
+ * of 4^3), in chunks the dispatch limit allows (sets u_first). */
+void vxl_dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t count, uint32_t e);
 #define VXL_GPAGE_UNIT 9 /* texture unit of the gradient pool's page table */
 #define VXL_PAGE_UNIT 8 /* texture unit of the page table */
 #define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
+#define VXL_FLAG_COMPRESSED_DOMAIN 128u /* with PAGED: the pool holds codes, every tap decodes its 8 neighbours */
+#define VXL_CODE_UNIT 10    /* texture unit of the code pool while decoding */
+#define VXL_PALETTE_UNIT 11 /* texture unit of the palettes */
+#define VXL_PALETTES_PER_ROW 16 /* palettes per texel row of palette_tex (as shaders/palette.glsl) */
+
+/* The sampling flags of programs reading the volume (raycast, probe). */
+static inline uint32_t vxl_volume_flags(const vxl_renderer *r)
+{
+    return r->volume_tex ? 0u : r->pool_tex && r->pool_tex == r->code_tex ? VXL_FLAG_PAGED | VXL_FLAG_COMPRESSED_DOMAIN : VXL_FLAG_PAGED;
+}
+
+/* compressed_pool.c: compressed storage on the GL side */
+uint64_t vxl_code_bytes_for(const vxl_renderer *r, const vxl_pages *pg); /* UINT64_MAX: over the texture limit */
+int vxl_compressed_upload(vxl_renderer *r);
+int vxl_compressed_decode(vxl_renderer *r, const int32_t *source, uint32_t count, const uint32_t slots[3]);
+void vxl_compressed_release(vxl_renderer *r);
 
 /* render.c helpers shared with probe.c */
 int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store);

@@ -77,7 +77,7 @@ void vxl_preset_window(uint32_t preset, double mn, double mx, double *lo, double
 const char *vxl_filter_name(uint32_t f) { return f < VXL_FILTER_COUNT ? filter_names[f] : NULL; }
 const char *vxl_preset_name(uint32_t p) { return p < VXL_PRESET_COUNT ? preset_names[p] : NULL; }
 
-static const char *const storage_names[VXL_STORAGE_COUNT] = {"auto", "dense", "bricked", "sparse"};
+static const char *const storage_names[VXL_STORAGE_COUNT] = {"auto", "dense", "bricked", "sparse", "compressed"};
 const char *vxl_storage_name(uint32_t s) { return s < VXL_STORAGE_COUNT ? storage_names[s] : NULL; }
 
 static int lookup(const char *const *names, uint32_t n, const char *name, uint32_t *out, const char *what)

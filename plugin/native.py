@@ -34,7 +34,7 @@ VDB_HELPER_NAME = "voxlight-vdb-read"
 FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed", "cubic")
 PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
 BACKENDS = ("auto", "osmesa", "egl")
-STORAGES = ("auto", "dense", "bricked", "sparse")  # VXL_STORAGE_*
+STORAGES = ("auto", "dense", "bricked", "sparse", "compressed")  # VXL_STORAGE_*
 MAX_LIGHTS = 8
 # VXL_CLASSIFY_* and VXL_GOPACITY_* order.
 CLASSIFY_MODES = ("post", "pre", "preint")
@@ -206,7 +206,8 @@ class RenderStats(ctypes.Structure):
                 ("pages_resident", ctypes.c_uint32),
                 ("pages_constant", ctypes.c_uint32),
                 ("lod_level", ctypes.c_uint32),
-                ("lod_wanted_bytes", ctypes.c_uint64)]
+                ("lod_wanted_bytes", ctypes.c_uint64),
+                ("decode_ms", ctypes.c_double)]
 
 
 def _sized(struct_type):
@@ -804,7 +805,7 @@ def _empty_stats():
             "effective_step": 0.0, "bricks_total": 0, "bricks_occupied": 0,
             "brick_size": 0, "calls": 0, "seconds": 0.0, "storage_name": "", "resident_bytes": 0,
             "pages_total": 0, "pages_resident": 0, "pages_constant": 0, "lod_level": 0,
-            "lod_wanted_bytes": 0}
+            "lod_wanted_bytes": 0, "decode_ms": 0.0}
 
 
 def _merge_stats(acc, s):
@@ -814,7 +815,7 @@ def _merge_stats(acc, s):
     acc["sample_bound"] = max(acc["sample_bound"], s["sample_bound"])
     for k in ("effective_step", "bricks_total", "bricks_occupied", "brick_size", "storage_name",
               "resident_bytes", "pages_total", "pages_resident", "pages_constant", "lod_level",
-              "lod_wanted_bytes"):
+              "lod_wanted_bytes", "decode_ms"):
         acc[k] = s[k]
     return acc
 

@@ -208,7 +208,9 @@ class VoxlightSceneProperties(bpy.types.PropertyGroup):
                                  ("bricked", "Bricked", "Bricks in a pool texture; constant bricks "
                                   "cost nothing"),
                                  ("sparse", "Sparse", "Only the bricks the transfer function can "
-                                  "show; a coarser level when even they exceed the budget")],
+                                  "show; a coarser level when even they exceed the budget"),
+                                 ("compressed", "Compressed", "Every brick as a palette of up to 256 "
+                                  "values and 8-bit codes; the visible ones decoded into a cache")],
                           description="How volumes are held on the GPU (volumes reload when "
                                       "this changes)")
     memory_budget_mib: IntProperty(name="Memory Budget (MiB)", default=2048, min=1,

@@ -1,7 +1,9 @@
 // common.glsl - volume sampling shared by the ray caster, the probe and the
 // gradient filters. Positions are in voxel space: voxel centres at integers,
 // the box is [-0.5, dims-0.5].
+#ifndef COMPRESSED_DOMAIN
 uniform sampler3D u_volume; // normalised value in [0,1], trilinear, clamp to edge
+#endif
 uniform vec3 u_dims;
 
 vec3 voxel_to_tex(vec3 p) { return (p + 0.5) / u_dims; }
@@ -26,6 +28,25 @@ uniform vec3 u_page_dims;
 uniform float u_page_brick;
 uniform float u_lod_scale;
 
+#ifdef COMPRESSED_DOMAIN
+// Compressed storage filtered in the compressed domain (for measuring
+// deferred filtering against it): u_volume is the code pool (8-bit codes,
+// a brick's slot = its palette row), and a value is palette[code], which is
+// not linear in the codes, so every tap decodes its 8 neighbours and
+// weights them by hand.
+#include "palette.glsl"
+uniform usampler3D u_volume;
+uniform ivec3 u_code_slots;
+
+int palette_row(vec3 origin)
+{
+    ivec3 s = ivec3(origin) / (int(u_page_brick) + 2); // origin = slot corner + ghost
+    return s.x + u_code_slots.x * (s.y + u_code_slots.y * s.z);
+}
+
+float decode_texel(ivec3 t, int row) { return palette_value(row, texelFetch(u_volume, t, 0).r); }
+#endif
+
 float sample_value(vec3 p)
 {
     if (u_lod_scale > 1.0) p = (p + 0.5) / u_lod_scale - 0.5; // coarse voxel k covers fine k*s .. k*s+s-1
@@ -34,7 +55,20 @@ float sample_value(vec3 p)
     ivec3 b = ivec3(floor((q + 0.5) / u_page_brick));
     vec4 e = texelFetch(u_page, b, 0);
     if (e.w >= 0.0) return e.w;
+#ifndef COMPRESSED_DOMAIN
     return textureLod(u_volume, (e.xyz + q - vec3(b) * u_page_brick + 0.5) / u_pool_dims, 0.0).r;
+#else
+    vec3 t = e.xyz + q - vec3(b) * u_page_brick; // texel centres at integers
+    ivec3 i = ivec3(floor(t));
+    vec3 w = t - vec3(i);
+    int row = palette_row(e.xyz);
+    float c000 = decode_texel(i, row), c100 = decode_texel(i + ivec3(1, 0, 0), row);
+    float c010 = decode_texel(i + ivec3(0, 1, 0), row), c110 = decode_texel(i + ivec3(1, 1, 0), row);
+    float c001 = decode_texel(i + ivec3(0, 0, 1), row), c101 = decode_texel(i + ivec3(1, 0, 1), row);
+    float c011 = decode_texel(i + ivec3(0, 1, 1), row), c111 = decode_texel(i + ivec3(1, 1, 1), row);
+    return mix(mix(mix(c000, c100, w.x), mix(c010, c110, w.x), w.y), mix(mix(c001, c101, w.x), mix(c011, c111, w.x), w.y),
+               w.z);
+#endif
 }
 
 // The stored value of voxel c (inside the volume, full resolution): what
@@ -45,6 +79,10 @@ float paged_fetch(ivec3 c)
     ivec3 b = c / n;
     vec4 e = texelFetch(u_page, b, 0);
     if (e.w >= 0.0) return e.w;
+#ifndef COMPRESSED_DOMAIN
     return texelFetch(u_volume, ivec3(e.xyz) + c - b * n, 0).r;
+#else
+    return decode_texel(ivec3(e.xyz) + c - b * n, palette_row(e.xyz));
+#endif
 }
 #endif

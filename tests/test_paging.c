@@ -5,6 +5,7 @@
  * over the backend's texture limit renders bricked; budgets and unsupported
  * combinations fail with a clear message. Small page bricks (8^3) so small
  * volumes cross many brick edges. */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -14,7 +15,8 @@
 #define W 64
 #define H 64
 
-static vxl_renderer *make_stored(uint32_t storage, uint32_t page_brick, uint64_t budget)
+/* compressed_domain: compressed storage filtered in the compressed domain */
+static vxl_renderer *make_stored_in(uint32_t storage, uint32_t page_brick, uint64_t budget, uint32_t compressed_domain)
 {
     vxl_renderer_options o;
     memset(&o, 0, sizeof o);
@@ -23,8 +25,14 @@ static vxl_renderer *make_stored(uint32_t storage, uint32_t page_brick, uint64_t
     o.storage = storage;
     o.page_brick = page_brick;
     o.memory_budget_bytes = budget;
+    o.compressed_domain = compressed_domain;
     vxl_renderer *r = NULL;
     return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
+}
+
+static vxl_renderer *make_stored(uint32_t storage, uint32_t page_brick, uint64_t budget)
+{
+    return make_stored_in(storage, page_brick, budget, 0);
 }
 
 static vxl_render_params scene(uint32_t filter, uint32_t mode)
@@ -41,6 +49,18 @@ static vxl_render_params scene(uint32_t filter, uint32_t mode)
     return p;
 }
 
+/* Runs 0-4: the five on-the-fly filters in post-classification; 5
+ * pre-integration, 6 boundary opacity (central differences), 7 skipping off. */
+#define STORAGE_RUNS 8
+static vxl_render_params storage_run(uint32_t run)
+{
+    vxl_render_params p = scene(run <= VXL_FILTER_SOBEL26 ? run : VXL_FILTER_CENTRAL,
+                                run == 5 ? VXL_CLASSIFY_PREINT : VXL_CLASSIFY_POST);
+    if (run == 6) p.gradient_opacity = VXL_GOPACITY_BOUNDARY;
+    if (run == 7) p.no_skip = 1;
+    return p;
+}
+
 static vxl_render_stats stats_of(vxl_renderer *r)
 {
     vxl_render_stats s;
@@ -50,48 +70,77 @@ static vxl_render_stats stats_of(vxl_renderer *r)
     return s;
 }
 
-TEST(bricked_and_sparse_equal_dense)
+/* The 45x40x37 phantom (45 is not a multiple of 8: partial bricks at the
+ * far faces) on each of the n renderers. */
+static int set_each(vxl_renderer *const *rs, int n, vxl_volume *v)
+{
+    int ok = v != NULL;
+    for (int i = 0; i < n && ok; i++) ok = vxl_renderer_set_volume(rs[i], v) == VXL_OK;
+    vxl_volume_destroy(v);
+    return ok;
+}
+
+static int set_phantom(vxl_renderer *const *rs, int n, uint32_t kind)
+{
+    vxl_phantom_desc pd = {.struct_size = sizeof pd, .kind = kind, .dims = {45, 40, 37}, .seed = 3};
+    vxl_volume *v = NULL;
+    return vxl_phantom_create(&pd, &v) == VXL_OK && set_each(rs, n, v);
+}
+
+/* Renders p with each of the n renderers into imgs[i]; 0 on the first failure. */
+static int render_each(vxl_renderer *const *rs, float *const *imgs, int n, const vxl_render_params *p)
+{
+    for (int i = 0; i < n; i++)
+        if (vxl_render(rs[i], p, imgs[i], NULL) != VXL_OK) return 0;
+    return 1;
+}
+
+/* Compressed storage (palette of <= 256 values + 8-bit codes per brick,
+ * decoded into a linear cache, then filtered natively) against dense too,
+ * and the compressed-domain variant (every tap decodes 8 codes) against
+ * it. Float phantoms with P = 8: a brick holds 1000 voxels of up to 1000
+ * distinct values in 256 Lloyd levels; the quantisation step is then about
+ * (max - min) / 256 per brick, well under 1% of the range where values
+ * vary fastest, so the image stays above 40 dB (measured 46.6-69.1). */
+TEST(every_storage_equals_dense)
 {
     vxl_renderer *rd = make_stored(VXL_STORAGE_DENSE, 0, 0), *rb = make_stored(VXL_STORAGE_BRICKED, 8, 0),
-                 *rs = make_stored(VXL_STORAGE_SPARSE, 8, 0);
-    REQUIRE(rd && rb && rs);
-    static float d[W * H * 4], b[W * H * 4], s[W * H * 4];
+                 *rs = make_stored(VXL_STORAGE_SPARSE, 8, 0), *rc = make_stored(VXL_STORAGE_COMPRESSED, 8, 0),
+                 *rx = make_stored_in(VXL_STORAGE_COMPRESSED, 8, 0, 1);
+    REQUIRE(rd && rb && rs && rc && rx);
+    static float d[W * H * 4], b[W * H * 4], s[W * H * 4], c[W * H * 4], x[W * H * 4];
     const uint32_t kinds[3] = {VXL_PHANTOM_SPARSE_BALLS, VXL_PHANTOM_MARSCHNER_LOBB, VXL_PHANTOM_NOISY_BLOB};
+    vxl_renderer *const all[5] = {rd, rb, rs, rc, rx};
     for (int k = 0; k < 3; k++) {
-        /* 45 is not a multiple of 8: partial bricks at the far faces */
-        vxl_phantom_desc pd = {.struct_size = sizeof pd, .kind = kinds[k], .dims = {45, 40, 37}, .seed = 3};
-        vxl_volume *v = NULL;
-        REQUIRE(vxl_phantom_create(&pd, &v) == VXL_OK);
-        REQUIRE(vxl_renderer_set_volume(rd, v) == VXL_OK);
-        REQUIRE(vxl_renderer_set_volume(rb, v) == VXL_OK);
-        REQUIRE(vxl_renderer_set_volume(rs, v) == VXL_OK);
-        vxl_volume_destroy(v);
+        REQUIRE(set_phantom(all, 5, kinds[k]));
         /* the five on-the-fly filters in post-classification, pre-integration
          * and boundary opacity with central differences, and skipping off */
-        for (uint32_t run = 0; run < 8; run++) {
-            uint32_t f = run <= VXL_FILTER_SOBEL26 ? run : VXL_FILTER_CENTRAL;
-            vxl_render_params p = scene(f, run == 5 ? VXL_CLASSIFY_PREINT : VXL_CLASSIFY_POST);
-            if (run == 6) p.gradient_opacity = VXL_GOPACITY_BOUNDARY;
-            if (run == 7) p.no_skip = 1;
-            REQUIRE(vxl_render(rd, &p, d, NULL) == VXL_OK);
-            REQUIRE(vxl_render(rb, &p, b, NULL) == VXL_OK);
-            REQUIRE(vxl_render(rs, &p, s, NULL) == VXL_OK);
+        for (uint32_t run = 0; run < STORAGE_RUNS; run++) {
+            vxl_render_params p = storage_run(run);
+            const uint32_t f = p.filter;
+            const char *ph = vxl_phantom_name(kinds[k]), *fn = vxl_filter_name(f);
+            float *const imgs[5] = {d, b, s, c, x};
+            CHECKF(render_each(all, imgs, 5, &p), "%s", vxl_last_error());
             double qb = image_psnr(b, d, W * H * 4), qs = image_psnr(s, d, W * H * 4);
-            vxl_render_stats sb = stats_of(rb), ss = stats_of(rs);
-            fprintf(stderr, "    %-15s %-8s run %u: bricked %6.1f dB (%u/%u resident), sparse %6.1f dB (%u resident)\n",
-                    vxl_phantom_name(kinds[k]), vxl_filter_name(f), run, qb, sb.pages_resident, sb.pages_total, qs,
-                    ss.pages_resident);
-            CHECKF(qb >= 60, "%s/%s run %u: bricked %.1f dB", vxl_phantom_name(kinds[k]), vxl_filter_name(f), run, qb);
-            CHECKF(qs >= 60, "%s/%s run %u: sparse %.1f dB", vxl_phantom_name(kinds[k]), vxl_filter_name(f), run, qs);
+            double qc = image_psnr(c, d, W * H * 4), qx = image_psnr(x, c, W * H * 4);
+            vxl_render_stats sb = stats_of(rb), ss = stats_of(rs), sc = stats_of(rc), sx = stats_of(rx);
+            fprintf(stderr, "    %-15s %-8s run %u: bricked %6.1f dB (%u/%u resident), sparse %6.1f dB (%u resident), "
+                    "compressed %5.1f dB; compressed domain %6.1f dB vs deferred\n",
+                    ph, fn, run, qb, sb.pages_resident, sb.pages_total, qs, ss.pages_resident, qc, qx);
+            CHECKF(qb >= 60, "%s/%s run %u: bricked %.1f dB", ph, fn, run, qb);
+            CHECKF(qs >= 60, "%s/%s run %u: sparse %.1f dB", ph, fn, run, qs);
+            CHECKF(qc >= 40, "%s/%s run %u: compressed %.1f dB", ph, fn, run, qc);
+            CHECKF(qx >= 60, "%s/%s run %u: compressed domain %.1f dB", ph, fn, run, qx);
             CHECK(alpha_sum(d, W * H) > 1);
             CHECK(sb.storage == VXL_STORAGE_BRICKED && ss.storage == VXL_STORAGE_SPARSE);
             CHECK(sb.page_brick == 8 && sb.pages_total == 6 * 5 * 5);
             CHECK(ss.pages_resident <= sb.pages_resident && sb.resident_bytes > 0);
+            CHECK(sc.storage == VXL_STORAGE_COMPRESSED && sc.pages_total == 6 * 5 * 5 && sc.resident_bytes > 0);
+            /* the code pool alone: no decode cache, nothing decoded */
+            CHECK(sx.resident_bytes < sc.resident_bytes && sx.decode_ms == 0);
         }
     }
-    vxl_renderer_destroy(rd);
-    vxl_renderer_destroy(rb);
-    vxl_renderer_destroy(rs);
+    for (int i = 0; i < 5; i++) vxl_renderer_destroy(all[i]);
 }
 
 /* Three Gaussian blobs (sigma 3) in 96^3: their float tails make almost
@@ -326,13 +375,144 @@ TEST(budgets_and_unsupported_modes_fail_clearly)
     vxl_volume_destroy(v);
 }
 
+/* A volume from memory on three renderers: dense, compressed (deferred
+ * filtering) and compressed filtered in the compressed domain. */
+static int dense_and_compressed(const vxl_volume_desc *vd, vxl_renderer *out[3])
+{
+    out[0] = make_stored(VXL_STORAGE_DENSE, 0, 0);
+    out[1] = make_stored(VXL_STORAGE_COMPRESSED, 8, 0);
+    out[2] = make_stored_in(VXL_STORAGE_COMPRESSED, 8, 0, 1);
+    vxl_volume *v = NULL;
+    return out[0] && out[1] && out[2] && vxl_volume_create(vd, NULL, &v) == VXL_OK && set_each(out, 3, v);
+}
+
+/* Irregular 8-bit levels: every brick has <= 256 values, so the palette is
+ * exact and compressed storage renders what dense renders. Filtering the
+ * codes instead of the values would not: value = palette[code] is not
+ * linear in the code. Between a voxel of code 0 (value 0) and one of code 3
+ * (value 255) the filtered value is 127.5, but the filtered code 1.5 lies
+ * between palette entries 3 and 250 (126.5 interpolating the palette, 250
+ * rounding the code): wrong, and on other pairs by far more. */
+static const double levels4[4] = {0, 3, 250, 255};
+static double stripes(double x, double y, double z, const double *p)
+{
+    (void)p;
+    return levels4[((int)x / 3 + (int)y / 5 + (int)z / 7) % 4] / 255.0;
+}
+
+TEST(compressed_is_exact_on_8bit_levels_and_codes_cannot_be_filtered)
+{
+    /* the arithmetic of the comment above, for every pair of codes */
+    double worst = 0;
+    for (int a = 0; a < 4; a++)
+        for (int b = 0; b < 4; b++) {
+            double value = 0.5 * (levels4[a] + levels4[b]), code = 0.5 * (a + b);
+            double decoded = levels4[(int)(code + 0.5)]; /* decoding a filtered code */
+            worst = fabs(decoded - value) > worst ? fabs(decoded - value) : worst;
+        }
+    fprintf(stderr, "    filtering the codes: worst error %.1f of 255 at a midpoint\n", worst);
+    CHECK(worst > 100);
+    /* an 8-bit volume of those levels */
+    const uint32_t n[3] = {45, 40, 37};
+    static uint8_t raw[45 * 40 * 37];
+    for (uint32_t z = 0; z < n[2]; z++)
+        for (uint32_t y = 0; y < n[1]; y++)
+            for (uint32_t i = 0; i < n[0]; i++)
+                raw[i + n[0] * (y + n[1] * z)] = (uint8_t)(stripes(i, y, z, NULL) * 255 + 0.5);
+    vxl_volume_desc vd = {.struct_size = sizeof vd, .dtype = VXL_DTYPE_U8, .dims = {n[0], n[1], n[2]}, .data = raw};
+    vxl_renderer *all[3];
+    REQUIRE(dense_and_compressed(&vd, all));
+    vxl_renderer *const rd = all[0], *const rc = all[1], *const rx = all[2];
+    static float d[W * H * 4], c[W * H * 4], x[W * H * 4];
+    float *const imgs[3] = {d, c, x};
+    for (uint32_t f = 0; f <= VXL_FILTER_SOBEL26; f++) {
+        vxl_render_params p = scene(f, VXL_CLASSIFY_POST);
+        p.window_low = 0.0f;
+        p.window_high = 1.0f;
+        REQUIRE(render_each(all, imgs, 3, &p));
+        double qc = image_psnr(c, d, W * H * 4), qx = image_psnr(x, d, W * H * 4);
+        fprintf(stderr, "    8-bit levels %-8s: compressed %6.1f dB, compressed domain %6.1f dB vs dense\n",
+                vxl_filter_name(f), qc, qx);
+        /* deferred filtering samples an R8 cache exactly as dense samples
+         * its R8 texture; the compressed domain weights the 8 decoded
+         * values in float, while llvmpipe filters 8-bit textures with
+         * coarser fixed-point weights, which these 0/255 steps expose (on
+         * the float phantoms above the two agree to 89-127 dB) */
+        CHECKF(qc >= 60 && qx >= 30, "%s: %.1f / %.1f dB", vxl_filter_name(f), qc, qx);
+        CHECK(alpha_sum(d, W * H) > 1);
+    }
+    vxl_renderer_destroy(rd);
+    vxl_renderer_destroy(rc);
+    vxl_renderer_destroy(rx);
+}
+
+/* 16-bit data with more than 256 values per brick: the histogram + Lloyd
+ * path with integer levels, so the R16 cache holds the palette exactly
+ * (compressed domain and deferred agree) and the image stays close to dense. */
+TEST(compressed_16bit_fits_integer_levels)
+{
+    const uint32_t n[3] = {45, 40, 37};
+    static uint16_t raw[45 * 40 * 37];
+    for (uint32_t z = 0; z < n[2]; z++)
+        for (uint32_t y = 0; y < n[1]; y++)
+            for (uint32_t i = 0; i < n[0]; i++)
+                raw[i + n[0] * (y + n[1] * z)] = (uint16_t)(30000 + 20000 * sin(i / 5.0) * cos(y / 7.0) + 300.0 * z);
+    vxl_volume_desc vd = {.struct_size = sizeof vd, .dtype = VXL_DTYPE_U16, .dims = {n[0], n[1], n[2]}, .data = raw};
+    vxl_renderer *all[3];
+    REQUIRE(dense_and_compressed(&vd, all));
+    vxl_renderer *const rd = all[0], *const rc = all[1], *const rx = all[2];
+    static float d[W * H * 4], c[W * H * 4], x[W * H * 4];
+    float *const imgs[3] = {d, c, x};
+    vxl_render_params p = scene(VXL_FILTER_CENTRAL, VXL_CLASSIFY_POST);
+    p.has_window = 0;
+    REQUIRE(render_each(all, imgs, 3, &p));
+    double qc = image_psnr(c, d, W * H * 4), qx = image_psnr(x, c, W * H * 4);
+    fprintf(stderr, "    16-bit: compressed %.1f dB vs dense, compressed domain %.1f dB vs deferred\n", qc, qx);
+    CHECK(alpha_sum(d, W * H) > 1);
+    CHECKF(qc >= 50 && qx >= 60, "%.1f / %.1f dB", qc, qx);
+    vxl_renderer_destroy(rd);
+    vxl_renderer_destroy(rc);
+    vxl_renderer_destroy(rx);
+}
+
+/* Compressed storage's budget covers codes, palettes and the decode cache:
+ * too small for the codes, set_volume refuses; room for the codes but not
+ * for the visible bricks' cache, the frame fails; both name the budget. */
+TEST(compressed_budget_counts_codes_and_cache)
+{
+    vxl_renderer *rx = make_stored_in(VXL_STORAGE_COMPRESSED, 8, 0, 1), *tiny = make_stored(VXL_STORAGE_COMPRESSED, 8, 4096);
+    REQUIRE(rx && tiny);
+    vxl_renderer *const one[1] = {rx};
+    REQUIRE(set_phantom(one, 1, VXL_PHANTOM_MARSCHNER_LOBB));
+    vxl_render_params p = scene(VXL_FILTER_CENTRAL, VXL_CLASSIFY_POST);
+    static float img[W * H * 4];
+    REQUIRE(vxl_render(rx, &p, img, NULL) == VXL_OK);
+    const uint64_t codes = stats_of(rx).resident_bytes; /* codes + palettes + page table */
+    vxl_renderer *const small[1] = {tiny};
+    CHECK(!set_phantom(small, 1, VXL_PHANTOM_MARSCHNER_LOBB));
+    CHECKF(strstr(vxl_renderer_error(tiny), "memory budget") != NULL, "%s", vxl_renderer_error(tiny));
+    vxl_renderer *rc = make_stored(VXL_STORAGE_COMPRESSED, 8, codes + 8192);
+    REQUIRE(rc);
+    vxl_renderer *const mid[1] = {rc};
+    CHECKF(set_phantom(mid, 1, VXL_PHANTOM_MARSCHNER_LOBB), "%s", vxl_renderer_error(rc));
+    CHECK(vxl_render(rc, &p, img, NULL) != VXL_OK);
+    fprintf(stderr, "    codes %.1f KiB; %s\n", codes / 1024.0, vxl_renderer_error(rc));
+    CHECKF(strstr(vxl_renderer_error(rc), "memory budget") != NULL, "%s", vxl_renderer_error(rc));
+    vxl_renderer_destroy(rx);
+    vxl_renderer_destroy(tiny);
+    vxl_renderer_destroy(rc);
+}
+
 int main(void)
 {
-    RUN(bricked_and_sparse_equal_dense);
+    RUN(every_storage_equals_dense);
     RUN(precomputed_gradients_bricked_equal_dense);
     RUN(sparse_follows_the_transfer_function);
     RUN(no_seams_on_a_ramp_across_brick_edges);
     RUN(over_the_texture_limit_renders_bricked);
     RUN(budgets_and_unsupported_modes_fail_clearly);
+    RUN(compressed_is_exact_on_8bit_levels_and_codes_cannot_be_filtered);
+    RUN(compressed_16bit_fits_integer_levels);
+    RUN(compressed_budget_counts_codes_and_cache);
     return TEST_SUMMARY();
 }

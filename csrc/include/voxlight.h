@@ -106,7 +106,10 @@ extern "C" {
                                  constant bricks cost nothing */
 #define VXL_STORAGE_SPARSE 3  /* bricked, and only the bricks the classification can see are resident;
                                  over the budget, a 2x/4x/8x coarser level (stats.lod_level) */
-#define VXL_STORAGE_COUNT 4
+#define VXL_STORAGE_COMPRESSED 4 /* bricked, each data brick a palette of <= 256 values and 8-bit codes;
+                                    decoded on the GL side into a linear cache the ray caster filters
+                                    natively (deferred filtering) */
+#define VXL_STORAGE_COUNT 5
 
 #define VXL_MAX_LIGHTS 8
 
@@ -213,6 +216,10 @@ typedef struct vxl_renderer_options {
     /* Appended (issue 8); read only when struct_size covers them. */
     uint32_t storage;             /* VXL_STORAGE_*; 0 = AUTO */
     uint32_t page_brick;          /* voxels per brick edge when bricked: 8, 16, 32 or 64; 0 = 32 */
+    /* Appended (issue 8, compressed storage): 1 = filter in the compressed
+     * domain (every tap decodes its 8 neighbours; no decode cache), for
+     * measuring deferred filtering against it; 0 = deferred filtering. */
+    uint32_t compressed_domain;
 } vxl_renderer_options;
 
 typedef struct vxl_renderer_info {
@@ -328,6 +335,9 @@ typedef struct vxl_render_stats {
      * voxels 2^k times coarser per axis. The page counts above are of that level. */
     uint32_t lod_level;
     uint64_t lod_wanted_bytes;  /* what full resolution would have needed (0 when lod_level is 0) */
+    /* Compressed storage: milliseconds the last decode into the linear cache
+     * took (GPU, finished), 0 when nothing was decoded for this frame. */
+    double decode_ms;
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);

@@ -59,3 +59,17 @@ def test_lod_fallback_is_reported(tmp_path):
     assert res.returncode == 0, res.stderr
     m = re.search(r"LOD fallback: level (\d+) \((\d+)x coarser per axis\): the visible bricks need ([0-9.]+) MiB", res.stderr)
     assert m and int(m.group(1)) >= 1 and abs(float(m.group(3)) - mib) < 0.2, res.stderr
+
+
+def test_compressed_storage_reports_its_decode(tmp_path):
+    """--storage compressed renders and says what it holds and how long decoding took."""
+    out = tmp_path / "c.png"
+    res = run("render", "phantom:marschner-lobb:40x40x40", "-o", out, "--size", "48x48", "--storage", "compressed",
+              "--page-brick", "16")
+    assert res.returncode == 0, res.stderr
+    storage, mib, resident = storage_line(res.stderr)
+    assert storage == "compressed" and mib > 0 and resident > 0
+    assert re.search(r"compressed bricks decoded into the cache in [0-9.]+ ms", res.stderr), res.stderr
+    assert png_alpha_mean(out) > 0.002
+    assert_clean_error(run("render", "phantom:sphere:24x24x24", "-o", tmp_path / "x.png", "--storage", "compressed",
+                           "--filter", "precomputed"), "compressed")

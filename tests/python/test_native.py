@@ -241,7 +241,7 @@ def test_bricked_storage_matches_dense(lib, ball_file):
     """The storage option reaches the library; bricked renders what dense
     renders and reports its resident memory."""
     imgs, stats = {}, {}
-    for storage in ("dense", "bricked", "sparse"):
+    for storage in ("dense", "bricked", "sparse", "compressed"):
         r = native.Renderer(backend="osmesa", lib=lib, storage=storage, page_brick=8)
         try:
             with native.Volume.load(ball_file, lib=lib) as v:
@@ -255,6 +255,10 @@ def test_bricked_storage_matches_dense(lib, ball_file):
         assert stats[storage]["storage_name"] == storage
         assert stats[storage]["pages_total"] > 0 and stats[storage]["resident_bytes"] > 0
     assert stats["dense"]["storage_name"] == "dense" and stats["dense"]["pages_total"] == 0
+    # compressed: 256 palette levels per brick of 10^3 voxels
+    print("compressed: max difference", np.abs(imgs["compressed"] - imgs["dense"]).max())
+    assert np.abs(imgs["compressed"] - imgs["dense"]).max() < 2e-2
+    assert stats["compressed"]["storage_name"] == "compressed" and stats["compressed"]["decode_ms"] > 0
 
 
 def _camera_params(renderer, lib, w, h, **kw):

@@ -182,14 +182,20 @@ int vxl_paged_plan(vxl_renderer *r, const vxl_volume *v, uint32_t storage, vxl_p
     if (!rc) rc = vxl_bricks_minmax_cpu(&out->bricks, v, vxl_skip_brick_size(), &r->err);
     memcpy(out->level_dims[0], v->dims, sizeof out->level_dims[0]);
     out->n_levels = 1;
-    if (storage == VXL_STORAGE_AUTO) storage = VXL_STORAGE_BRICKED; /* dense did not fit */
-    out->storage = storage;
-    if (!rc && storage == VXL_STORAGE_SPARSE) rc = plan_levels(r, v, brick, out);
     if (rc) {
         plan_free(out);
         return rc;
     }
     uint64_t all = resident_bytes_for(r, pg, pg->n_data), none = resident_bytes_for(r, pg, 0);
+    /* AUTO, dense did not fit: every brick when they fit the budget, else
+     * only the visible ones (sparse), with its coarser levels to fall back
+     * on; the stats, the CLI and the panel say which. */
+    if (storage == VXL_STORAGE_AUTO) storage = all > r->budget ? VXL_STORAGE_SPARSE : VXL_STORAGE_BRICKED;
+    out->storage = storage;
+    if (storage == VXL_STORAGE_SPARSE && (rc = plan_levels(r, v, brick, out))) {
+        plan_free(out);
+        return rc;
+    }
     uint64_t need = storage == VXL_STORAGE_BRICKED ? all : none;
     if (storage == VXL_STORAGE_COMPRESSED) { /* every brick's codes, and a cache that follows the classification */
         uint64_t codes = vxl_code_bytes_for(r, pg), rest = r->compressed_domain ? page_table_bytes(pg) : none;

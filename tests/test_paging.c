@@ -298,6 +298,23 @@ TEST(over_the_texture_limit_renders_bricked)
     CHECKF(alpha_sum(a, WW * WH) > 1, "alpha sum %g", alpha_sum(a, WW * WH));
     double q = image_psnr(s, a, WW * WH * 4);
     CHECKF(q >= 60, "sparse vs bricked %.1f dB", q);
+    /* AUTO with a budget that all the bricks exceed but the visible ones
+     * fit: sparse, the same image, instead of a refusal */
+    vxl_renderer *rb = make_stored(VXL_STORAGE_AUTO, 0, ss.resident_bytes + (sa.resident_bytes - ss.resident_bytes) / 2);
+    REQUIRE(rb);
+    CHECKF(ss.resident_bytes < sa.resident_bytes, "sparse %llu vs bricked %llu bytes",
+           (unsigned long long)ss.resident_bytes, (unsigned long long)sa.resident_bytes);
+    v = make_volume_f32(nx, 24, 24, ball_row, NULL);
+    REQUIRE(v);
+    CHECKF(vxl_renderer_set_volume(rb, v) == VXL_OK, "%s", vxl_last_error());
+    vxl_volume_destroy(v);
+    static float b[WW * WH * 4];
+    CHECKF(vxl_render(rb, &p, b, NULL) == VXL_OK, "%s", vxl_renderer_error(rb));
+    vxl_render_stats sb = stats_of(rb);
+    CHECK(sb.storage == VXL_STORAGE_SPARSE && sb.lod_level == 0);
+    q = image_psnr(b, a, WW * WH * 4);
+    CHECKF(q >= 60, "auto-sparse vs bricked %.1f dB", q);
+    vxl_renderer_destroy(rb);
     fprintf(stderr, "    %ux24x24: bricked %u/%u bricks, %.2f MiB; sparse %u, %.2f MiB\n", nx, sa.pages_resident,
             sa.pages_total, sa.resident_bytes / 1048576.0, ss.pages_resident, ss.resident_bytes / 1048576.0);
     CHECK(ss.resident_bytes < sa.resident_bytes);

@@ -34,7 +34,12 @@ def test_dense_over_the_texture_limit_is_a_clear_error(tmp_path):
 
 
 def test_budget_and_unsupported_filters_are_clear_errors(tmp_path):
-    assert_clean_error(run("render", OVER_LIMIT, "-o", tmp_path / "x.png", "--memory-budget", "1M"), "budget")
+    # auto over the texture limit and far over the budget: sparse, then 8x
+    # coarser, and it says so; below even that, a clear error naming the budget
+    res = run("render", OVER_LIMIT, "-o", tmp_path / "x.png", "--size", "64x32", "--memory-budget", "1M")
+    assert res.returncode == 0, res.stderr
+    assert "storage sparse" in res.stderr and "LOD fallback: level 3" in res.stderr, res.stderr
+    assert_clean_error(run("render", OVER_LIMIT, "-o", tmp_path / "x.png", "--memory-budget", "16K"), "budget")
     assert_clean_error(run("render", "phantom:sphere:24x24x24", "-o", tmp_path / "x.png", "--storage", "bricked",
                            "--filter", "cubic"), "one texture")
 

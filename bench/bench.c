@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "voxlight.h"
 
 #define BRAIN "/usr/share/mricron/templates/ch2better.nii.gz"
@@ -36,30 +37,6 @@ typedef struct workload {
 
 static const float sample_distances[3] = {0.5f, 1.0f, 1.5f};
 static const float steps_full[3] = {1.0f, 0.5f, 0.25f};
-
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static vxl_render_params base_params(uint32_t size)
-{
-    vxl_render_params p;
-    memset(&p, 0, sizeof p);
-    p.struct_size = sizeof p;
-    p.width = p.height = size;
-    p.azimuth_deg = 30;
-    p.elevation_deg = 20;
-    return p;
-}
 
 /* Classification per workload: phantoms show their 0.5 iso-region with the
  * bone preset; the brain uses the MRI default. */
@@ -190,18 +167,12 @@ static void write_scene(const options *o, const workload *w, vxl_renderer *r, co
 static int run_config(FILE *csv, const options *o, workload *w, vxl_renderer *r, const char *backend,
                       vxl_render_params *p, float *img, int sd_index)
 {
-    double times[64];
     uint32_t frames = o->frames;
-    if (vxl_render(r, p, img, NULL)) { /* warm-up: compiles the program, builds caches */
+    double ms = median_ms(r, p, img, (int)frames);
+    if (ms < 0) {
         fprintf(stderr, "bench: %s: %s\n", w->name, vxl_renderer_error(r));
         return 1;
     }
-    for (uint32_t i = 0; i < frames; i++) {
-        double t = now_ms();
-        if (vxl_render(r, p, img, NULL)) return 1;
-        times[i] = now_ms() - t;
-    }
-    qsort(times, frames, sizeof *times, cmp_d);
     vxl_render_stats st = {.struct_size = sizeof st};
     vxl_renderer_get_stats(r, &st);
     double rmse, psnr, maxabs;
@@ -209,7 +180,7 @@ static int run_config(FILE *csv, const options *o, workload *w, vxl_renderer *r,
     int sd_applies = p->filter != VXL_FILTER_PRECOMPUTED && p->filter != VXL_FILTER_CUBIC;
     fprintf(csv, "%s,%s,", w->name, vxl_filter_name(p->filter));
     if (sd_applies) fprintf(csv, "%g", p->sample_distance);
-    fprintf(csv, ",%g,%u,post,%s,voxlight,%.2f,%d,", p->step, p->reuse_gradients, backend, times[frames / 2],
+    fprintf(csv, ",%g,%u,post,%s,voxlight,%.2f,%d,", p->step, p->reuse_gradients, backend, ms,
             1 + taps[p->filter]);
     if (w->phantom) fprintf(csv, "%.3f,%.3f", w->ang_mean[p->filter][sd_index], w->ang_p95[p->filter][sd_index]);
     else fprintf(csv, ",");
@@ -299,19 +270,15 @@ static int run_spike_study(FILE *csv, const options *o)
         for (int s = 0; s < (o->quick ? 3 : 5) && !rc; s++) {
             p.classify = m;
             p.step = steps[s];
-            double t[64];
-            rc = vxl_render(r, &p, img, NULL);
-            for (uint32_t i = 0; i < o->frames && !rc; i++) {
-                double t0 = now_ms();
-                rc = vxl_render(r, &p, img, NULL);
-                t[i] = now_ms() - t0;
+            double ms = median_ms(r, &p, img, (int)o->frames);
+            if (ms < 0) {
+                rc = 1;
+                break;
             }
-            if (rc) break;
-            qsort(t, o->frames, sizeof *t, cmp_d);
             double rmse, psnr, maxabs;
             image_error(img, ref, n, &rmse, &psnr, &maxabs);
             fprintf(csv, "spike64,central,,%g,0,%s,%s,voxlight,%.2f,1,,,%.6f,%.2f,%.5f,%ux%u,%u,,analytic\n", p.step,
-                    modes[m], info.backend_name, t[o->frames / 2], rmse, psnr, maxabs, o->size, o->size, o->frames);
+                    modes[m], info.backend_name, ms, rmse, psnr, maxabs, o->size, o->size, o->frames);
         }
     if (rc) fprintf(stderr, "bench: spike study: %s\n", vxl_last_error());
     vxl_renderer_destroy(r);

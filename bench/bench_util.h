@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "voxlight.h"
@@ -21,10 +22,12 @@ static inline int cmp_d(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* Median of `frames` (<= 32) renders after one warm-up that builds grids and programs. */
+/* Median of `frames` (1..64, what voxlight-bench's --frames accepts) renders
+ * after one warm-up that builds grids and programs; -1 if a render failed
+ * (the message is in vxl_renderer_error). */
 static inline double median_ms(vxl_renderer *r, const vxl_render_params *p, float *img, int frames)
 {
-    double t[32];
+    double t[64];
     if (vxl_render(r, p, img, NULL)) return -1;
     for (int i = 0; i < frames; i++) {
         double s = now_ms();
@@ -33,6 +36,19 @@ static inline double median_ms(vxl_renderer *r, const vxl_render_params *p, floa
     }
     qsort(t, (size_t)frames, sizeof *t, cmp_d);
     return t[frames / 2];
+}
+
+/* The studies' common frame: size^2, the default camera at azimuth 30,
+ * elevation 20; everything else the library default. */
+static inline vxl_render_params base_params(uint32_t size)
+{
+    vxl_render_params p;
+    memset(&p, 0, sizeof p);
+    p.struct_size = sizeof p;
+    p.width = p.height = size;
+    p.azimuth_deg = 30;
+    p.elevation_deg = 20;
+    return p;
 }
 
 static inline double psnr(const float *a, const float *b, size_t n)

@@ -50,12 +50,7 @@ int main(int argc, char **argv)
             setenv("VOXLIGHT_BRICK_SIZE", bs, 1);
             if ((rc = vxl_renderer_set_volume(r, v))) break; /* drops the grid: rebuilt at this size */
             for (int f = 0; f < 2 && !rc; f++) {
-                vxl_render_params p;
-                memset(&p, 0, sizeof p);
-                p.struct_size = sizeof p;
-                p.width = p.height = size;
-                p.azimuth_deg = 30;
-                p.elevation_deg = 20;
+                vxl_render_params p = base_params(size);
                 p.filter = filters[f];
                 if (kinds[w]) {
                     p.preset = VXL_PRESET_BONE;

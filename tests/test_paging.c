@@ -35,19 +35,7 @@ static vxl_renderer *make_stored(uint32_t storage, uint32_t page_brick, uint64_t
     return make_stored_in(storage, page_brick, budget, 0);
 }
 
-static vxl_render_params scene(uint32_t filter, uint32_t mode)
-{
-    vxl_render_params p = default_params(W, H);
-    p.filter = filter;
-    p.classify = mode;
-    p.preset = VXL_PRESET_BONE;
-    p.has_window = 1;
-    p.window_low = 0.35f;
-    p.window_high = 0.75f;
-    p.azimuth_deg = 20;
-    p.elevation_deg = 25;
-    return p;
-}
+static vxl_render_params scene(uint32_t filter, uint32_t mode) { return phantom_scene(W, H, filter, mode); }
 
 /* Runs 0-4: the five on-the-fly filters in post-classification; 5
  * pre-integration, 6 boundary opacity (central differences), 7 skipping off. */

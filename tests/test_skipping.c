@@ -34,20 +34,12 @@ TEST(skipping_never_changes_the_image)
             int iso = run >= n_plain;
             uint32_t f = iso ? run - n_plain : run < VXL_FILTER_COUNT ? run : VXL_FILTER_CENTRAL;
             uint32_t mode = iso || run < VXL_FILTER_COUNT ? VXL_CLASSIFY_POST : run - VXL_FILTER_COUNT + 1;
-            vxl_render_params p = default_params(W, H);
+            vxl_render_params p = phantom_scene(W, H, f, mode);
             if (iso) {
                 p.gradient_opacity = VXL_GOPACITY_ISO;
                 p.iso_value = 0.6f;
                 p.iso_thickness = 1.5f;
             }
-            p.classify = mode;
-            p.preset = VXL_PRESET_BONE;
-            p.has_window = 1;
-            p.window_low = 0.35f;
-            p.window_high = 0.75f;
-            p.azimuth_deg = 20;
-            p.elevation_deg = 25;
-            p.filter = f;
             static float dflt[W * H * 4];
             REQUIRE(vxl_render(R, &p, dflt, NULL) == VXL_OK); /* default threshold 0.99 */
             p.early_termination = 0.999f;

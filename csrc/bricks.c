@@ -77,38 +77,14 @@ static void classify_iso(vxl_bricks *b, const vxl_frame *f)
     b->occupied = occupied;
 }
 
-int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
+/* Occupancy under the transfer function: a brick is occupied when any table
+ * entry its [min, max] can reach has non-zero opacity. -1 out of memory. */
+static int classify_table(vxl_bricks *b, const vxl_frame *f)
 {
-    uint64_t key = vxl_classification_key(f);
-    if (f->gopacity == VXL_GOPACITY_ISO) { /* occupancy follows the iso-surface, its thickness and the filter */
-        float iso[5] = {f->iso_pos, f->iso_thickness, f->sample_distance, (float)f->filter, (float)b->gbound_apron};
-        for (int i = 0; i < 5; i++) {
-            uint32_t bits;
-            memcpy(&bits, &iso[i], sizeof bits);
-            key = (key ^ (bits + 0x9e3779b97f4a7c15ull * (i + 1))) * 1099511628211ull;
-        }
-    }
-    if (b->distance && b->tf_key == key) return 0;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
-    if (!b->distance && !(b->distance = malloc(n))) return -1;
     /* prefix count of table entries with non-zero opacity */
     uint32_t *nonzero = malloc(((size_t)f->tf_size + 1) * sizeof *nonzero);
-    uint32_t maxdim = b->dims[0] > b->dims[1] ? b->dims[0] : b->dims[1];
-    maxdim = maxdim > b->dims[2] ? maxdim : b->dims[2];
-    uint8_t *scratch = malloc(2 * (size_t)maxdim);
-    if (!nonzero || !scratch) {
-        free(nonzero);
-        free(scratch);
-        return -1;
-    }
-    if (f->gopacity == VXL_GOPACITY_ISO) {
-        classify_iso(b, f);
-        for (int axis = 0; axis < 3; axis++) chebyshev_axis(b->distance, b->dims, axis, scratch, scratch + maxdim);
-        b->tf_key = key;
-        free(nonzero);
-        free(scratch);
-        return 1;
-    }
+    if (!nonzero) return -1;
     nonzero[0] = 0;
     for (uint32_t i = 0; i < f->tf_size; i++) nonzero[i + 1] = nonzero[i] + (f->tf[4 * i + 3] * f->opacity_scale > 0);
     uint32_t occupied = 0;
@@ -128,11 +104,37 @@ int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
         b->distance[i] = occ ? 0 : 255;
         occupied += (uint32_t)occ;
     }
-    for (int axis = 0; axis < 3; axis++) chebyshev_axis(b->distance, b->dims, axis, scratch, scratch + maxdim);
     free(nonzero);
+    b->occupied = occupied;
+    return 0;
+}
+
+int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
+{
+    uint64_t key = vxl_classification_key(f);
+    if (f->gopacity == VXL_GOPACITY_ISO) { /* occupancy follows the iso-surface, its thickness and the filter */
+        float iso[5] = {f->iso_pos, f->iso_thickness, f->sample_distance, (float)f->filter, (float)b->gbound_apron};
+        for (int i = 0; i < 5; i++) {
+            uint32_t bits;
+            memcpy(&bits, &iso[i], sizeof bits);
+            key = (key ^ (bits + 0x9e3779b97f4a7c15ull * (i + 1))) * 1099511628211ull;
+        }
+    }
+    if (b->distance && b->tf_key == key) return 0;
+    size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
+    if (!b->distance && !(b->distance = malloc(n))) return -1;
+    uint32_t maxdim = b->dims[0] > b->dims[1] ? b->dims[0] : b->dims[1];
+    maxdim = maxdim > b->dims[2] ? maxdim : b->dims[2];
+    uint8_t *scratch = malloc(2 * (size_t)maxdim);
+    if (!scratch) return -1;
+    if (f->gopacity == VXL_GOPACITY_ISO) classify_iso(b, f);
+    else if (classify_table(b, f)) {
+        free(scratch);
+        return -1;
+    }
+    for (int axis = 0; axis < 3; axis++) chebyshev_axis(b->distance, b->dims, axis, scratch, scratch + maxdim);
     free(scratch);
     b->tf_key = key;
-    b->occupied = occupied;
     return 1;
 }
 

@@ -27,9 +27,9 @@ def _to_matrix(a):
 
 def resolve_path(filepath, directory):
     """The file, or the folder when no file was picked (the browser then
-    gives a filepath ending in a separator, or only the directory)."""
-    if runtime.is_phantom(filepath):  # a generated volume, named, not a file
-        return filepath
+    gives a filepath ending in a separator, or only the directory). A
+    generated volume's name ("phantom:...") passes through: bpy.path.abspath
+    only expands "//"."""
     path = bpy.path.abspath(filepath) if filepath else ""
     if (not path or path.endswith(os.sep)) and directory:
         path = bpy.path.abspath(directory)

@@ -1,13 +1,18 @@
 /* bspline.c - coefficients of the interpolating cubic B-spline for the
  * `cubic` gradient filter, computed on the GL side once per volume
  * (shaders/bspline_prefilter.comp) and kept until the volume changes. */
+#include <stdlib.h>
+
 #include "renderer_internal.h"
 
 void vxl_bspline_release(vxl_renderer *r)
 {
     if (r->bspline_tex) r->gl.DeleteTextures(1, &r->bspline_tex);
-    r->bspline_tex = 0;
+    if (r->cpage_tex) r->gl.DeleteTextures(1, &r->cpage_tex);
+    r->bspline_tex = r->cpage_tex = 0;
     r->bspline_bytes = 0;
+    free(r->bspline_covered); /* bricked: the coefficient bricks made */
+    r->bspline_covered = NULL;
 }
 
 static GLuint groups8(uint32_t n) { return (n + 7) / 8; }

@@ -28,33 +28,44 @@ static void set_classify_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame 
     vxl_uniform_f(r, prog, "u_opacity_scale", f->opacity_scale);
 }
 
+/* Pre-classification classifies texel for texel whatever holds the values:
+ * the volume texture, or the brick pool (ghosts included, so a classified
+ * brick filters as the dense classified volume does; a brick not in the pool
+ * is classified in the shader, classify.glsl). A new pool is a new key. */
 static int prepare_pre(vxl_renderer *r, const vxl_frame *f)
 {
     vxl_gl *gl = &r->gl;
-    uint64_t key = vxl_classification_key(f);
+    const uint32_t *dims = r->volume_tex ? r->dims : r->pool_dims;
+    uint64_t key = (vxl_classification_key(f) ^ r->pool_generation) * 1099511628211ull;
     if (r->classified_tex && r->classified_key == key) goto bind;
-    uint64_t n = (uint64_t)r->dims[0] * r->dims[1] * r->dims[2];
+    uint64_t n = (uint64_t)dims[0] * dims[1] * dims[2];
+    if (r->classified_tex && memcmp(r->classified_dims, dims, sizeof r->classified_dims)) {
+        gl->DeleteTextures(1, &r->classified_tex); /* the pool changed size */
+        r->classified_tex = 0;
+        r->classified_bytes = 0;
+    }
     if (!r->classified_tex) {
-        uint64_t need = r->volume_bytes + r->gradient_bytes + r->bspline_bytes + n * 4;
+        uint64_t need = (r->volume_tex ? r->volume_bytes : r->pool_bytes) + r->gradient_bytes + r->bspline_bytes + n * 4;
         if (need > r->budget)
             return vxl_fail(&r->err, VXL_ERR_LIMIT,
                             "pre-classification needs %.1f MiB in all, over the memory budget of %.1f MiB",
                             need / 1048576.0, r->budget / 1048576.0);
         r->classified_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
-        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, (GLsizei)r->dims[0], (GLsizei)r->dims[1], (GLsizei)r->dims[2], 0,
-                       GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, (GLsizei)dims[0], (GLsizei)dims[1], (GLsizei)dims[2], 0, GL_RGBA,
+                       GL_UNSIGNED_BYTE, NULL);
         r->classified_bytes = n * 4;
+        memcpy(r->classified_dims, dims, sizeof r->classified_dims);
     }
     GLuint prog;
     int rc = vxl_program_get(r, VXL_PROG_CLASSIFY_VOLUME, 0, 0, &prog);
     if (rc) return rc;
     gl->UseProgram(prog);
     gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
+    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex ? r->volume_tex : r->pool_tex);
     vxl_uniform_i(r, prog, "u_volume", 0);
     set_classify_uniforms(r, prog, f); /* the TF is already on unit 2 */
     gl->BindImageTexture(0, r->classified_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    gl->DispatchCompute((r->dims[0] + 3) / 4, (r->dims[1] + 3) / 4, (r->dims[2] + 3) / 4);
+    gl->DispatchCompute((dims[0] + 3) / 4, (dims[1] + 3) / 4, (dims[2] + 3) / 4);
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     gl->UseProgram(0);
     r->classified_key = key;

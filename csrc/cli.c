@@ -27,7 +27,7 @@ static const char usage[] =
     "storage: auto = one texture when it fits the texture limit and --memory-budget, else bricked;\n"
     "         sparse keeps only the bricks the transfer function can show; compressed holds every brick\n"
     "         as a palette of <= 256 values + 8-bit codes and decodes the visible ones into a cache\n"
-    "         (bricked/sparse/compressed: the five on-the-fly filters, post or preint classification)\n"
+    "         (compressed storage: the five on-the-fly filters; bricked and sparse: every filter and mode)\n"
     "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of marschner-lobb sphere ramp\n"
     "         noisy-blob sparse-balls dense-balls large-sparse (default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
 

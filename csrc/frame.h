@@ -44,6 +44,13 @@ typedef struct vxl_frame {
     float *tf_copy;             /* owned when the caller gave a table */
 } vxl_frame;
 
+/* The gradient filter a frame evaluates: rays that never evaluate gradients
+ * (no shading, no gradient opacity) run one program for every filter. */
+static inline uint32_t vxl_frame_filter(const vxl_frame *f)
+{
+    return f->shading || f->gopacity ? f->filter : VXL_FILTER_CENTRAL;
+}
+
 /* A hash of everything the classification depends on (table, window,
  * opacity scale): caches derived from it compare keys. */
 uint64_t vxl_classification_key(const vxl_frame *f);

@@ -133,6 +133,7 @@ static int upload_pool(vxl_renderer *r, uint32_t level, const uint8_t *need)
     if (rc) return rc;
     r->pages_resident = count;
     r->pages_constant = constant;
+    r->pool_generation++;
     r->pool_bytes = bytes;
     r->level = level;
     return VXL_OK;
@@ -221,6 +222,7 @@ int vxl_paged_install(vxl_renderer *r, vxl_paged_volume *pv)
     memcpy(r->level_dims, pv->level_dims, sizeof r->level_dims);
     r->n_levels = pv->n_levels;
     r->level = 0;
+    for (int k = 0; k < VXL_LOD_LEVELS; k++) r->gradient_max_level[k] = -1;
     r->bricks = pv->bricks;
     r->storage = pv->storage;
     memset(pv, 0, sizeof *pv);
@@ -246,17 +248,42 @@ int vxl_paged_install(vxl_renderer *r, vxl_paged_volume *pv)
 int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify)
 {
     if (!r->storage || r->storage == VXL_STORAGE_DENSE) return VXL_OK;
-    const char *what = filter == VXL_FILTER_PRECOMPUTED && r->storage != VXL_STORAGE_BRICKED
-                           ? "the precomputed gradient filter with sparse or compressed storage"
-                       : filter == VXL_FILTER_CUBIC     ? "the cubic gradient filter"
-                       : classify == VXL_CLASSIFY_PRE   ? "pre-classification"
-                                                        : NULL;
+    const int derived = filter == VXL_FILTER_PRECOMPUTED || filter == VXL_FILTER_CUBIC;
+    const char *what = r->storage == VXL_STORAGE_COMPRESSED && r->compressed_domain && (derived || classify == VXL_CLASSIFY_PRE)
+                           ? "filtering in the compressed domain (a comparison mode) with the precomputed or cubic filter or pre-classification"
+                       : r->storage == VXL_STORAGE_COMPRESSED && derived
+                           ? "the precomputed and cubic filters with compressed storage (their data is derived from every brick's values, which only the GL side keeps, as codes)"
+                           : NULL;
     if (!what) return VXL_OK;
     return vxl_fail(&r->err, VXL_ERR_STATE,
-                    "%s needs the volume as one texture, but it is stored %s (%ux%ux%u); use central, forward3, "
-                    "sobel8, sobel14 or sobel26 (or precomputed with bricked storage) with post- or pre-integrated "
-                    "classification",
-                    what, vxl_storage_name(r->storage), r->dims[0], r->dims[1], r->dims[2]);
+                    "%s is not supported (volume %ux%ux%u); use bricked or sparse storage, or central, forward3, "
+                    "sobel8, sobel14 or sobel26",
+                    what, r->dims[0], r->dims[1], r->dims[2]);
+}
+
+/* Voxels from a visible sample at which a frame reads values: gradient taps
+ * sample_distance away plus the trilinear footprint, and the front of a
+ * pre-integrated segment one step back. */
+static uint32_t visible_reach(const vxl_frame *f)
+{
+    uint32_t reach = (uint32_t)ceilf(f->sample_distance) + 1;
+    if (f->classify == VXL_CLASSIFY_PREINT) reach += (uint32_t)ceilf(f->step);
+    return reach;
+}
+
+/* Bytes a frame derives from the pool of `level` (pool_part bytes): the
+ * derived filter's pool (cubic coefficients, precomputed gradients) and the
+ * pre-classified pool, so the level chosen fits all of them. */
+static uint64_t derived_bytes(const vxl_renderer *r, const vxl_frame *f, uint32_t level, uint64_t pool_part,
+                              uint8_t *scratch)
+{
+    if (!f) return 0;
+    const uint32_t filter = vxl_frame_filter(f);
+    uint64_t b = filter == VXL_FILTER_CUBIC         ? vxl_paged_bspline_bytes(r, level, scratch, NULL)
+                 : filter == VXL_FILTER_PRECOMPUTED ? vxl_paged_gradient_bytes(r, level, (int)f->store, scratch, NULL)
+                                                    : 0;
+    if (b != UINT64_MAX && f->classify == VXL_CLASSIFY_PRE) b += pool_part / r->levels[level].bytes_per_voxel * 4;
+    return b;
 }
 
 /* Sparse: the finest level whose visible bricks fit the budget. Falls back
@@ -265,33 +292,41 @@ int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify)
 int vxl_paged_prepare(vxl_renderer *r, const vxl_frame *f)
 {
     r->decode_ms = 0;
+    /* what derived pools (gradients, coefficients) must cover */
+    r->visible_reach = f ? visible_reach(f) : 0;
+    r->visible_all = !f || f->gopacity == VXL_GOPACITY_ISO || r->storage == VXL_STORAGE_BRICKED;
     if (r->storage != VXL_STORAGE_SPARSE && (r->storage != VXL_STORAGE_COMPRESSED || pool_is_codes(r))) return VXL_OK;
-    /* gradient taps reach sample_distance voxels per axis, trilinear one more */
-    uint32_t reach = f ? (uint32_t)ceilf(f->sample_distance) + 1 : 0;
-    const int all = !f || f->gopacity == VXL_GOPACITY_ISO;
+    uint32_t reach = r->visible_reach;
+    /* precomputed gradients read within 2 voxels of a visible sample are
+     * derived from the values 2 voxels around them */
+    if (f && vxl_frame_filter(f) == VXL_FILTER_PRECOMPUTED) reach = (reach > 2 ? reach : 2) + 2;
+    const int all = r->visible_all;
     const uint64_t n0 = vxl_page_count(&r->levels[0]);
-    uint8_t *need = malloc(n0);
+    uint8_t *need = malloc(2 * n0), *scratch = need + n0;
     if (!need) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the page table");
     uint64_t wanted = 0, bytes = UINT64_MAX;
     uint32_t level = 0;
     for (; level < r->n_levels; level++) { /* f == NULL (probes): full resolution only */
-        uint32_t count = vxl_pages_needed(&r->levels[level], &r->bricks, reach, 1u << level, all, need);
+        uint32_t count = vxl_pages_needed(&r->levels[level], &r->bricks, reach, 1u << level, all, NULL, need);
         bytes = resident_bytes_for(r, &r->levels[level], count);
-        if (bytes != UINT64_MAX) bytes += r->code_bytes;
+        if (bytes != UINT64_MAX) {
+            uint64_t d = derived_bytes(r, f, level, bytes - page_table_bytes(&r->levels[level]), scratch);
+            bytes = d == UINT64_MAX ? d : bytes + r->code_bytes + d;
+        }
         if (level == 0) wanted = bytes;
         if (bytes <= r->budget || !f) break;
     }
     if (level == r->n_levels && r->n_levels == 1) { /* compressed storage has no coarser levels */
         free(need);
         return vxl_fail(&r->err, VXL_ERR_LIMIT,
-                        "the visible bricks need %.1f MiB (codes and decode cache), over the renderer's memory budget "
+                        "the visible bricks need %.1f MiB (codes, decode cache and what the frame derives from it), over the renderer's memory budget "
                         "of %.1f MiB",
                         wanted / 1048576.0, r->budget / 1048576.0);
     }
     if (level == r->n_levels) {
         free(need);
         return vxl_fail(&r->err, VXL_ERR_LIMIT,
-                        "the visible bricks need %.1f MiB at full resolution and still %.1f MiB at %ux coarser, over "
+                        "the visible bricks (and what the frame derives from them) need %.1f MiB at full resolution and still %.1f MiB at %ux coarser, over "
                         "the renderer's memory budget of %.1f MiB",
                         wanted / 1048576.0, bytes / 1048576.0, 1u << (r->n_levels - 1), r->budget / 1048576.0);
     }

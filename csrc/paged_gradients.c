@@ -1,45 +1,73 @@
-/* paged_gradients.c - the precomputed gradient filter with bricked storage:
- * the same blur + Sobel + global-max scaling as precompute.c, computed per
- * brick into a gradient pool with its own page table (shaders/
- * paged_gradient.comp). A brick needs gradient data unless it and its 26
- * neighbours all hold one value (then its gradient is exactly zero: the
- * blur and the Sobel reach 2 voxels, a brick is at least 8). */
+/* paged_gradients.c - the precomputed gradient filter with bricked and sparse
+ * storage: the same blur + Sobel + global-max scaling as precompute.c,
+ * computed per brick into a gradient pool with its own page table (shaders/
+ * paged_gradient.comp). A brick needs gradient data unless every voxel
+ * within 2 of it holds one value (then its gradient is exactly zero: the
+ * blur and the Sobel reach 2 voxels), and, sparse, only when a visible
+ * sample can read it. The maximum that scales the stored gradients is the
+ * whole volume's, as with one texture: from the pool when every brick is in
+ * it, else from the CPU bricks (bspline_bricks.c). */
 #include <stdlib.h>
 #include <string.h>
 
+#include "bspline_bricks.h"
 #include "renderer_internal.h"
 
 static const GLenum store_internal[] = {GL_RGBA8_SNORM, GL_RGBA16F, GL_RGBA32F};
 static const uint32_t store_bytes[] = {4, 8, 16};
 
-/* Bricks whose gradient is not zero everywhere, as (x, y, z, 0) each. */
-static GLint *derived_bricks(const vxl_pages *pg, uint32_t *count)
+/* The blur and the Sobel reach 2 voxels; the trilinear read of a gradient
+ * texel one, translated through the brick of the nearest texel: 2. */
+#define GRADIENT_SUPPORT 2
+#define GRADIENT_READ_REACH 2
+
+uint64_t vxl_paged_gradient_bytes(const vxl_renderer *r, uint32_t level, int store, uint8_t *want, uint32_t *count_out)
 {
-    const uint64_t n = vxl_page_count(pg);
-    GLint *out = malloc(n * 4 * sizeof *out);
+    const vxl_pages *pg = &r->levels[level];
+    const uint32_t count = vxl_paged_derived_want(r, level, GRADIENT_SUPPORT, GRADIENT_READ_REACH, want);
+    const uint64_t eb = pg->brick + 4, eg = pg->brick + 2;
+    uint32_t bslots[3], gslots[3];
+    if (count_out) *count_out = count;
+    if (!vxl_pool_layout(r, count, (uint32_t)eb, bslots) || !vxl_pool_layout(r, count, (uint32_t)eg, gslots))
+        return UINT64_MAX;
+    /* the gradient pool, its page table and the transient blurred bricks */
+    return (uint64_t)gslots[0] * gslots[1] * gslots[2] * eg * eg * eg * store_bytes[store] + vxl_page_count(pg) * 16 +
+           (uint64_t)bslots[0] * bslots[1] * bslots[2] * eb * eb * eb * 4;
+}
+
+/* The wanted bricks as (x, y, z, 0) each, in slot order. */
+static GLint *brick_list(const vxl_pages *pg, const uint8_t *want, uint32_t count)
+{
+    GLint *out = malloc((count ? count : 1) * 4 * sizeof *out);
     if (!out) return NULL;
-    *count = 0;
-    for (uint64_t i = 0; i < n; i++) {
-        const int c[3] = {(int)(i % pg->grid[0]), (int)(i / pg->grid[0] % pg->grid[1]),
-                          (int)(i / ((uint64_t)pg->grid[0] * pg->grid[1]))};
-        int flat = 1;
-        for (int k = 0; k < 27 && flat; k++) {
-            int q[3] = {c[0] + k % 3 - 1, c[1] + k / 3 % 3 - 1, c[2] + k / 9 - 1};
-            if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= (int)pg->grid[0] || q[1] >= (int)pg->grid[1] ||
-                q[2] >= (int)pg->grid[2])
-                continue; /* beyond the volume: its edge repeats, which the brick itself holds */
-            size_t j = (size_t)q[0] + pg->grid[0] * ((size_t)q[1] + (size_t)pg->grid[1] * q[2]);
-            flat = pg->data_index[j] < 0 && pg->low[j] == pg->low[i];
-        }
-        if (flat) continue;
-        GLint *o = out + 4 * (size_t)*count;
-        o[0] = c[0];
-        o[1] = c[1];
-        o[2] = c[2];
+    GLint *o = out;
+    for (uint64_t i = 0; i < vxl_page_count(pg); i++) {
+        if (!want[i]) continue;
+        o[0] = (GLint)(i % pg->grid[0]);
+        o[1] = (GLint)(i / pg->grid[0] % pg->grid[1]);
+        o[2] = (GLint)(i / ((uint64_t)pg->grid[0] * pg->grid[1]));
         o[3] = 0;
-        (*count)++;
+        o += 4;
     }
     return out;
+}
+
+/* The whole level's largest |gradient|, from the CPU bricks; kept per level. */
+static int cpu_gradient_max(vxl_renderer *r, float *out)
+{
+    if (r->gradient_max_level[r->level] >= 0) {
+        *out = r->gradient_max_level[r->level];
+        return VXL_OK;
+    }
+    vxl_brick_store s;
+    uint8_t *owned;
+    int rc = vxl_paged_brick_store(r, &s, &owned);
+    if (rc) return rc;
+    float m = vxl_pages_gradient_max(&r->levels[r->level], &s, r->level_dims[r->level]);
+    free(owned);
+    if (m < 0) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory finding the largest gradient");
+    *out = r->gradient_max_level[r->level] = m;
+    return VXL_OK;
 }
 
 static GLuint groups(uint32_t n) { return (n + 3) / 4; }
@@ -58,36 +86,61 @@ static void set_common(vxl_renderer *r, GLuint prog, uint32_t count, const uint3
 {
     vxl_gl *gl = &r->gl;
     gl->UseProgram(prog);
-    vxl_uniform_i(r, prog, "u_brick", (int)r->levels[0].brick);
-    vxl_uniform_f(r, prog, "u_page_brick", (float)r->levels[0].brick);
+    const uint32_t *ld = r->level_dims[r->level];
+    vxl_uniform_i(r, prog, "u_brick", (int)r->levels[r->level].brick);
+    vxl_uniform_f(r, prog, "u_page_brick", (float)r->levels[r->level].brick);
     vxl_uniform_i(r, prog, "u_count", (int)count);
-    float dims[3] = {(float)r->dims[0], (float)r->dims[1], (float)r->dims[2]};
+    float dims[3] = {(float)ld[0], (float)ld[1], (float)ld[2]};
     gl->Uniform3fv(gl->GetUniformLocation(prog, "u_dims"), 1, dims);
     gl->Uniform3i(gl->GetUniformLocation(prog, "u_slots"), (GLint)slots[0], (GLint)slots[1], (GLint)slots[2]);
 }
 
 int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
 {
-    if (r->gradient_tex && r->gradient_store == store) return VXL_OK;
+    const vxl_pages *pg = &r->levels[r->level];
+    const uint64_t n = vxl_page_count(pg);
+    uint8_t *want = malloc(n);
+    if (!want) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the gradient bricks");
+    uint32_t count;
+    const uint64_t all_bytes = vxl_paged_gradient_bytes(r, r->level, store, want, &count);
+    if (r->gradient_tex && r->gradient_store == store &&
+        vxl_paged_derived_current(r, r->gradient_covered, r->gradient_level, want)) {
+        free(want);
+        return VXL_OK;
+    }
     vxl_gradients_release(r);
+    vxl_bspline_release(r); /* one derived pool at a time: storage that pages is short of memory */
     vxl_gl *gl = &r->gl;
-    const vxl_pages *pg = &r->levels[0];
     const uint32_t pb = pg->brick, eb = pb + 4, eg = pb + 2;
-    uint32_t count = 0, bslots[3], gslots[3];
-    GLint *list = derived_bricks(pg, &count);
-    if (!list) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the gradient bricks");
-    if (!vxl_pool_layout(r, count, eb, bslots) || !vxl_pool_layout(r, count, eg, gslots)) {
+    uint32_t bslots[3], gslots[3];
+    GLint *list = brick_list(pg, want, count);
+    if (!list) {
+        free(want);
+        return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the gradient bricks");
+    }
+    /* the pool holds every data brick only when bricked; else the maximum
+     * comes from the CPU bricks, which sparse storage keeps */
+    const int pool_complete = r->storage == VXL_STORAGE_BRICKED;
+    float cpu_max = 0;
+    int rc = pool_complete ? VXL_OK : cpu_gradient_max(r, &cpu_max);
+    if (rc) {
         free(list);
+        free(want);
+        return rc;
+    }
+    if (all_bytes == UINT64_MAX || !vxl_pool_layout(r, count, eb, bslots) || !vxl_pool_layout(r, count, eg, gslots)) {
+        free(list);
+        free(want);
         return vxl_fail(&r->err, VXL_ERR_LIMIT, "%u gradient bricks do not fit a pool within the 3D texture limit of %d",
                         count, r->info.max_3d_texture_size);
     }
     const uint64_t gbytes = (uint64_t)gslots[0] * gslots[1] * gslots[2] * eg * eg * eg * store_bytes[store],
-                   bbytes = (uint64_t)bslots[0] * bslots[1] * bslots[2] * eb * eb * eb * 4,
-                   need = r->pool_bytes + gbytes + bbytes + vxl_page_count(pg) * 16;
+                   need = r->pool_bytes + r->classified_bytes + all_bytes;
     GLuint progs[3];
-    int rc = vxl_gradient_programs(r, 1, store, need, progs);
+    rc = vxl_gradient_programs(r, 1, store, need, progs);
     if (rc) {
         free(list);
+        free(want);
         return rc;
     }
     const GLuint blur_prog = progs[0], max_prog = progs[1], store_prog = progs[2];
@@ -110,20 +163,23 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     gl->BindImageTexture(0, blur, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
     vxl_dispatch_bricks(r, blur_prog, count, eb);
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    /* pass 2: the global maximum magnitude */
-    const GLuint zero = 0;
-    gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[0]);
-    gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zero, &zero, GL_DYNAMIC_READ);
-    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r->ssbo[0]);
-    set_common(r, max_prog, count, gslots);
-    gl->Uniform3i(gl->GetUniformLocation(max_prog, "u_blur_slots"), (GLint)bslots[0], (GLint)bslots[1], (GLint)bslots[2]);
-    gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, blur);
-    vxl_uniform_i(r, max_prog, "u_blur", 0);
-    vxl_dispatch_bricks(r, max_prog, count, eg);
-    gl->MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    /* pass 2: the global maximum magnitude (of every brick: pool_complete) */
     union { GLuint u; float f; } max_mag = {0};
-    gl->GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof max_mag.u, &max_mag.u);
+    max_mag.f = cpu_max;
+    if (pool_complete) {
+        const GLuint zero = 0;
+        gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[0]);
+        gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zero, &zero, GL_DYNAMIC_READ);
+        gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r->ssbo[0]);
+        set_common(r, max_prog, count, gslots);
+        gl->Uniform3i(gl->GetUniformLocation(max_prog, "u_blur_slots"), (GLint)bslots[0], (GLint)bslots[1], (GLint)bslots[2]);
+        gl->ActiveTexture(GL_TEXTURE0);
+        gl->BindTexture(GL_TEXTURE_3D, blur);
+        vxl_uniform_i(r, max_prog, "u_blur", 0);
+        vxl_dispatch_bricks(r, max_prog, count, eg);
+        gl->MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        gl->GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof max_mag.u, &max_mag.u);
+    }
     /* pass 3: scaled raw gradient into the gradient pool */
     r->gradient_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
     for (int a = 0; a < 3; a++) r->gpool_dims[a] = gslots[a] * eg;
@@ -142,7 +198,6 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     gl->DeleteTextures(1, &blur);
     /* the gradient page table: slot origins + ghost, or zero gradient */
-    const uint64_t n = vxl_page_count(pg);
     float *entries = calloc(n * 4, sizeof *entries);
     if (!entries) rc = vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the gradient page table");
     for (uint64_t i = 0; i < n && entries; i++) entries[4 * i + 3] = 0; /* zero gradient */
@@ -165,10 +220,13 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     gl->UseProgram(0);
     if (!rc) rc = vxl_gl_check(r, "precomputing gradients of the bricked volume");
     if (rc) {
+        free(want);
         vxl_gradients_release(r);
         return rc;
     }
+    r->gradient_covered = want;
+    r->gradient_level = r->level;
     r->gradient_store = store;
-    r->gradient_bytes = gbytes + vxl_page_count(pg) * 16;
+    r->gradient_bytes = gbytes + n * 16;
     return VXL_OK;
 }

@@ -138,38 +138,102 @@ int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl
     return VXL_OK;
 }
 
+int vxl_pages_flat_around(const vxl_pages *pg, uint64_t i, uint32_t voxels)
+{
+    if (pg->data_index[i] >= 0) return 0;
+    const int64_t k = (voxels + pg->brick - 1) / pg->brick; /* bricks that far reach `voxels` */
+    const int64_t c[3] = {(int64_t)(i % pg->grid[0]), (int64_t)(i / pg->grid[0] % pg->grid[1]),
+                          (int64_t)(i / ((uint64_t)pg->grid[0] * pg->grid[1]))};
+    int64_t lo[3], hi[3];
+    for (int a = 0; a < 3; a++) { /* beyond the volume its edge repeats, which the bricks inside hold */
+        lo[a] = c[a] - k < 0 ? 0 : c[a] - k;
+        hi[a] = c[a] + k >= pg->grid[a] ? pg->grid[a] - 1 : c[a] + k;
+    }
+    for (int64_t z = lo[2]; z <= hi[2]; z++)
+        for (int64_t y = lo[1]; y <= hi[1]; y++)
+            for (int64_t x = lo[0]; x <= hi[0]; x++) {
+                size_t j = (size_t)x + pg->grid[0] * ((size_t)y + (size_t)pg->grid[1] * z);
+                if (pg->data_index[j] >= 0 || pg->low[j] != pg->low[i]) return 0;
+            }
+    return 1;
+}
+
+/* Whether page brick c (of `scale` full-resolution voxels per voxel) widened
+ * by reach_k of its own voxels overlaps an occupied skip brick. */
+static int near_occupied(const vxl_pages *pg, const vxl_bricks *b, const uint32_t c[3], int64_t reach_k,
+                         uint32_t scale)
+{
+    uint32_t lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+        int64_t v0 = ((int64_t)c[a] * pg->brick - reach_k) * scale,
+                v1 = ((int64_t)c[a] * pg->brick + pg->brick + reach_k) * scale - 1;
+        lo[a] = clampi(v0 < 0 ? 0 : v0 / b->size, b->dims[a]);
+        hi[a] = clampi(v1 / b->size, b->dims[a]);
+    }
+    for (uint32_t z = lo[2]; z <= hi[2]; z++)
+        for (uint32_t y = lo[1]; y <= hi[1]; y++)
+            for (uint32_t x = lo[0]; x <= hi[0]; x++)
+                if (b->distance[x + (size_t)b->dims[0] * (y + (size_t)b->dims[1] * z)] == 0) return 1;
+    return 0;
+}
+
 uint32_t vxl_pages_needed(const vxl_pages *pg, const vxl_bricks *b, uint32_t reach, uint32_t scale, int all,
-                          uint8_t *need)
+                          const uint8_t *candidate, uint8_t *need)
 {
     const uint64_t n = vxl_page_count(pg);
     /* a coarse trilinear footprint reaches one more coarse voxel */
     const int64_t reach_k = scale > 1 ? (reach + scale - 1) / scale + 1 : reach;
     uint32_t count = 0;
     for (uint64_t i = 0; i < n; i++) {
-        need[i] = 0;
-        if (pg->data_index[i] < 0) continue;
-        if (all) {
-            need[i] = 1;
-            count++;
-            continue;
-        }
         const uint32_t c[3] = {(uint32_t)(i % pg->grid[0]), (uint32_t)(i / pg->grid[0] % pg->grid[1]),
                                (uint32_t)(i / ((uint64_t)pg->grid[0] * pg->grid[1]))};
-        uint32_t lo[3], hi[3]; /* skip bricks covering the page's voxels widened by reach */
-        for (int a = 0; a < 3; a++) {
-            int64_t v0 = ((int64_t)c[a] * pg->brick - reach_k) * scale,
-                    v1 = ((int64_t)c[a] * pg->brick + pg->brick + reach_k) * scale - 1;
-            lo[a] = clampi(v0 < 0 ? 0 : v0 / b->size, b->dims[a]);
-            hi[a] = clampi(v1 / b->size, b->dims[a]);
-        }
-        for (uint32_t z = lo[2]; z <= hi[2] && !need[i]; z++)
-            for (uint32_t y = lo[1]; y <= hi[1] && !need[i]; y++)
-                for (uint32_t x = lo[0]; x <= hi[0]; x++)
-                    if (b->distance[x + (size_t)b->dims[0] * (y + (size_t)b->dims[1] * z)] == 0) {
-                        need[i] = 1;
-                        break;
-                    }
+        need[i] = (candidate ? candidate[i] : pg->data_index[i] >= 0) && (all || near_occupied(pg, b, c, reach_k, scale));
         count += need[i];
     }
     return count;
+}
+
+/* Normalised value of texel t of a store's texels. */
+static float texel_value(const vxl_brick_store *s, size_t t)
+{
+    switch (s->bytes_per_voxel) {
+    case 1: return s->texels[t] / 255.0f;
+    case 2: return ((const uint16_t *)(const void *)s->texels)[t] / 65535.0f;
+    default: return ((const float *)(const void *)s->texels)[t];
+    }
+}
+
+void vxl_pages_gather(const vxl_pages *pg, const vxl_brick_store *s, const uint32_t dims[3], const int64_t lo[3],
+                      const uint32_t size[3], float *out)
+{
+    const uint32_t e = s->edge, P = pg->brick;
+    const size_t row = (size_t)s->slots[0] * e, slice = row * s->slots[1] * e;
+    for (uint32_t z = 0; z < size[2]; z++) {
+        const uint32_t gz = clampi(lo[2] + z, dims[2]), bz = gz / P, lz = gz - bz * P + VXL_PAGE_GHOST;
+        for (uint32_t y = 0; y < size[1]; y++) {
+            const uint32_t gy = clampi(lo[1] + y, dims[1]), by = gy / P, ly = gy - by * P + VXL_PAGE_GHOST;
+            const size_t brow = pg->grid[0] * ((size_t)by + (size_t)pg->grid[1] * bz);
+            for (uint32_t x = 0; x < size[0];) {
+                /* a run of x inside one page brick */
+                const uint32_t gx = clampi(lo[0] + x, dims[0]), bx = gx / P;
+                uint32_t run = 1;
+                if (lo[0] + x >= 0 && lo[0] + x < dims[0]) {
+                    const uint32_t brick_end = (bx + 1) * P < dims[0] ? (bx + 1) * P : dims[0];
+                    run = brick_end - gx;
+                    run = run < size[0] - x ? run : size[0] - x;
+                }
+                const size_t bi = bx + brow;
+                const int32_t d = pg->data_index[bi];
+                if (d < 0) {
+                    for (uint32_t k = 0; k < run; k++) out[x + k] = pg->low[bi];
+                } else {
+                    const size_t sx = d % s->slots[0], sy = d / s->slots[0] % s->slots[1], sz = d / ((size_t)s->slots[0] * s->slots[1]);
+                    const size_t t = (sx * e + gx - bx * P + VXL_PAGE_GHOST) + row * (sy * e + ly) + slice * (sz * e + lz);
+                    for (uint32_t k = 0; k < run; k++) out[x + k] = texel_value(s, t + k);
+                }
+                x += run;
+            }
+            out += size[0];
+        }
+    }
 }

@@ -44,13 +44,41 @@ void vxl_pages_free(vxl_pages *pg);
  * texture; fills b->size, b->dims and b->minmax. */
 int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl_err *e);
 
-/* need[i] = 1 for every data brick a frame can read under the occupancy in b
- * (b->distance, 0 = occupied, on the full-resolution grid): a brick within
- * `reach` full-resolution voxels of an occupied skip brick, since gradient
- * taps reach that far from a visible sample. pg may be a coarser level whose
- * voxels cover `scale` full-resolution voxels per axis. all != 0 marks every
- * data brick (classifications occupancy cannot bound). Returns the count. */
+/* need[i] = 1 for every candidate brick a frame can read under the
+ * occupancy in b (b->distance, 0 = occupied, on the full-resolution grid): a
+ * brick within `reach` full-resolution voxels of an occupied skip brick,
+ * since gradient taps reach that far from a visible sample. candidate NULL:
+ * the data bricks; else candidate[i] != 0 (bricks of a pool derived from the
+ * data, constant ones included). pg may be a coarser level whose voxels
+ * cover `scale` full-resolution voxels per axis. all != 0 marks every
+ * candidate (classifications occupancy cannot bound). Returns the count. */
 uint32_t vxl_pages_needed(const vxl_pages *pg, const vxl_bricks *b, uint32_t reach, uint32_t scale, int all,
-                          uint8_t *need);
+                          const uint8_t *candidate, uint8_t *need);
+
+/* 1 if brick i and every brick within `voxels` voxels of it are constant
+ * with one value: a filter reaching no farther sees a constant there. */
+int vxl_pages_flat_around(const vxl_pages *pg, uint64_t i, uint32_t voxels);
+
+/* Where the texels of data brick d lie: slot d of a 3D array of slots of
+ * edge `edge` (ghost included), slots[0] x slots[1] x ... of them. The CPU
+ * bricks of a vxl_pages are slots 1 x 1 x n_data; a pool read back from the
+ * GL side is laid out as the pool. */
+typedef struct vxl_brick_store {
+    const uint8_t *texels;
+    uint32_t slots[2];
+    uint32_t edge, bytes_per_voxel;
+} vxl_brick_store;
+
+static inline vxl_brick_store vxl_pages_store(const vxl_pages *pg)
+{
+    vxl_brick_store s = {pg->data, {1, 1}, vxl_page_edge(pg), pg->bytes_per_voxel};
+    return s;
+}
+
+/* The normalised values (as a sampler returns them) of the voxels lo + l,
+ * l < size per axis, of the volume of `dims` voxels cut into pg, each
+ * coordinate clamped into the volume; x fastest. */
+void vxl_pages_gather(const vxl_pages *pg, const vxl_brick_store *s, const uint32_t dims[3], const int64_t lo[3],
+                      const uint32_t size[3], float *out);
 
 #endif

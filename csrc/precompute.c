@@ -2,6 +2,8 @@
  * then a 26-neighbour Sobel, computed on the GL side once per volume. It
  * stores the raw gradient divided by the global maximum magnitude, so that
  * interpolation happens before normalisation (see measured-facts.md). */
+#include <stdlib.h>
+
 #include "renderer_internal.h"
 
 static const GLenum store_internal[] = {GL_RGBA8_SNORM, GL_RGBA16F, GL_RGBA32F};
@@ -13,6 +15,8 @@ void vxl_gradients_release(vxl_renderer *r)
     if (r->gpage_tex) r->gl.DeleteTextures(1, &r->gpage_tex);
     r->gradient_tex = r->gpage_tex = 0;
     r->gradient_bytes = 0;
+    free(r->gradient_covered);
+    r->gradient_covered = NULL;
 }
 
 static GLuint groups(uint32_t n) { return (n + 3) / 4; }

@@ -61,8 +61,12 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
         gl->ActiveTexture(GL_TEXTURE1);
         gl->BindTexture(GL_TEXTURE_3D, r->gradient_tex);
     } else if (filter == VXL_FILTER_CUBIC) {
-        int rc = vxl_bspline_ensure(r);
+        int rc = r->volume_tex ? vxl_bspline_ensure(r) : vxl_paged_bspline_ensure(r);
         if (rc) return rc;
+        if (r->cpage_tex) {
+            gl->ActiveTexture(GL_TEXTURE0 + VXL_CPAGE_UNIT);
+            gl->BindTexture(GL_TEXTURE_3D, r->cpage_tex);
+        }
         gl->ActiveTexture(GL_TEXTURE1);
         gl->BindTexture(GL_TEXTURE_3D, r->bspline_tex);
     }
@@ -83,6 +87,10 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
         float gd[3] = {(float)r->gpool_dims[0], (float)r->gpool_dims[1], (float)r->gpool_dims[2]};
         GLint gloc = gl->GetUniformLocation(prog, "u_gpool_dims");
         if (gloc >= 0) gl->Uniform3fv(gloc, 1, gd);
+        vxl_uniform_i(r, prog, "u_cpage", VXL_CPAGE_UNIT);
+        float cd[3] = {(float)r->cpool_dims[0], (float)r->cpool_dims[1], (float)r->cpool_dims[2]};
+        GLint cloc = gl->GetUniformLocation(prog, "u_cpool_dims");
+        if (cloc >= 0) gl->Uniform3fv(cloc, 1, cd);
         if (r->pool_tex == r->code_tex) { /* compressed storage filtered in the compressed domain */
             gl->ActiveTexture(GL_TEXTURE0 + VXL_PALETTE_UNIT);
             gl->BindTexture(GL_TEXTURE_2D, r->palette_tex);
@@ -195,8 +203,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     GLuint prog;
     uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2) |
                      (f->gopacity << 4) | vxl_volume_flags(r);
-    /* rays that never evaluate gradients: one program serves every filter */
-    uint32_t filter = f->shading || f->gopacity ? f->filter : VXL_FILTER_CENTRAL;
+    uint32_t filter = vxl_frame_filter(f);
     int rc = vxl_paged_check_filter(r, filter, f->classify);
     if (!rc) rc = vxl_program_get(r, VXL_PROG_RAYCAST, filter, flags, &prog);
     if (!rc) rc = ensure_framebuffer(r, f->width, f->height);

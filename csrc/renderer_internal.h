@@ -74,7 +74,13 @@ struct vxl_renderer {
     float *page_entries;          /* RGBA per page brick, as uploaded */
     uint32_t pages_resident, pages_constant;
     uint64_t pool_bytes;
-    uint32_t pool_reach;          /* the tap reach (voxels) the resident set was derived for */
+    uint64_t pool_generation;     /* counts pool uploads: what is derived from the pool texel for texel keys on it */
+    /* What the last frame could see, for pools derived from the data
+     * (gradients, coefficients): bricks within visible_reach voxels of an
+     * occupied skip brick, or every brick (visible_all: bricked storage,
+     * probes, classifications occupancy cannot bound). */
+    uint32_t visible_reach;
+    int visible_all;
     /* Compressed storage (compress.h): the codes of every data brick in
      * code_tex (R8UI, slot = data index) and their palettes in palette_tex
      * (16 rows of 256 per texel row). pool_tex is the linear cache the
@@ -94,9 +100,16 @@ struct vxl_renderer {
     int gradient_store;        /* VXL_GRADIENT_STORE_* of gradient_tex */
     float gradient_max;        /* largest |gradient| (value per voxel): gradient_tex holds g / gradient_max */
     uint64_t gradient_bytes;
+    uint8_t *gradient_covered; /* bricked: per page brick of gradient_level, 1 if in the gradient pool */
+    uint32_t gradient_level;
+    float gradient_max_level[VXL_LOD_LEVELS]; /* sparse: the whole level's maximum from the CPU bricks, < 0 unknown */
 
-    /* Cubic B-spline coefficients: depend only on the volume data. */
-    GLuint bspline_tex;
+    /* Cubic B-spline coefficients: depend only on the volume data. Bricked,
+     * a pool of coefficient bricks with its page table (paged_bspline.c). */
+    GLuint bspline_tex, cpage_tex;
+    uint32_t cpool_dims[3];
+    uint8_t *bspline_covered;  /* bricked: per page brick of bspline_level, 1 if in the coefficient pool */
+    uint32_t bspline_level;
     uint64_t bspline_bytes;
 
     /* Empty-space skipping: min-max per brick (data only) and the distance
@@ -110,6 +123,7 @@ struct vxl_renderer {
     GLuint classified_tex, preint_tex;
     uint64_t classified_key, preint_key;
     uint64_t classified_bytes;
+    uint32_t classified_dims[3];
 
     vxl_program_entry programs[VXL_MAX_PROGRAMS];
     int n_programs;
@@ -160,11 +174,28 @@ int vxl_paged_check_filter(vxl_renderer *r, uint32_t filter, uint32_t classify);
 void vxl_paged_release(vxl_renderer *r);
 uint32_t vxl_skip_brick_size(void);
 int vxl_paged_gradients_ensure(vxl_renderer *r, int store); /* paged_gradients.c */
+/* paged_bspline.c: the cubic filter's coefficient pool, and what it shares
+ * with the gradient pool: which bricks a derived pool needs (not flat within
+ * `support` voxels, readable within `read_reach` of a visible sample) and
+ * whether one made for `covered` at `level` still serves. */
+int vxl_paged_bspline_ensure(vxl_renderer *r);
+uint32_t vxl_paged_derived_want(const vxl_renderer *r, uint32_t level, uint32_t support, uint32_t read_reach,
+                                uint8_t *want);
+/* Bytes the cubic / precomputed pool of `level` needs for the last frame's
+ * visibility (UINT64_MAX: over the texture limit); fills want (a mask of the
+ * level's page count) and *count. */
+uint64_t vxl_paged_bspline_bytes(const vxl_renderer *r, uint32_t level, uint8_t *want, uint32_t *count);
+uint64_t vxl_paged_gradient_bytes(const vxl_renderer *r, uint32_t level, int store, uint8_t *want, uint32_t *count);
+int vxl_paged_derived_current(const vxl_renderer *r, const uint8_t *covered, uint32_t level, const uint8_t *want);
+/* The current level's bricks on the CPU: its own when kept, else (bricked)
+ * the pool read back into *owned, which the caller frees. */
+int vxl_paged_brick_store(vxl_renderer *r, vxl_brick_store *s, uint8_t **owned);
 int vxl_pool_layout(const vxl_renderer *r, uint32_t n, uint32_t edge, uint32_t slots[3]);
 /* Runs prog over `count` bricks of edge e (one invocation per voxel, groups
  * of 4^3), in chunks the dispatch limit allows (sets u_first). */
 void vxl_dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t count, uint32_t e);
 #define VXL_GPAGE_UNIT 9 /* texture unit of the gradient pool's page table */
+#define VXL_CPAGE_UNIT 12 /* texture unit of the coefficient pool's page table */
 #define VXL_PAGE_UNIT 8 /* texture unit of the page table */
 #define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
 #define VXL_FLAG_COMPRESSED_DOMAIN 128u /* with PAGED: the pool holds codes, every tap decodes its 8 neighbours */

@@ -30,10 +30,27 @@ float correct_opacity(float a, float step)
 #ifdef CLASSIFY_PRE
 uniform sampler3D u_classified; // premultiplied RGBA per voxel, opacity scale applied
 
-// Straight colour and per-voxel opacity of the interpolated classified voxels.
-vec4 pre_classified(vec3 tex)
+#ifndef PAGED
+vec4 classified_texels(vec3 p) { return textureLod(u_classified, voxel_to_tex(p), 0.0); }
+#else
+// Bricked storage: u_classified is the pool classified texel for texel (the
+// same slots, ghosts included). A brick not in the pool is its one value,
+// classified and rounded as the RGBA8 texels are, so bricked equals dense.
+vec4 classified_texels(vec3 p)
 {
-    vec4 c = textureLod(u_classified, tex, 0.0);
+    vec3 t = level_position(p);
+    vec4 e = page_entry(u_page, t);
+    if (e.w < 0.0) return textureLod(u_classified, (t + 0.5) / u_pool_dims, 0.0);
+    vec4 k = classify(e.w);
+    return round(vec4(k.rgb * k.a, k.a) * 255.0) / 255.0;
+}
+#endif
+
+// Straight colour and per-voxel opacity of the interpolated classified voxels
+// around voxel position p.
+vec4 pre_classified(vec3 p)
+{
+    vec4 c = classified_texels(p);
     return vec4(c.a > 0.0 ? c.rgb / c.a : vec3(0.0), c.a);
 }
 #endif

@@ -47,18 +47,32 @@ int palette_row(vec3 origin)
 float decode_texel(ivec3 t, int row) { return palette_value(row, texelFetch(u_volume, t, 0).r); }
 #endif
 
+// Full-resolution position -> position on the level in the pool (coarse
+// voxel k covers fine k*s .. k*s+s-1).
+vec3 level_position(vec3 p) { return u_lod_scale > 1.0 ? (p + 0.5) / u_lod_scale - 0.5 : p; }
+
+// The entry of `table` (the page table, or that of a pool derived from the
+// data: gradients, spline coefficients, all laid out brick for brick) for
+// level position q, and q moved to its texel position in that pool (texel
+// centres at integers). Clamping q to the voxel centres first reproduces
+// clamp-to-edge sampling of one texture.
+vec4 page_entry(sampler3D table, inout vec3 q)
+{
+    q = clamp(q, vec3(0.0), u_page_dims - 1.0);
+    ivec3 b = ivec3(floor((q + 0.5) / u_page_brick));
+    vec4 e = texelFetch(table, b, 0);
+    q = e.xyz + q - vec3(b) * u_page_brick;
+    return e;
+}
+
 float sample_value(vec3 p)
 {
-    if (u_lod_scale > 1.0) p = (p + 0.5) / u_lod_scale - 0.5; // coarse voxel k covers fine k*s .. k*s+s-1
-    // clamping to the voxel centres reproduces clamp-to-edge of one texture
-    vec3 q = clamp(p, vec3(0.0), u_page_dims - 1.0);
-    ivec3 b = ivec3(floor((q + 0.5) / u_page_brick));
-    vec4 e = texelFetch(u_page, b, 0);
+    vec3 t = level_position(p);
+    vec4 e = page_entry(u_page, t);
     if (e.w >= 0.0) return e.w;
 #ifndef COMPRESSED_DOMAIN
-    return textureLod(u_volume, (e.xyz + q - vec3(b) * u_page_brick + 0.5) / u_pool_dims, 0.0).r;
+    return textureLod(u_volume, (t + 0.5) / u_pool_dims, 0.0).r;
 #else
-    vec3 t = e.xyz + q - vec3(b) * u_page_brick; // texel centres at integers
     ivec3 i = ivec3(floor(t));
     vec3 w = t - vec3(i);
     int row = palette_row(e.xyz);
@@ -71,7 +85,7 @@ float sample_value(vec3 p)
 #endif
 }
 
-// The stored value of voxel c (inside the volume, full resolution): what
+// The stored value of voxel c of the level in the pool (inside it): what
 // texelFetch of one texture returns.
 float paged_fetch(ivec3 c)
 {

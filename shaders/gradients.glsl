@@ -12,17 +12,17 @@ uniform float u_gradient_scale; // that global max: magnitudes in value per voxe
 #ifdef PAGED
 // Bricked storage: u_gradient is a pool of its own, u_gpage its page table
 // (w < 0 in the pool, else a brick whose whole neighbourhood is one value:
-// zero gradient). Paged like sample_value, see paged_gradient.comp.
+// zero gradient), see paged_gradient.comp. On a coarser level the gradient
+// is the level's, per level voxel.
 uniform sampler3D u_gpage;
 uniform vec3 u_gpool_dims;
 
 vec3 paged_gradient(vec3 p)
 {
-    vec3 q = clamp(p, vec3(0.0), u_page_dims - 1.0);
-    ivec3 b = ivec3(floor((q + 0.5) / u_page_brick));
-    vec4 e = texelFetch(u_gpage, b, 0);
+    vec3 t = level_position(p);
+    vec4 e = page_entry(u_gpage, t);
     if (e.w >= 0.0) return vec3(0.0);
-    return textureLod(u_gradient, (e.xyz + q - vec3(b) * u_page_brick + 0.5) / u_gpool_dims, 0.0).xyz;
+    return textureLod(u_gradient, (t + 0.5) / u_gpool_dims, 0.0).xyz / u_lod_scale;
 }
 #endif
 #endif
@@ -48,7 +48,22 @@ void bspline_pairs(float x, out vec2 h, out vec2 g, out vec2 dh, out vec2 dg)
     dh = vec2(-1.0 + d1 / dg.x, 1.0 + d3 / dg.y);
 }
 
+#ifndef PAGED
 float coeff(vec3 q) { return textureLod(u_bspline, voxel_to_tex(q), 0.0).r; }
+#else
+// Bricked storage: u_bspline is a pool of coefficient bricks with a one-voxel
+// ghost, u_cpage its page table (w >= 0: a brick whose coefficients are all
+// that value), laid out brick for brick like the data (paged_bspline.c).
+// q is a level position.
+uniform sampler3D u_cpage;
+uniform vec3 u_cpool_dims;
+
+float coeff(vec3 q)
+{
+    vec4 e = page_entry(u_cpage, q);
+    return e.w >= 0.0 ? e.w : textureLod(u_bspline, (q + 0.5) / u_cpool_dims, 0.0).r;
+}
+#endif
 
 // One gradient component: derivative pairs along axis `a`, value pairs on
 // the other two; 8 trilinear fetches.
@@ -120,11 +135,18 @@ vec3 gradient_at(vec3 p, float centre)
     return textureLod(u_gradient, voxel_to_tex(p), 0.0).xyz * u_gradient_scale;
 #elif defined(FILTER_CUBIC)
     // Analytic derivative of the interpolating cubic B-spline: 24 fetches.
-    vec3 base = floor(p);
+#ifdef PAGED
+    vec3 q = level_position(p); // a coarser level's spline, per level voxel
+    float per_voxel = 1.0 / u_lod_scale;
+#else
+    vec3 q = p;
+    float per_voxel = 1.0;
+#endif
+    vec3 base = floor(q);
     vec2 h[3], g[3], dh[3], dg[3];
-    for (int c = 0; c < 3; c++) bspline_pairs(p[c], h[c], g[c], dh[c], dg[c]);
+    for (int c = 0; c < 3; c++) bspline_pairs(q[c], h[c], g[c], dh[c], dg[c]);
     return vec3(bspline_partial(base, h, g, dh, dg, 0), bspline_partial(base, h, g, dh, dg, 1),
-                bspline_partial(base, h, g, dh, dg, 2));
+                bspline_partial(base, h, g, dh, dg, 2)) * per_voxel;
 #else
 #error "no FILTER_* define"
 #endif

@@ -154,7 +154,7 @@ void main()
         if (a <= 0.0) continue;
         vec3 rgb = seg.rgb / a;
 #elif defined(CLASSIFY_PRE)
-        vec4 c = pre_classified(voxel_to_tex(p));
+        vec4 c = pre_classified(p);
         if (c.a <= 0.0) continue;
         float a = correct_opacity(c.a, u_step);
         vec3 rgb = c.rgb;

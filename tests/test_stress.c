@@ -31,7 +31,7 @@
  * The two backends render concurrently, one thread each (each renderer has
  * its own GL thread), which also exercises two renderers used at once.
  *
- * Usage: test_stress [--full] [--only SUBSTRING] [--skip SUBSTRING] [--backend osmesa|egl] [--serial]
+ * Usage: test_stress [--full] [--only SUBSTRING] [--skip SUBSTRING] [--backend osmesa|egl|sparse] [--serial]
  *   --full    larger images and volumes, every mode, and each render repeated
  *             over variants (views, steps, sample distances, gradient stores,
  *             jitter); run by `./build.sh stress`. Takes minutes.
@@ -56,11 +56,13 @@
 #define MAX_PRINTED_FAILURES 8 /* per case; the rest are counted */
 #define WATCHDOG_S 180         /* a render running longer than this is a hang */
 
-enum { BACKEND_OSMESA, BACKEND_EGL, BACKEND_N };
-static const uint32_t backend_ids[BACKEND_N] = {VXL_BACKEND_OSMESA, VXL_BACKEND_EGL};
-static const char *const backend_names[BACKEND_N] = {"osmesa", "egl"};
+/* "sparse" is OSMesa with sparse storage in page bricks of 8: every case
+ * through the page table, the derived filters' brick pools included. */
+enum { BACKEND_OSMESA, BACKEND_EGL, BACKEND_SPARSE, BACKEND_N };
+static const uint32_t backend_ids[BACKEND_N] = {VXL_BACKEND_OSMESA, VXL_BACKEND_EGL, VXL_BACKEND_OSMESA};
+static const char *const backend_names[BACKEND_N] = {"osmesa", "egl", "sparse"};
 static vxl_renderer *R[BACKEND_N];
-static int backend_enabled[BACKEND_N] = {1, 1};
+static int backend_enabled[BACKEND_N] = {1, 1, 1};
 
 static stress_env ENV;
 static const char *only_filter, *skip_filter;
@@ -498,6 +500,18 @@ GROUP_TEST(steps)
 GROUP_TEST(lighting)
 GROUP_TEST(invalid_inputs)
 
+static vxl_renderer *make_sparse_renderer(void)
+{
+    vxl_renderer_options o;
+    memset(&o, 0, sizeof o);
+    o.struct_size = sizeof o;
+    o.backend = VXL_BACKEND_OSMESA;
+    o.storage = VXL_STORAGE_SPARSE;
+    o.page_brick = 8;
+    vxl_renderer *r = NULL;
+    return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
+}
+
 /* The matrix needs its backends: a missing one is a failure, not a skip. */
 TEST(backends_open)
 {
@@ -558,8 +572,9 @@ int main(int argc, char **argv)
             const char *b = argv[++i];
             backend_enabled[BACKEND_OSMESA] = !strcmp(b, "osmesa");
             backend_enabled[BACKEND_EGL] = !strcmp(b, "egl");
+            backend_enabled[BACKEND_SPARSE] = !strcmp(b, "sparse");
         } else {
-            fprintf(stderr, "usage: %s [--full] [--only SUBSTRING] [--skip SUBSTRING] [--backend osmesa|egl] [--serial]\n",
+            fprintf(stderr, "usage: %s [--full] [--only SUBSTRING] [--skip SUBSTRING] [--backend osmesa|egl|sparse] [--serial]\n",
                     argv[0]);
             return 2;
         }
@@ -572,7 +587,7 @@ int main(int argc, char **argv)
     }
     double t0 = now_s();
     for (int b = 0; b < BACKEND_N; b++)
-        if (backend_enabled[b]) R[b] = make_renderer(backend_ids[b]);
+        if (backend_enabled[b]) R[b] = b == BACKEND_SPARSE ? make_sparse_renderer() : make_renderer(backend_ids[b]);
     pthread_t wd;
     pthread_create(&wd, NULL, watchdog, NULL);
     pthread_detach(wd);
@@ -580,7 +595,7 @@ int main(int argc, char **argv)
             "stress: %s run, %ux%u images, volumes of %u, %zu cases x %d filters x %d classify modes x %s modes "
             "x %d backends%s\n",
             full ? "full" : "default", ENV.image, ENV.image, ENV.n, (size_t)STRESS_CASE_COUNT, VXL_FILTER_COUNT,
-            VXL_CLASSIFY_COUNT, full ? "8" : "1-6", (int)(R[0] != NULL) + (int)(R[1] != NULL),
+            VXL_CLASSIFY_COUNT, full ? "8" : "1-6", (int)(R[0] != NULL) + (int)(R[1] != NULL) + (int)(R[2] != NULL),
             full ? " x up to 12 variants" : "");
 
     RUN(backends_open);
@@ -602,9 +617,9 @@ int main(int argc, char **argv)
     pthread_mutex_unlock(&lock);
     for (int b = 0; b < BACKEND_N; b++) vxl_renderer_destroy(R[b]);
     fprintf(stderr,
-            "stress: %llu cases, %llu renders (osmesa %llu, egl %llu; %llu deliberately invalid) in %.1f s wall, "
+            "stress: %llu cases, %llu renders (osmesa %llu, egl %llu, sparse %llu; %llu deliberately invalid) in %.1f s wall, "
             "%.1f s cpu; slowest render %.3f s: %s\n",
-            n_cases_run, n_renders, n_by_backend[0], n_by_backend[1], n_error_renders, now_s() - t0, cpu_s(),
+            n_cases_run, n_renders, n_by_backend[0], n_by_backend[1], n_by_backend[2], n_error_renders, now_s() - t0, cpu_s(),
             slowest_render_s, slowest_label);
     return TEST_SUMMARY();
 }

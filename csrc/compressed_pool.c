@@ -110,7 +110,7 @@ int vxl_compressed_decode(vxl_renderer *r, const int32_t *source, uint32_t count
     gl->Uniform3i(gl->GetUniformLocation(prog, "u_code_slots"), (GLint)r->code_slots[0], (GLint)r->code_slots[1],
                   (GLint)r->code_slots[2]);
     gl->BindImageTexture(0, r->pool_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, image_formats[pg->bytes_per_voxel - 1]);
-    vxl_dispatch_bricks(r, prog, count, e);
+    vxl_dispatch_bricks(r, prog, 0, count, e);
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     gl->Finish(); /* the decode time is a reported number */
     r->decode_ms = now_ms() - t0;

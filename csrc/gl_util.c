@@ -97,10 +97,8 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     case VXL_PROG_GRAD_BLUR:
         rc = compile(r, GL_COMPUTE_SHADER, "gradient_blur.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
-    case VXL_PROG_GRAD_MAX: /* the Sobel passes of the dense and the bricked texture */
-    case VXL_PROG_PAGED_GRAD_MAX:
-        rc = compile(r, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_MAX ? "gradient_sobel.comp" : "paged_gradient.comp",
-                     "#define MAX_PASS 1\n", &a);
+    case VXL_PROG_GRAD_MAX: /* the dense texture's largest gradient (bricked: found on the CPU) */
+        rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_GRAD_STORE:
     case VXL_PROG_PAGED_GRAD_STORE:

@@ -21,6 +21,16 @@ static const uint32_t store_bytes[] = {4, 8, 16};
 #define GRADIENT_SUPPORT 2
 #define GRADIENT_READ_REACH 2
 
+/* Bricks blurred at once: their blurred copies (R32F, edge P+4) within 64
+ * MiB, or a sixteenth of the budget when that is less. */
+static uint32_t blur_chunk(const vxl_renderer *r, uint32_t eb, uint32_t count)
+{
+    const uint64_t bytes = r->budget / 16 < (64u << 20) ? r->budget / 16 : (64u << 20);
+    uint32_t chunk = (uint32_t)(bytes / ((uint64_t)eb * eb * eb * 4));
+    chunk = chunk ? chunk : 1;
+    return count && count < chunk ? count : chunk;
+}
+
 uint64_t vxl_paged_gradient_bytes(const vxl_renderer *r, uint32_t level, int store, uint8_t *want, uint32_t *count_out)
 {
     const vxl_pages *pg = &r->levels[level];
@@ -28,9 +38,10 @@ uint64_t vxl_paged_gradient_bytes(const vxl_renderer *r, uint32_t level, int sto
     const uint64_t eb = pg->brick + 4, eg = pg->brick + 2;
     uint32_t bslots[3], gslots[3];
     if (count_out) *count_out = count;
-    if (!vxl_pool_layout(r, count, (uint32_t)eb, bslots) || !vxl_pool_layout(r, count, (uint32_t)eg, gslots))
+    if (!vxl_pool_layout(r, blur_chunk(r, (uint32_t)eb, count), (uint32_t)eb, bslots) ||
+        !vxl_pool_layout(r, count, (uint32_t)eg, gslots))
         return UINT64_MAX;
-    /* the gradient pool, its page table and the transient blurred bricks */
+    /* the gradient pool, its page table and one chunk of blurred bricks */
     return (uint64_t)gslots[0] * gslots[1] * gslots[2] * eg * eg * eg * store_bytes[store] + vxl_page_count(pg) * 16 +
            (uint64_t)bslots[0] * bslots[1] * bslots[2] * eb * eb * eb * 4;
 }
@@ -72,12 +83,12 @@ static int cpu_gradient_max(vxl_renderer *r, float *out)
 
 static GLuint groups(uint32_t n) { return (n + 3) / 4; }
 
-void vxl_dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t count, uint32_t e)
+void vxl_dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t first, uint32_t count, uint32_t e)
 {
     const uint32_t per = 65535u * 4u / e; /* bricks per dispatch: z groups <= 65535 */
-    for (uint32_t first = 0; first < count; first += per) {
-        uint32_t n = count - first < per ? count - first : per;
-        vxl_uniform_i(r, prog, "u_first", (int)first);
+    for (uint32_t k = first; k < first + count; k += per) {
+        uint32_t n = first + count - k < per ? first + count - k : per;
+        vxl_uniform_i(r, prog, "u_first", (int)k);
         r->gl.DispatchCompute(groups(e), groups(e), groups(n * e));
     }
 }
@@ -118,17 +129,19 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
         free(want);
         return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the gradient bricks");
     }
-    /* the pool holds every data brick only when bricked; else the maximum
-     * comes from the CPU bricks, which sparse storage keeps */
-    const int pool_complete = r->storage == VXL_STORAGE_BRICKED;
-    float cpu_max = 0;
-    int rc = pool_complete ? VXL_OK : cpu_gradient_max(r, &cpu_max);
+    /* the whole volume's maximum, from the CPU bricks (sparse keeps them,
+     * bricked reads its pool back): a separable CPU blur and Sobel beat the
+     * same 27-tap passes through the page table on the GL side, and sparse
+     * storage has only the visible bricks there */
+    float max_mag = 0;
+    int rc = cpu_gradient_max(r, &max_mag);
     if (rc) {
         free(list);
         free(want);
         return rc;
     }
-    if (all_bytes == UINT64_MAX || !vxl_pool_layout(r, count, eb, bslots) || !vxl_pool_layout(r, count, eg, gslots)) {
+    const uint32_t chunk = blur_chunk(r, eb, count);
+    if (all_bytes == UINT64_MAX || !vxl_pool_layout(r, chunk, eb, bslots) || !vxl_pool_layout(r, count, eg, gslots)) {
         free(list);
         free(want);
         return vxl_fail(&r->err, VXL_ERR_LIMIT, "%u gradient bricks do not fit a pool within the 3D texture limit of %d",
@@ -143,59 +156,50 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
         free(want);
         return rc;
     }
-    const GLuint blur_prog = progs[0], max_prog = progs[1], store_prog = progs[2];
+    const GLuint blur_prog = progs[0], store_prog = progs[2];
     gl->GetError();
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[1]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(count ? count : 1) * 4 * (GLsizeiptr)sizeof(GLint), list,
                    GL_STATIC_DRAW);
     gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, r->ssbo[1]);
-    /* pass 1: blur every derived brick plus its 2-voxel border, through the data pool */
+    /* The bricks go through in chunks whose blurred copies fit one small
+     * texture: the blurred copy of every brick at once would double the
+     * memory. Pass 1 blurs a chunk, pass 2 stores its scaled gradients. */
     GLuint blur = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
     gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R32F, (GLsizei)(bslots[0] * eb), (GLsizei)(bslots[1] * eb),
                    (GLsizei)(bslots[2] * eb), 0, GL_RED, GL_FLOAT, NULL);
-    set_common(r, blur_prog, count, bslots);
-    gl->ActiveTexture(GL_TEXTURE0 + VXL_PAGE_UNIT);
-    gl->BindTexture(GL_TEXTURE_3D, r->page_tex);
-    gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, r->pool_tex);
-    vxl_uniform_i(r, blur_prog, "u_volume", 0);
-    vxl_uniform_i(r, blur_prog, "u_page", VXL_PAGE_UNIT);
-    gl->BindImageTexture(0, blur, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
-    vxl_dispatch_bricks(r, blur_prog, count, eb);
-    gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    /* pass 2: the global maximum magnitude (of every brick: pool_complete) */
-    union { GLuint u; float f; } max_mag = {0};
-    max_mag.f = cpu_max;
-    if (pool_complete) {
-        const GLuint zero = 0;
-        gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[0]);
-        gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zero, &zero, GL_DYNAMIC_READ);
-        gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r->ssbo[0]);
-        set_common(r, max_prog, count, gslots);
-        gl->Uniform3i(gl->GetUniformLocation(max_prog, "u_blur_slots"), (GLint)bslots[0], (GLint)bslots[1], (GLint)bslots[2]);
-        gl->ActiveTexture(GL_TEXTURE0);
-        gl->BindTexture(GL_TEXTURE_3D, blur);
-        vxl_uniform_i(r, max_prog, "u_blur", 0);
-        vxl_dispatch_bricks(r, max_prog, count, eg);
-        gl->MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-        gl->GetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof max_mag.u, &max_mag.u);
-    }
-    /* pass 3: scaled raw gradient into the gradient pool */
     r->gradient_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
     for (int a = 0; a < 3; a++) r->gpool_dims[a] = gslots[a] * eg;
     gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)store_internal[store], (GLsizei)r->gpool_dims[0], (GLsizei)r->gpool_dims[1],
                    (GLsizei)r->gpool_dims[2], 0, GL_RGBA, GL_FLOAT, NULL);
-    set_common(r, store_prog, count, gslots);
-    gl->Uniform3i(gl->GetUniformLocation(store_prog, "u_blur_slots"), (GLint)bslots[0], (GLint)bslots[1],
-                  (GLint)bslots[2]);
-    gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, blur);
-    vxl_uniform_i(r, store_prog, "u_blur", 0);
-    vxl_uniform_f(r, store_prog, "u_inv_max", max_mag.f > 0 ? 1.0f / max_mag.f : 0.0f);
-    r->gradient_max = max_mag.f; /* the shader scales back to value per voxel */
-    gl->BindImageTexture(0, r->gradient_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, store_internal[store]);
-    vxl_dispatch_bricks(r, store_prog, count, eg);
-    gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    for (uint32_t first = 0; first < count; first += chunk) {
+        const uint32_t n_chunk = count - first < chunk ? count - first : chunk;
+        /* pass 1: blur the chunk's bricks plus a 2-voxel border, through the data pool */
+        set_common(r, blur_prog, first + n_chunk, bslots); /* u_count: this chunk ends the list */
+        vxl_uniform_i(r, blur_prog, "u_blur_first", (int)first);
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_PAGE_UNIT);
+        gl->BindTexture(GL_TEXTURE_3D, r->page_tex);
+        gl->ActiveTexture(GL_TEXTURE0);
+        gl->BindTexture(GL_TEXTURE_3D, r->pool_tex);
+        vxl_uniform_i(r, blur_prog, "u_volume", 0);
+        vxl_uniform_i(r, blur_prog, "u_page", VXL_PAGE_UNIT);
+        gl->BindImageTexture(0, blur, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+        vxl_dispatch_bricks(r, blur_prog, first, n_chunk, eb);
+        gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        /* pass 2: the Sobel of the blurred chunk, divided by the maximum, into the gradient pool */
+        set_common(r, store_prog, first + n_chunk, gslots);
+        vxl_uniform_i(r, store_prog, "u_blur_first", (int)first);
+        gl->Uniform3i(gl->GetUniformLocation(store_prog, "u_blur_slots"), (GLint)bslots[0], (GLint)bslots[1],
+                      (GLint)bslots[2]);
+        gl->ActiveTexture(GL_TEXTURE0);
+        gl->BindTexture(GL_TEXTURE_3D, blur);
+        vxl_uniform_i(r, store_prog, "u_blur", 0);
+        vxl_uniform_f(r, store_prog, "u_inv_max", max_mag > 0 ? 1.0f / max_mag : 0.0f);
+        gl->BindImageTexture(0, r->gradient_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, store_internal[store]);
+        vxl_dispatch_bricks(r, store_prog, first, n_chunk, eg);
+        gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    }
+    r->gradient_max = max_mag; /* the shader scales back to value per voxel */
     gl->DeleteTextures(1, &blur);
     /* the gradient page table: slot origins + ghost, or zero gradient */
     float *entries = calloc(n * 4, sizeof *entries);

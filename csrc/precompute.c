@@ -34,7 +34,8 @@ int vxl_gradient_programs(vxl_renderer *r, int paged, int store, uint64_t need, 
                         "use an on-the-fly filter or the 8-bit store",
                         paged ? " of the bricked volume" : "", need / 1048576.0, r->budget / 1048576.0);
     int rc = vxl_program_get(r, paged ? VXL_PROG_PAGED_BLUR : VXL_PROG_GRAD_BLUR, 0, 0, &progs[0]);
-    if (!rc) rc = vxl_program_get(r, paged ? VXL_PROG_PAGED_GRAD_MAX : VXL_PROG_GRAD_MAX, 0, 0, &progs[1]);
+    progs[1] = 0; /* paged: the maximum comes from the CPU bricks (bspline_bricks.c) */
+    if (!rc && !paged) rc = vxl_program_get(r, VXL_PROG_GRAD_MAX, 0, 0, &progs[1]);
     if (!rc) rc = vxl_program_get(r, paged ? VXL_PROG_PAGED_GRAD_STORE : VXL_PROG_GRAD_STORE, 0, (uint32_t)store, &progs[2]);
     return rc;
 }

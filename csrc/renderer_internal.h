@@ -31,7 +31,7 @@
 #define VXL_PROG_BRICK_MINMAX 7
 #define VXL_PROG_CLASSIFY_VOLUME 8
 #define VXL_PROG_PAGED_BLUR 9
-#define VXL_PROG_PAGED_GRAD_MAX 10
+/* 10: was the bricked texture's max pass, now on the CPU */
 #define VXL_PROG_PAGED_GRAD_STORE 11
 #define VXL_PROG_DECODE_BRICKS 12 /* flags: the cache's bytes per voxel - 1 */
 
@@ -191,9 +191,10 @@ int vxl_paged_derived_current(const vxl_renderer *r, const uint8_t *covered, uin
  * the pool read back into *owned, which the caller frees. */
 int vxl_paged_brick_store(vxl_renderer *r, vxl_brick_store *s, uint8_t **owned);
 int vxl_pool_layout(const vxl_renderer *r, uint32_t n, uint32_t edge, uint32_t slots[3]);
-/* Runs prog over `count` bricks of edge e (one invocation per voxel, groups
- * of 4^3), in chunks the dispatch limit allows (sets u_first). */
-void vxl_dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t count, uint32_t e);
+/* Runs prog over bricks first .. first + count - 1 of edge e (one
+ * invocation per voxel, groups of 4^3), in chunks the dispatch limit allows
+ * (sets u_first). */
+void vxl_dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t first, uint32_t count, uint32_t e);
 #define VXL_GPAGE_UNIT 9 /* texture unit of the gradient pool's page table */
 #define VXL_CPAGE_UNIT 12 /* texture unit of the coefficient pool's page table */
 #define VXL_PAGE_UNIT 8 /* texture unit of the page table */

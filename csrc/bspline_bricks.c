@@ -128,7 +128,7 @@ float vxl_pages_gradient_max(const vxl_pages *pg, const vxl_brick_store *s, cons
     static const float smooth[3] = {0.25f, 0.5f, 0.25f}, deriv[3] = {-1.0f, 0.0f, 1.0f};
     float max2 = 0.0f;
     for (uint64_t i = 0; i < vxl_page_count(pg); i++) {
-        if (vxl_pages_flat_around(pg, i, 2)) continue; /* blur and Sobel reach 2 voxels: zero gradient */
+        if (vxl_pages_flat_around(pg, i, VXL_GRADIENT_SUPPORT)) continue; /* zero gradient */
         const uint64_t b[3] = {i % pg->grid[0], i / pg->grid[0] % pg->grid[1], i / ((uint64_t)pg->grid[0] * pg->grid[1])};
         int64_t lo[3];
         uint32_t m[3];

@@ -18,6 +18,13 @@
  * brick gives the whole line's coefficients. */
 #define VXL_BSPLINE_MARGIN 12
 
+/* The precomputed filter's blur and Sobel reach 2 voxels each way: a brick
+ * whose voxels within that hold one value has zero gradient, and its
+ * gradient texels read by a visible sample (trilinear, through the brick of
+ * the nearest texel) lie within 2 voxels of it. */
+#define VXL_GRADIENT_SUPPORT 2
+#define VXL_GRADIENT_READ_REACH 2
+
 /* Floats of scratch vxl_bspline_brick needs for bricks of pg. */
 size_t vxl_bspline_scratch_floats(const vxl_pages *pg);
 

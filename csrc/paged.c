@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bspline_bricks.h"
 #include "renderer_internal.h"
 
 static const GLenum internal_formats[] = {GL_R8, GL_R16, 0, GL_R32F};
@@ -297,9 +298,10 @@ int vxl_paged_prepare(vxl_renderer *r, const vxl_frame *f)
     r->visible_all = !f || f->gopacity == VXL_GOPACITY_ISO || r->storage == VXL_STORAGE_BRICKED;
     if (r->storage != VXL_STORAGE_SPARSE && (r->storage != VXL_STORAGE_COMPRESSED || pool_is_codes(r))) return VXL_OK;
     uint32_t reach = r->visible_reach;
-    /* precomputed gradients read within 2 voxels of a visible sample are
-     * derived from the values 2 voxels around them */
-    if (f && vxl_frame_filter(f) == VXL_FILTER_PRECOMPUTED) reach = (reach > 2 ? reach : 2) + 2;
+    /* precomputed gradients read near a visible sample are derived from the
+     * values around them */
+    if (f && vxl_frame_filter(f) == VXL_FILTER_PRECOMPUTED)
+        reach = (reach > VXL_GRADIENT_READ_REACH ? reach : VXL_GRADIENT_READ_REACH) + VXL_GRADIENT_SUPPORT;
     const int all = r->visible_all;
     const uint64_t n0 = vxl_page_count(&r->levels[0]);
     uint8_t *need = malloc(2 * n0), *scratch = need + n0;

@@ -5,8 +5,8 @@
  * within 2 of it holds one value (then its gradient is exactly zero: the
  * blur and the Sobel reach 2 voxels), and, sparse, only when a visible
  * sample can read it. The maximum that scales the stored gradients is the
- * whole volume's, as with one texture: from the pool when every brick is in
- * it, else from the CPU bricks (bspline_bricks.c). */
+ * whole volume's, as with one texture, found on the CPU from the bricks'
+ * values (bspline_bricks.c). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,11 +15,6 @@
 
 static const GLenum store_internal[] = {GL_RGBA8_SNORM, GL_RGBA16F, GL_RGBA32F};
 static const uint32_t store_bytes[] = {4, 8, 16};
-
-/* The blur and the Sobel reach 2 voxels; the trilinear read of a gradient
- * texel one, translated through the brick of the nearest texel: 2. */
-#define GRADIENT_SUPPORT 2
-#define GRADIENT_READ_REACH 2
 
 /* Bricks blurred at once: their blurred copies (R32F, edge P+4) within 64
  * MiB, or a sixteenth of the budget when that is less. */
@@ -34,7 +29,7 @@ static uint32_t blur_chunk(const vxl_renderer *r, uint32_t eb, uint32_t count)
 uint64_t vxl_paged_gradient_bytes(const vxl_renderer *r, uint32_t level, int store, uint8_t *want, uint32_t *count_out)
 {
     const vxl_pages *pg = &r->levels[level];
-    const uint32_t count = vxl_paged_derived_want(r, level, GRADIENT_SUPPORT, GRADIENT_READ_REACH, want);
+    const uint32_t count = vxl_paged_derived_want(r, level, VXL_GRADIENT_SUPPORT, VXL_GRADIENT_READ_REACH, want);
     const uint64_t eb = pg->brick + 4, eg = pg->brick + 2;
     uint32_t bslots[3], gslots[3];
     if (count_out) *count_out = count;

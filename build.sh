@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# build.sh - the only set-up step. On a fresh Debian 12 machine:
+# build.sh - the only set-up step. On a fresh Debian 12 or 13 machine:
 #   ./build.sh demo    install what is missing, build, render the demo to demo.png
 #   ./build.sh test    install, build (normal + ASan/UBSan), run every test
 #   ./build.sh         install and build only
@@ -8,27 +8,95 @@ cd "$(dirname "$0")"
 ROOT=$(pwd)
 
 # Debian packages the project needs: compilers, GL headers (we never link GL),
-# OSMesa and Mesa's EGL for the offscreen context, OpenImageIO for image files,
+# Mesa's EGL and OSMesa for the offscreen context, OpenImageIO for image files,
 # dcmtk for DICOM series,
 # the demo brain (mricron-data), Blender and Xvfb for the add-on and its tests,
 # numpy and pytest for the Python tests, clang with its sanitizer/libFuzzer
-# runtime for the loader fuzz targets (tests/fuzz/), pyopenvdb to write test .vdb files.
-PACKAGES=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
-          libgl1-mesa-dri libosmesa6 libosmesa6-dev libopenimageio-dev mricron-data blender
-          xvfb xauth python3 python3-numpy python3-pytest zip unzip
-          clang libclang-rt-14-dev python3-matplotlib python3-vtk9 python3-openvdb libdcmtk-dev)
+# runtime for the loader fuzz targets (tests/fuzz/) and llvm for llvm-symbolizer
+# (sanitizer stacks name csrc/ files: tests/fuzz/run.sh reads them), pyopenvdb
+# to write test .vdb files, VTK and matplotlib for the benchmark, and Python
+# 3.11's venv for the bpy wheels (./build.sh bpy; Debian 13 has no Python 3.11,
+# so there a pyenv 3.11 is used).
+# Names differ between Debian releases (12 and 13 are supported), so each
+# entry is one need: alternatives separated by '|', of which the first
+# installed, else the first the apt lists offer, is used. '?' marks a need a
+# release may not offer at all: OSMesa left Mesa in 25.1, and without it the
+# library (and every test) renders through Mesa's surfaceless EGL. "clang-rt"
+# stands for the sanitizer/libFuzzer runtime of clang's major version.
+NEEDS=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
+       libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev mricron-data blender
+       xvfb xauth python3 python3-numpy python3-pytest zip unzip clang clang-rt llvm
+       python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv")
+
+# (output captured, not piped into grep -q: under pipefail an early grep exit
+# would fail the pipeline)
+pkg_installed() { [[ $(dpkg-query -W -f='${Status}' "$1" 2>/dev/null) == "install ok installed" ]]; }
+# offered: the apt lists hold an installable version (virtual names have none)
+pkg_offered() { [[ $(apt-cache policy "$1" 2>/dev/null) == *"Candidate: "[!\(]* ]]; }
+apt_lists_present() { compgen -G '/var/lib/apt/lists/*_Packages*' >/dev/null; }
+
+# The '|'-separated alternatives of one need (empty: not known yet).
+need_alternatives() {
+    local need=${1#\?} major
+    if [ "$need" != clang-rt ]; then echo "$need"; return 0; fi
+    # the installed clang's major version, else the one apt would install
+    # (clang depends on clang-N)
+    major=$(dpkg-query -W -f='${Depends}' clang 2>/dev/null | grep -oE 'clang-[0-9]+' | sed -n '1s/clang-//p')
+    [ -n "$major" ] || major=$(apt-cache depends clang 2>/dev/null | grep -oE 'clang-[0-9]+' | sed -n '1s/clang-//p')
+    # LLVM 14 on: libclang-rt-N-dev; before, the runtime was in libclang-common-N-dev
+    if [ -n "$major" ]; then echo "libclang-rt-$major-dev|libclang-common-$major-dev"; fi
+}
+
+# Resolves every need into CHOSEN (what is used), MISSING (to install),
+# ABSENT (optional needs this release does not offer) and UNRESOLVED (needs
+# the apt lists, as they are, cannot satisfy). $1=1: the lists are fresh.
+resolve_needs() {
+    local fresh=$1 need alts a pick
+    local -a alt
+    CHOSEN=() MISSING=() ABSENT=() UNRESOLVED=()
+    for need in "${NEEDS[@]}"; do
+        alts=$(need_alternatives "$need")
+        IFS='|' read -r -a alt <<<"$alts"
+        pick=""
+        for a in "${alt[@]}"; do pkg_installed "$a" && { pick=$a; break; }; done
+        if [ -n "$pick" ]; then CHOSEN+=("$pick"); continue; fi
+        for a in "${alt[@]}"; do pkg_offered "$a" && { pick=$a; break; }; done
+        if [ -n "$pick" ]; then
+            CHOSEN+=("$pick"); MISSING+=("$pick")
+        elif [[ $need == \?* ]] && { [ "$fresh" = 1 ] || apt_lists_present; }; then
+            ABSENT+=("${need#\?}")
+        else
+            UNRESOLVED+=("${alts:-$need}")
+        fi
+    done
+}
 
 install_deps() {
-    local missing=()
-    for p in "${PACKAGES[@]}"; do
-        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+    resolve_needs 0
+    if [ ${#MISSING[@]} -gt 0 ] || [ ${#UNRESOLVED[@]} -gt 0 ]; then
+        local sudo=""
+        [ "$(id -u)" -ne 0 ] && sudo="sudo"
+        $sudo apt-get update -qq
+        resolve_needs 1
+        if [ ${#UNRESOLVED[@]} -gt 0 ]; then
+            echo "build.sh: this release offers none of: ${UNRESOLVED[*]}" >&2
+            exit 1
+        fi
+        if [ ${#MISSING[@]} -gt 0 ]; then
+            echo "build.sh: installing ${MISSING[*]}"
+            DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${MISSING[@]}" >/dev/null
+        fi
+    fi
+    # what was chosen where releases differ
+    local c rt="" vtk="" osmesa="none offered by this release: rendering uses EGL surfaceless"
+    for c in "${CHOSEN[@]}"; do
+        case $c in
+            libclang-rt-*|libclang-common-*) rt=$c ;;
+            python3-vtk*) vtk=$c ;;
+            libosmesa*) osmesa=$c ;;
+        esac
     done
-    [ ${#missing[@]} -eq 0 ] && return 0
-    echo "build.sh: installing ${missing[*]}"
-    local sudo=""
-    [ "$(id -u)" -ne 0 ] && sudo="sudo"
-    $sudo apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+    echo "build.sh: Debian packages: clang runtime $rt, VTK $vtk, OSMesa $osmesa"
 }
 
 build() {
@@ -38,6 +106,87 @@ build() {
 
 build_asan() {
     make -s -j"$(nproc)" BUILD=build-asan SAN=1
+}
+
+# Blender as a Python module (pip's bpy), one virtual environment per tested
+# release under build/bpy/<major.minor>/: the current LTS (4.5) and the newest
+# 5.x whose wheel installs on this Python. Both need Python 3.11. A venv that
+# already holds the right bpy is kept (no network); BPY_REFRESH=1 looks again
+# for a newer 5.x.
+find_python311() {
+    local c
+    for c in /usr/bin/python3.11 "$(command -v python3.11 || true)" "$HOME"/.pyenv/versions/3.11*/bin/python3.11; do
+        if [ -n "$c" ] && [ -x "$c" ] && "$c" -c 'import sys, venv, ensurepip; sys.exit(sys.version_info[:2] != (3, 11))' 2>/dev/null; then
+            echo "$c"; return 0
+        fi
+    done
+    return 1
+}
+
+bpy_version_in() {  # venv dir -> installed bpy version, or nothing
+    [ -x "$1/bin/python" ] || return 0
+    "$1/bin/python" -c 'import importlib.metadata as m; print(m.version("bpy"))' 2>/dev/null || true
+}
+
+bpy_venv_install() {  # python3.11, venv dir, exact bpy version
+    local py=$1 dir=$2 version=$3
+    rm -rf "$dir"
+    "$py" -m venv "$dir" || return 1
+    "$dir/bin/python" -m pip install -q --disable-pip-version-check "bpy==$version" numpy pytest \
+        || { rm -rf "$dir"; return 1; }
+    "$dir/bin/python" -c 'import bpy' || { rm -rf "$dir"; return 1; }
+    echo "build.sh: build/bpy/${version%.*}/ has bpy $version"
+}
+
+bpy_venv_extras() {  # venv dir: what the Blender test scripts import besides bpy
+    "$1/bin/python" -c 'import numpy, pytest' 2>/dev/null ||
+        "$1/bin/python" -m pip install -q --disable-pip-version-check numpy pytest
+}
+
+bpy_available() {  # python3.11, major -> versions on the index for this Python, newest first
+    "$1" -m pip index versions bpy --disable-pip-version-check 2>/dev/null \
+        | sed -n 's/^Available versions: //p' | tr ',' '\n' | tr -d ' ' | grep -E "^$2\.[0-9]+\.[0-9]+$" || true
+}
+
+bpy_venvs() {
+    local py
+    if ! py=$(find_python311); then
+        echo "build.sh: bpy 4.5 and 5.x need Python 3.11 with its venv module; none found" \
+             "(looked for /usr/bin/python3.11, python3.11 on PATH, ~/.pyenv/versions/3.11*)." \
+             "Install python3.11 and python3.11-venv, or pyenv install 3.11." >&2
+        return 1
+    fi
+    mkdir -p build/bpy
+    local have v dir
+    # The LTS: the newest 4.5.x.
+    have=$(bpy_version_in build/bpy/4.5)
+    if [[ "$have" != 4.5.* ]]; then
+        for v in $(bpy_available "$py" 4 | grep -E '^4\.5\.'); do
+            bpy_venv_install "$py" build/bpy/4.5 "$v" && break
+            echo "build.sh: bpy $v did not install here; trying an older 4.5.x" >&2
+        done
+        [ -d build/bpy/4.5 ] || { echo "build.sh: no bpy 4.5.x installs with $py (is the package index reachable?)" >&2; return 1; }
+    fi
+    bpy_venv_extras build/bpy/4.5 || return 1
+    # The newest 5.x whose wheel installs; its venv is named by what installed.
+    for dir in build/bpy/5.*; do
+        [ -d "$dir" ] || continue
+        have=$(bpy_version_in "$dir")
+        if [[ "$have" == "${dir#build/bpy/}".* ]] && [ -z "${BPY_REFRESH:-}" ]; then
+            bpy_venv_extras "$dir"; return
+        fi
+    done
+    for v in $(bpy_available "$py" 5); do
+        dir=build/bpy/${v%.*}
+        if [ "$(bpy_version_in "$dir")" = "$v" ]; then bpy_venv_extras "$dir"; return; fi
+        if bpy_venv_install "$py" "$dir" "$v"; then
+            for old in build/bpy/5.*; do [ "$old" = "$dir" ] || rm -rf "$old"; done
+            return 0
+        fi
+        echo "build.sh: bpy $v did not install here; trying an older 5.x" >&2
+    done
+    echo "build.sh: no bpy 5.x installs with $py (is the package index reachable?)" >&2
+    return 1
 }
 
 # Runs each command, echoes its summary, and totals the pass/fail counts.
@@ -79,7 +228,7 @@ run_c_tests() {
         out=$("$t" 2>&1)
         local rc=$?
         set -e
-        echo "$out" | grep -E 'FAIL|CHECK failed|REQUIRE failed|ERROR|runtime error' || true
+        echo "$out" | grep -E 'FAIL|CHECK failed|REQUIRE failed|ERROR|runtime error|^software backend:' || true
         local line
         line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1)
         echo "$(basename "$t"): ${line:-crashed (exit $rc)}"
@@ -107,6 +256,8 @@ case "$cmd" in
         echo "build.sh: wrote $ROOT/demo.png" ;;
     test)
         install_deps; build; build_asan
+        # Without them the Blender suite reports the missing versions as failures.
+        bpy_venvs || echo "build.sh: the bpy venvs are incomplete" >&2
         run_suite "C tests" run_c_tests build
         # Mesa and LLVM keep allocations until exit: their leaks are suppressed
         # by library name (tests/lsan.supp); ours are not.
@@ -150,8 +301,10 @@ case "$cmd" in
             --out bench/results.csv --steps "$steps"
         if [ "$mode" = --quick ]; then dest=bench/out/benchmark; else dest=docs/benchmark; fi
         /usr/bin/python3 bench/plot.py bench/results.csv --png "$dest.png" --md "$dest.md" --command "./build.sh bench $mode" ;;
+    bpy)
+        bpy_venvs ;;
     clean)
         make clean ;;
     *)
-        echo "usage: ./build.sh [build|demo|test|fuzz [SECONDS [TARGET...]]|stress|bench [--quick]|clean]" >&2; exit 2 ;;
+        echo "usage: ./build.sh [build|demo|test|bpy|fuzz [SECONDS [TARGET...]]|stress|bench [--quick]|clean]" >&2; exit 2 ;;
 esac

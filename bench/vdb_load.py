@@ -1,7 +1,7 @@
 """Load time of an OpenVDB grid against the same floats as raw NIfTI, through
 `build/voxlight info` (load + value range, no GL): what the VDB path adds on
 top of the shared volume build. The library reads .vdb files in a helper
-process (csrc/vdb_spawn.c); the "helper alone" row is that process's
+process (csrc/reader_spawn.c, `voxlight-read-oiio`); the "helper alone" row is that process's
 in-process read with its output thrown away, and VOXLIGHT_BASELINE_CLI names
 another `voxlight` build to time too (e.g. one from before the helper, which
 read in-process). Usage: /usr/bin/python3 bench/vdb_load.py [N]"""
@@ -26,8 +26,8 @@ files = {"vdb": write_vdb(os.path.join(d, "ball.vdb"), [{"name": "density", "arr
          "nifti": str(write_nifti(os.path.join(d, "ball.nii"), ball, np.eye(4)))}
 cli = os.path.join(ROOT, "build", "voxlight")
 cases = [("vdb", [cli, "info", files["vdb"]]), ("nifti", [cli, "info", files["nifti"]]),
-         ("vdb, helper alone", [os.path.join(ROOT, "build", "voxlight-vdb-read"), files["vdb"], "65536",
-                                str(1 << 40)])]
+         ("vdb, helper alone", [os.path.join(ROOT, "build", "voxlight-read-oiio"), "vdb", files["vdb"],
+                                "65536", str(1 << 40), "0", "0", "0", "0", ""])]
 if os.environ.get("VOXLIGHT_BASELINE_CLI"):
     cases.append(("vdb, baseline CLI", [os.environ["VOXLIGHT_BASELINE_CLI"], "info", files["vdb"]]))
 for name, cmd in cases:

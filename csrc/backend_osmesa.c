@@ -1,11 +1,27 @@
 /* backend_osmesa.c - Mesa's OSMesa (llvmpipe), loaded with dlopen so that the
  * library works where OSMesa is absent and never drags a GL into the host. */
 #include <dlfcn.h>
-#include <GL/osmesa.h>
+#include <GL/glcorearb.h>
 #include <string.h>
 
 #include "context.h"
 #include "voxlight.h"
+
+/* The few declarations of Mesa's GL/osmesa.h this file uses, written out so
+ * that the build needs no OSMesa headers: Mesa 25.1 removed OSMesa and
+ * releases built on it (Debian 13 may be one) ship no libosmesa6-dev. The
+ * values are OSMesa's stable ABI (osmesa.h, unchanged since Mesa 11.2). */
+typedef struct osmesa_context *OSMesaContext;
+typedef void (*OSMESAproc)(void);
+#define OSMESA_RGBA GL_RGBA
+#define OSMESA_FORMAT 0x22
+#define OSMESA_DEPTH_BITS 0x30
+#define OSMESA_STENCIL_BITS 0x31
+#define OSMESA_ACCUM_BITS 0x32
+#define OSMESA_PROFILE 0x33
+#define OSMESA_CORE_PROFILE 0x34
+#define OSMESA_CONTEXT_MAJOR_VERSION 0x36
+#define OSMESA_CONTEXT_MINOR_VERSION 0x37
 
 typedef OSMesaContext (*create_fn)(const int *, OSMesaContext);
 typedef GLboolean (*make_current_fn)(OSMesaContext, void *, GLenum, GLsizei, GLsizei);

@@ -49,6 +49,9 @@ uint32_t vxl_bricks_gradient_apron(const vxl_frame *f)
      * differences; precomputed: stored relative to the volume's largest
      * gradient. Taps at +-d reach floor(p -+ d) .. +1: ceil(d) + 1 voxels. */
     if (f->filter == VXL_FILTER_CUBIC || f->filter == VXL_FILTER_PRECOMPUTED) return 0;
+    /* approximating B-spline: its derivative is a convex blend of adjacent
+     * differences over texels floor(p) - 1 .. floor(p) + 2 */
+    if (f->filter == VXL_FILTER_CUBIC_SMOOTH) return 2;
     return (uint32_t)ceil(f->sample_distance) + 1;
 }
 

@@ -23,11 +23,11 @@ static const char usage[] =
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
     "--voxel-size (mm) is for inputs without geometry (TIFF/PNG stacks); one value sets all three\n"
-    "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic; presets: auto gray bone hot mri ct\n"
+    "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic cubic-smooth; presets: auto gray bone hot mri ct\n"
     "storage: auto = one texture when it fits the texture limit and --memory-budget, else bricked;\n"
     "         sparse keeps only the bricks the transfer function can show; compressed holds every brick\n"
     "         as a palette of <= 256 values + 8-bit codes and decodes the visible ones into a cache\n"
-    "         (compressed storage: the five on-the-fly filters; bricked and sparse: every filter and mode)\n"
+    "         (compressed storage: every filter but precomputed and cubic; bricked and sparse: every filter and mode)\n"
     "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of marschner-lobb sphere ramp\n"
     "         noisy-blob sparse-balls dense-balls large-sparse (default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
 
@@ -242,7 +242,7 @@ static int parse_render(int argc, char **argv, render_args *a)
             p->width = w; p->height = h;
         } else if (!strcmp(o, "--filter")) {
             NEED_VALUE();
-            if (vxl_filter_from_name(val, &p->filter)) return die("unknown filter '%s' (central, forward3, sobel8, sobel14, sobel26, precomputed, cubic)", val);
+            if (vxl_filter_from_name(val, &p->filter)) return die("unknown filter '%s' (central, forward3, sobel8, sobel14, sobel26, precomputed, cubic, cubic-smooth)", val);
         } else if (!strcmp(o, "--sample-distance")) {
             NEED_VALUE();
             if (!parse_float(val, &p->sample_distance) || p->sample_distance <= 0) return die("bad --sample-distance '%s'", val);

@@ -27,6 +27,10 @@
 // keys, they are time points (group_time_points); vxl_load_options.frame
 // picks one.
 //
+// Only the helper process voxlight-read-dicom runs this (helper_dicom.c,
+// reader_stream.h): libvoxlight.so links no C++. Whether a path is DICOM
+// at all is decided in the library, in C (dicom_detect.c).
+//
 // Not decoded: compressed (encapsulated) transfer syntaxes, multi-frame
 // images, colour, BitsAllocated other than 8/16. Each is a clear error naming
 // the file.
@@ -50,6 +54,7 @@
 #include <vector>
 
 extern "C" {
+#include "helper_main.h"
 #include "loader_util.h"
 }
 
@@ -122,12 +127,6 @@ bool has_dicm_magic(const std::string &path)
     bool ok = fread(b, 1, sizeof b, f) == sizeof b && memcmp(b + 128, "DICM", 4) == 0;
     fclose(f);
     return ok;
-}
-
-bool is_regular(const std::string &p)
-{
-    struct stat st;
-    return stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
 // Regular files under dir (recursively to kMaxDepth when recurse), skipping
@@ -229,7 +228,11 @@ Parse read_slice(const std::string &path, Slice &s, std::string &why)
     }
     DcmXfer x(ds->getOriginalXfer());
     s.xfer = x.getXferName();
+#if PACKAGE_VERSION_NUMBER >= 369 // dcmtk 3.6.9 (Debian 13) deprecates isEncapsulated()
+    s.encapsulated = x.usesEncapsulatedFormat();
+#else
     s.encapsulated = x.isEncapsulated();
+#endif
     return Parse::ok;
 }
 
@@ -586,31 +589,7 @@ void copy_field(char *dst, size_t n, const std::string &s)
 
 } // namespace
 
-extern "C" int vxl_dicom_path_is_dicom(const char *path, int is_dir)
-{
-    try {
-        if (!is_dir) return has_dicm_magic(path) || is_dicomdir_name(path);
-        std::string d(path);
-        if (is_regular(d + "/DICOMDIR")) return 1;
-        // the first few files decide: a slice folder is DICOM all through
-        DIR *dir = opendir(path);
-        if (!dir) return 0;
-        int seen = 0, found = 0;
-        while (struct dirent *ent = readdir(dir)) {
-            if (ent->d_name[0] == '.' || seen >= 16) continue;
-            std::string p = d + "/" + ent->d_name;
-            if (!is_regular(p)) continue;
-            seen++;
-            if (has_dicm_magic(p)) { found = 1; break; }
-        }
-        closedir(dir);
-        return found;
-    } catch (...) {
-        return 0;
-    }
-}
-
-extern "C" int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+extern "C" int vxl_dicom_read(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
     *out = nullptr;
@@ -631,32 +610,24 @@ extern "C" int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl
     }
 }
 
-extern "C" VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint32_t max, uint32_t *count)
+extern "C" int vxl_dicom_read_series(const char *path, vxl_dicom_series **out, uint32_t *count, vxl_err *e)
 {
-    if (!count || (max && !out))
-        return vxl_fail(nullptr, VXL_ERR_INVALID_ARGUMENT, "count is NULL, or out is NULL with max > 0");
+    if (!out || !count) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out or count is NULL");
+    *out = nullptr;
     *count = 0;
-    if (!path || !*path) return vxl_fail(nullptr, VXL_ERR_INVALID_ARGUMENT, "path is empty");
+    if (!path || !*path) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "path is empty");
     try {
-        // Cheap refusal first, so callers may ask about any input (the CLI's
-        // info does) without a NIfTI's folder being parsed file by file.
-        struct stat st;
-        bool dir = stat(path, &st) == 0 && S_ISDIR(st.st_mode);
-        std::string name(path);
-        bool dcm_ext = name.size() > 4 && strcasecmp(name.c_str() + name.size() - 4, ".dcm") == 0;
-        if (!vxl_dicom_path_is_dicom(path, dir) && !dcm_ext)
-            return vxl_fail(nullptr, VXL_ERR_FORMAT, "'%s' is not DICOM (no DICOMDIR, no \"DICM\" file)", path);
         Scan sc;
-        int rc = scan(path, sc, nullptr);
+        int rc = scan(path, sc, e);
         if (rc) return rc;
-        const size_t stride = max && out->struct_size ? out->struct_size : sizeof(vxl_dicom_series);
-        const size_t have = std::min(stride, sizeof(vxl_dicom_series));
-        for (size_t i = 0; i < sc.series.size() && i < max; i++) {
+        vxl_dicom_series *list =
+            static_cast<vxl_dicom_series *>(calloc(sc.series.size() ? sc.series.size() : 1, sizeof *list));
+        if (!list) return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory listing DICOM series", path);
+        for (size_t i = 0; i < sc.series.size(); i++) {
             const Series &s = sc.series[i];
             const Slice &f = s.slices[0];
-            vxl_dicom_series d;
-            memset(&d, 0, sizeof d);
-            d.struct_size = uint32_t(have);
+            vxl_dicom_series &d = list[i];
+            d.struct_size = uint32_t(sizeof d);
             d.slice_count = uint32_t(s.slices.size());
             d.dims[0] = f.cols;
             d.dims[1] = f.rows;
@@ -668,13 +639,13 @@ extern "C" VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series 
             copy_field(d.modality, sizeof d.modality, f.modality);
             copy_field(d.description, sizeof d.description, f.description);
             copy_field(d.problem, sizeof d.problem, s.problem);
-            memcpy(reinterpret_cast<char *>(out) + i * stride, &d, have);
         }
+        *out = list;
         *count = uint32_t(sc.series.size());
         return VXL_OK;
     } catch (const std::bad_alloc &) {
-        return vxl_fail(nullptr, VXL_ERR_NO_MEMORY, "'%s': out of memory listing DICOM series", path);
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory listing DICOM series", path);
     } catch (const std::exception &x) {
-        return vxl_fail(nullptr, VXL_ERR_FORMAT, "'%s': %s", path, x.what());
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %s", path, x.what());
     }
 }

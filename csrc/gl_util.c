@@ -9,7 +9,7 @@
 static const char *const filter_defines[VXL_FILTER_COUNT] = {
     "#define FILTER_CENTRAL 1\n", "#define FILTER_FORWARD3 1\n", "#define FILTER_SOBEL8 1\n",
     "#define FILTER_SOBEL14 1\n", "#define FILTER_SOBEL26 1\n", "#define FILTER_PRECOMPUTED 1\n",
-    "#define FILTER_CUBIC 1\n"};
+    "#define FILTER_CUBIC 1\n", "#define FILTER_CUBIC_SMOOTH 1\n"};
 
 /* flags bits for RAYCAST: 1 shading, 2 reuse gradients, bits 2-3 the
  * classify mode, bits 4-5 the gradient-opacity mode, bit 6 (also PROBE)

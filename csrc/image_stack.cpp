@@ -15,7 +15,8 @@
 // Hostile input: the first image's header sizes pass the memory budget
 // before any voxel is allocated, every other slice must match it exactly
 // (size, channels, type), and OpenImageIO's messages are passed on with the
-// file name. The library stays C11; this file is only the extern "C" glue.
+// file name. Only the helper process voxlight-read-oiio runs this
+// (helper_oiio.c, reader_stream.h): libvoxlight.so links no C++.
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -31,6 +32,7 @@
 #include <vector>
 
 extern "C" {
+#include "helper_main.h"
 #include "loader_util.h"
 }
 
@@ -143,6 +145,7 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path, vxl_err *e
     auto in = OIIO::ImageInput::create(path);
     if (!in) {
         std::string msg = OIIO::geterror();
+        vxl_one_line(&msg[0]);
         *rc = vxl_fail(e, VXL_ERR_FORMAT, "'%s': no image reader for this file: %s", path.c_str(), msg.c_str());
         return nullptr;
     }
@@ -151,6 +154,7 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path, vxl_err *e
     config.attribute("oiio:UnassociatedAlpha", 1); // keep grey values of grey+alpha images as stored
     if (!in->open(path, spec, config)) {
         std::string msg = in->geterror();
+        vxl_one_line(&msg[0]);
         *rc = vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read image: %s", path.c_str(),
                        msg.empty() ? "unknown error" : msg.c_str());
         return nullptr;
@@ -303,7 +307,7 @@ std::string slice_name(const Slice &s)
 
 } // namespace
 
-extern "C" int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
     *out = nullptr;
@@ -336,6 +340,7 @@ extern "C" int vxl_image_stack_load(const char *path, const vxl_load_options *op
             }
             if (!in->seek_subimage(s.subimage, 0)) {
                 std::string msg = in->geterror();
+                vxl_one_line(&msg[0]);
                 return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read page %d: %s", s.path.c_str(), s.subimage + 1,
                                 msg.c_str());
             }
@@ -376,6 +381,7 @@ extern "C" int vxl_image_stack_load(const char *path, const vxl_load_options *op
                                 spec.format.c_str(), first.c_str());
             if (!in->read_image(s.subimage, 0, 0, nread, read_as, tmp.data())) {
                 std::string msg = in->geterror();
+                vxl_one_line(&msg[0]);
                 return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read pixels: %s", name.c_str(),
                                 msg.empty() ? "unknown error" : msg.c_str());
             }

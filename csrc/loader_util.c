@@ -354,3 +354,20 @@ const char *vxl_load_series(const vxl_load_options *opt)
 {
     return options_cover(opt, offsetof(vxl_load_options, series) + sizeof opt->series) ? opt->series : NULL;
 }
+
+char *vxl_one_line(char *s)
+{
+    char *w = s;
+    int space = 0;
+    for (const char *r = s; *r; r++) {
+        if (*r == ' ' || *r == '\t' || *r == '\n' || *r == '\r' || *r == '\v' || *r == '\f') {
+            space = w != s;
+        } else {
+            if (space) *w++ = ' ';
+            space = 0;
+            *w++ = *r;
+        }
+    }
+    *w = '\0';
+    return s;
+}

@@ -77,4 +77,11 @@ void vxl_load_voxel_size(const vxl_load_options *opt, double out[3]);
 uint32_t vxl_load_frame(const vxl_load_options *opt);
 const char *vxl_load_series(const vxl_load_options *opt);
 
+/* Folds every run of white space in a third-party message (OpenImageIO,
+ * OpenVDB) into one space, in place, and trims both ends: our errors are one
+ * line, and a message padded with hundreds of spaces would otherwise fill
+ * the error buffer before its meaning (OpenVDB 11's "KeyError: Map   ...
+ * is not registered"). Returns s. */
+char *vxl_one_line(char *s);
+
 #endif

@@ -10,7 +10,8 @@
 #include "voxlight.h"
 
 static const char *const filter_names[VXL_FILTER_COUNT] = {"central", "forward3", "sobel8",
-                                                           "sobel14", "sobel26", "precomputed", "cubic"};
+                                                           "sobel14", "sobel26", "precomputed", "cubic",
+                                                           "cubic-smooth"};
 static const char *const preset_names[VXL_PRESET_COUNT] = {"auto", "gray", "bone", "hot", "mri", "ct"};
 
 static double smoothstep(double a, double b, double x)

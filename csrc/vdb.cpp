@@ -15,8 +15,8 @@
 // writes scene units), not converted to mm. OpenVDB puts voxel centres at
 // integer index coordinates, as we do.
 //
-// This is the in-process read; only the helper process runs it
-// (vdb_stream.h, vdb_spawn.c), the library never does.
+// This is the in-process read; only the helper process voxlight-read-oiio
+// runs it (helper_oiio.c, reader_stream.h), the library never does.
 //
 // Hostile input: the box comes from the header and passes the memory budget
 // before any voxel is allocated; the voxels are read one tile at a time and
@@ -38,11 +38,19 @@
 #include <vector>
 
 extern "C" {
+#include "helper_main.h"
 #include "loader_util.h"
-#include "vdb_stream.h"
 }
 
 namespace {
+
+// One dense scalar grid as read by OpenImageIO's OpenVDB reader.
+struct vxl_vdb_grid {
+    uint32_t dims[3];
+    double spacing[3];
+    double affine[16];
+    float *voxels; // malloc'd dims product floats; free() it
+};
 
 std::string grid_name(const OIIO::ImageSpec &spec)
 {
@@ -72,6 +80,7 @@ int select_grid(OIIO::ImageInput &in, const char *path, vxl_err *e)
                         names.empty() ? "none" : names.c_str());
     if (!in.seek_subimage(pick, 0)) {
         std::string msg = in.geterror();
+        vxl_one_line(&msg[0]);
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot open grid %d: %s", path, pick, msg.c_str());
     }
     return VXL_OK;
@@ -143,6 +152,7 @@ int read_box(OIIO::ImageInput &in, const char *path, const long long lo[3], cons
                 if (!in.read_tiles(sub, 0, int(tx), int(te[0]), int(ty), int(te[1]), int(tz), int(te[2]), 0, 1,
                                    OIIO::TypeFloat, buf.data(), fs, fs * tw, fs * tw * th)) {
                     std::string msg = in.geterror();
+                    vxl_one_line(&msg[0]);
                     return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read the tile at %lld,%lld,%lld: %s", path, tx,
                                     ty, tz, msg.empty() ? "unknown error" : msg.c_str());
                 }
@@ -176,6 +186,7 @@ int read_dense(const char *path, const vxl_load_options *opt, vxl_vdb_grid *g, v
     OIIO::ImageSpec spec;
     if (!in->open(path, spec)) {
         std::string msg = in->geterror();
+        vxl_one_line(&msg[0]);
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read OpenVDB file: %s", path,
                         msg.empty() ? "unknown error" : msg.c_str());
     }
@@ -210,20 +221,42 @@ int read_dense(const char *path, const vxl_load_options *opt, vxl_vdb_grid *g, v
     return VXL_OK;
 }
 
+// The grid, read densely, as a volume; the affine is the file's own (an
+// sform).
+int read_volume(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+{
+    vxl_vdb_grid g;
+    std::memset(&g, 0, sizeof g);
+    int rc = read_dense(path, opt, &g, e);
+    if (rc) return rc;
+    std::unique_ptr<float, decltype(&std::free)> voxels(g.voxels, &std::free);
+    vxl_err inner = {};
+    rc = vxl_volume_build(voxels.get(), VXL_DTYPE_F32, g.dims, g.spacing, g.affine, 0.0, 0.0, opt, out, &inner);
+    if (rc) return vxl_fail_in(e, path, &inner);
+    (*out)->affine_source = 2;
+    return VXL_OK;
+}
+
 } // namespace
 
-extern "C" int vxl_vdb_read_dense(const char *path, const vxl_load_options *opt, vxl_vdb_grid *out, vxl_err *e)
+extern "C" int vxl_vdb_read(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
-    std::memset(out, 0, sizeof *out);
+    *out = nullptr;
     if (!path || !*path) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "path is empty");
     try {
-        return read_dense(path, opt, out, e);
+        return read_volume(path, opt, out, e);
     } catch (const std::bad_alloc &) {
+        vxl_volume_destroy(*out);
+        *out = nullptr;
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory", path);
     } catch (const std::exception &x) {
+        vxl_volume_destroy(*out);
+        *out = nullptr;
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %s", path, x.what());
     } catch (...) {
+        vxl_volume_destroy(*out);
+        *out = nullptr;
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': unexpected error while reading the OpenVDB file", path);
     }
 }

@@ -8,8 +8,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
 
 uint32_t vxl_dtype_size(uint32_t dtype)
 {
@@ -175,57 +173,6 @@ int vxl_volume_create(const vxl_volume_desc *d, const vxl_load_options *opt, vxl
     if (!d) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "volume description is NULL");
     return vxl_volume_build(d->data, d->dtype, d->dims, d->spacing, d->has_affine ? d->affine : NULL,
                             d->scl_slope, d->scl_inter, opt, out, NULL);
-}
-
-static int has_suffix(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), m = strlen(suffix);
-    return n >= m && strcasecmp(s + n - m, suffix) == 0;
-}
-
-/* Loader dispatch: a folder is an image stack; then the extension; then,
- * for unknown extensions, the first bytes. NIfTI is the default, so its
- * reader names the problem for anything unrecognised. */
-typedef int (*vxl_loader_fn)(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
-
-static vxl_loader_fn vxl_loader_for(const char *path)
-{
-    struct stat st;
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-        return vxl_dicom_path_is_dicom(path, 1) ? vxl_dicom_load : vxl_image_stack_load;
-    static const struct { const char *ext; vxl_loader_fn fn; } by_ext[] = {
-        {".nii", vxl_nifti_load}, {".nii.gz", vxl_nifti_load}, {".hdr", vxl_nifti_load},
-        {".img", vxl_nifti_load}, {".hdr.gz", vxl_nifti_load}, {".img.gz", vxl_nifti_load},
-        {".nrrd", vxl_nrrd_load}, {".nhdr", vxl_nrrd_load},
-        {".mha", vxl_metaimage_load}, {".mhd", vxl_metaimage_load},
-        {".tif", vxl_image_stack_load}, {".tiff", vxl_image_stack_load}, {".png", vxl_image_stack_load},
-        {".vdb", vxl_vdb_load},
-        {".dcm", vxl_dicom_load}, {".dicom", vxl_dicom_load}, {"DICOMDIR", vxl_dicom_load},
-    };
-    for (size_t i = 0; i < sizeof by_ext / sizeof by_ext[0]; i++)
-        if (has_suffix(path, by_ext[i].ext)) return by_ext[i].fn;
-    unsigned char m[16] = {0};
-    FILE *f = fopen(path, "rb");
-    if (f) {
-        size_t n = fread(m, 1, sizeof m, f);
-        fclose(f);
-        if (n >= 4 && !memcmp(m, "NRRD", 4)) return vxl_nrrd_load;
-        if (n >= 4 && !memcmp(m, " BDV", 4)) return vxl_vdb_load; /* OpenVDB magic 0x56444220, little-endian */
-        if (n >= 8 && !memcmp(m, "\x89PNG\r\n\x1a\n", 8)) return vxl_image_stack_load;
-        if (n >= 4 && (!memcmp(m, "II*\0", 4) || !memcmp(m, "MM\0*", 4))) return vxl_image_stack_load;
-        if (n >= 5 && (!strncasecmp((const char *)m, "ObjectType", 10) || !strncasecmp((const char *)m, "NDims", 5)))
-            return vxl_metaimage_load;
-    }
-    if (vxl_dicom_path_is_dicom(path, 0)) return vxl_dicom_load; /* "DICM" after the 128-byte preamble */
-    return vxl_nifti_load;
-}
-
-int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **out)
-{
-    if (!out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
-    *out = NULL;
-    if (!path || !*path) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "path is empty");
-    return vxl_loader_for(path)(path, opt, out, NULL);
 }
 
 int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)

@@ -59,15 +59,20 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
 int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 /* MetaImage (.mha, .mhd + ElementDataFile; raw/zlib); in metaimage.c. */
 int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
-/* TIFF/PNG through OpenImageIO: a multi-page TIFF, a numbered series
- * (slice_0001.tif ...) or a folder of images; in image_stack.cpp. */
+/* The readers that need OpenImageIO or dcmtk run in helper processes, so
+ * this library links only the C runtime (reader_stream.h); these start the
+ * helper and rebuild its volume after checking everything it sent; in
+ * remote_readers.c. A missing helper or library is an error naming it.
+ * TIFF/PNG: a multi-page TIFF, a numbered series (slice_0001.tif ...) or a
+ * folder of images (image_stack.cpp in voxlight-read-oiio). */
 int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
-/* OpenVDB scalar grid through OpenImageIO's OpenVDB reader; in vdb.cpp. */
+/* OpenVDB scalar grid (vdb.cpp in voxlight-read-oiio). */
 int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
-/* DICOM through dcmtk: a folder, a DICOMDIR or one file of a series; in
- * dicom.cpp. vxl_dicom_path_is_dicom says whether a folder holds DICOM
- * (a DICOMDIR, or "DICM" files) or a file is DICOM, for the dispatch. */
+/* DICOM: a folder, a DICOMDIR or one file of a series (dicom.cpp in
+ * voxlight-read-dicom). */
 int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* Whether a folder holds DICOM (a DICOMDIR, or "DICM" files) or a file is
+ * DICOM, for the dispatch; in dicom_detect.c. */
 int vxl_dicom_path_is_dicom(const char *path, int is_dir);
 
 #endif

@@ -19,32 +19,64 @@ bl_info = {
 }
 
 if "bpy" in locals():
-    # Re-running register after a script reload: pick up edited modules.
-    import importlib
-    for _m in (native, depth, zbuffer, volume_space, runtime, lights, params,  # noqa: F821
-               properties, operators, panels, scene_geometry, offline, compositor,  # noqa: F821
-               render_hooks, viewport, api, preferences, tf, import_job, importer,  # noqa: F821
-               volume_object):  # noqa: F821
-        importlib.reload(_m)
+    # Executed again (a script reload, or an update installed over the
+    # legacy add-on): forget every submodule, so the imports below load the
+    # new code of all of them, in dependency order.
+    import sys
+    for _name in [n for n in sys.modules if n.startswith(__name__ + ".")]:
+        del sys.modules[_name]
+        globals().pop(_name.rsplit(".", 1)[1], None)
 
 import bpy  # noqa: E402
 
-from . import (api, compositor, depth, import_job, importer, lights, native, offline,  # noqa: E402
-               operators, panels, params, preferences, properties, render_hooks, runtime,
-               scene_geometry, tf, viewport, volume_object, volume_space, zbuffer)
-from .api import render_volume  # noqa: E402,F401
+from . import compat  # noqa: E402
 
-# Registration order: properties before the UI that shows them; handlers last.
-_modules = (preferences, properties, tf, operators, importer, volume_object, panels, render_hooks,
-            viewport)
+# On a Blender older than the add-on supports, nothing else is imported (the
+# other modules may use API that does not exist there): register() then only
+# shows why, in the preferences and on the console.
+UNSUPPORTED = compat.unsupported_message(bpy.app.version)
+
+if UNSUPPORTED is None:
+    from . import native  # noqa: E402
+    # The library's private copies (native.private_copy) go to the
+    # extension's own folder where Blender gives one; set before any module
+    # loads the library.
+    native.CACHE_DIR = compat.private_data_dir(__package__)
+    from . import (api, compositor, depth, import_job, importer, lights, native, offline,  # noqa: E402
+                   operators, panels, params, preferences, properties, render_hooks, runtime,
+                   scene_geometry, tf, viewport, volume_object, volume_space, zbuffer)
+    from .api import render_volume  # noqa: E402,F401
+
+    # Registration order: properties before the UI that shows them; handlers last.
+    _modules = (preferences, properties, tf, operators, importer, volume_object, panels,
+                render_hooks, viewport)
+else:
+    _modules = ()
+
+
+class _UnsupportedPreferences(bpy.types.AddonPreferences):
+    """Shown instead of the real preferences on an unsupported Blender."""
+    bl_idname = __package__
+
+    def draw(self, context):
+        col = self.layout.column()
+        col.alert = True
+        for i, line in enumerate(compat.wrap(UNSUPPORTED, 90)):
+            col.label(text=line, icon="ERROR" if i == 0 else "NONE")
 
 
 def library_status():
     """(ok, message): whether libvoxlight loaded, and why not."""
+    if UNSUPPORTED:
+        return False, UNSUPPORTED
     return native.library_status()
 
 
 def register():
+    if UNSUPPORTED:
+        print("Voxlight: %s" % UNSUPPORTED)
+        bpy.utils.register_class(_UnsupportedPreferences)
+        return
     for m in _modules:
         m.register()
     ok, msg = native.library_status()
@@ -54,6 +86,9 @@ def register():
 
 
 def unregister():
+    if UNSUPPORTED:
+        bpy.utils.unregister_class(_UnsupportedPreferences)
+        return
     for m in reversed(_modules):
         m.unregister()
     runtime.release_all()

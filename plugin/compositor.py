@@ -1,24 +1,49 @@
-"""Compositor nodes that put the volume image over the render:
+"""Compositor nodes that put the volume image into the render, before
+anything the user built on top of it:
 
-    Render Layers (or whatever fed the output) --> Alpha Over [bg]
-    Image "Voxlight Render" (premultiplied)    --> Alpha Over [fg] --> output
+    Render Layers [Image] --> Alpha Over [bg] --> (every node that used to
+    Image "Voxlight Render" --> Alpha Over [fg]    read Render Layers' Image)
 
 Python cannot read Render Result pixels, so the volume is composited here
-instead. The nodes are created once and found again by name; with no
-volumes to show, the Alpha Over is muted so it passes the render through.
+instead. The Alpha Over takes Render Layers' Image, and every link that left
+Render Layers' Image now leaves the Alpha Over, so the user's effects
+(Invert, Glare, colour grading ...) apply to the volume and the mesh render
+alike. Each run re-routes links that the user has since drawn from Render
+Layers' Image; a user who feeds the Alpha Over's background from anything
+else keeps that wiring. The nodes are found again by name; with nothing to
+show, the Alpha Over is muted so it passes the render through.
+
+"Volume as Separate Layer" (scene.voxlight.render_separate_layer) leaves the
+user's tree alone instead: the Alpha Over is taken out (its links restored
+to Render Layers) and each pass is an image the user can wire, shown by an
+unlinked Image node per pass: colour (premultiplied, scene-linear), alpha,
+and depth (view-space planar distance, as Blender's Depth pass; 1e10 where
+no volume is).
+
 Blender 5.0 moved the compositor to scene.compositing_node_group (with a
-Group Output instead of a Composite node); both layouts are handled.
+Group Output instead of a Composite node) and changed Alpha Over's inputs;
+compat.py hides both.
 """
 
 import bpy
+import numpy as np
+
+from . import compat
 
 IMAGE_NAME = "Voxlight Render"
 NODE_IMAGE = "Voxlight Volume"
 NODE_OVER = "Voxlight Alpha Over"
 
+# Separate-layer passes: (image and node name, what it holds).
+PASS_COLOR = "Voxlight Color"
+PASS_ALPHA = "Voxlight Alpha"
+PASS_DEPTH = "Voxlight Depth"
+PASSES = (PASS_COLOR, PASS_ALPHA, PASS_DEPTH)
+NO_DEPTH = 1e10  # what Blender's own Depth pass holds where nothing is
 
-def ensure_image(width, height):
-    img = bpy.data.images.get(IMAGE_NAME)
+
+def ensure_image(width, height, name=IMAGE_NAME):
+    img = bpy.data.images.get(name)
     if img is not None and (not img.is_float or tuple(img.size) != (width, height)):
         if tuple(img.size) != (width, height) and img.is_float:
             img.scale(width, height)
@@ -26,80 +51,147 @@ def ensure_image(width, height):
             bpy.data.images.remove(img)
             img = None
     if img is None:
-        img = bpy.data.images.new(IMAGE_NAME, width, height, alpha=True, float_buffer=True)
-    img.alpha_mode = "PREMUL"  # the library's output is premultiplied
+        img = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
+    # The library's colour is premultiplied; alpha and depth are data.
+    img.alpha_mode = "PREMUL"
+    if name in (PASS_ALPHA, PASS_DEPTH):
+        img.colorspace_settings.is_data = True
     img.use_fake_user = False
     return img
 
 
-def _tree(scene):
-    if hasattr(scene, "compositing_node_group"):  # Blender 5.0+
-        tree = scene.compositing_node_group
-        if tree is None:
-            tree = bpy.data.node_groups.new("Voxlight Compositing", "CompositorNodeTree")
-            tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
-            rl = tree.nodes.new("CompositorNodeRLayers")
-            out = tree.nodes.new("NodeGroupOutput")
-            out.location = (400, 0)
-            tree.links.new(rl.outputs["Image"], out.inputs[0])
-            scene.compositing_node_group = tree
-        return tree
-    scene.use_nodes = True
-    if scene.render.use_compositing is False:
-        scene.render.use_compositing = True
-    return scene.node_tree
-
-
-def _output_socket(tree):
-    for node in tree.nodes:
-        if node.bl_idname == "CompositorNodeComposite":
-            return node.inputs["Image"]
-    for node in tree.nodes:
-        if node.bl_idname == "NodeGroupOutput" and node.inputs:
-            return node.inputs[0]
-    out = tree.nodes.new("CompositorNodeComposite")
-    out.location = (600, 0)
-    return out.inputs["Image"]
+def _image_node(tree, name, image, location):
+    node = tree.nodes.get(name)
+    if node is None:
+        node = tree.nodes.new("CompositorNodeImage")
+        node.name = node.label = name
+        node.location = location
+    if node.image != image:
+        node.image = image
+    return node
 
 
 def _render_layers(tree):
-    for node in tree.nodes:
-        if node.bl_idname == "CompositorNodeRLayers":
-            return node
+    """The Render Layers node whose Image carries the render: the one
+    linked to the output or to anything, else the first, else a new one."""
+    rls = [n for n in tree.nodes if n.bl_idname == "CompositorNodeRLayers"]
+    linked = [n for n in rls if n.outputs["Image"].is_linked]
+    if linked or rls:
+        return (linked or rls)[0]
     return tree.nodes.new("CompositorNodeRLayers")
 
 
+def _route_through(tree, over):
+    """Every link leaving the Render Layers node that feeds the Alpha Over's
+    background (other than that one) is moved to leave the Alpha Over."""
+    background, _foreground = compat.alpha_over_sockets(over)
+    if not background.is_linked:
+        return
+    src = background.links[0].from_socket
+    if src.node.bl_idname != "CompositorNodeRLayers":
+        return  # the user fed the background from elsewhere: theirs to keep
+    for link in list(src.links):
+        if link.to_node == over:
+            continue
+        to = link.to_socket
+        tree.links.remove(link)
+        tree.links.new(over.outputs[0], to)
+
+
 def ensure_nodes(scene, image):
-    """Idempotent: builds the nodes on first use, then only re-points them."""
-    tree = _tree(scene)
+    """Idempotent: builds the nodes on first use, then re-points them and
+    routes new links from Render Layers' Image through the Alpha Over."""
+    if scene.render.use_compositing is False:
+        scene.render.use_compositing = True
+    tree = compat.compositor_tree(scene)
     over = tree.nodes.get(NODE_OVER)
-    img_node = tree.nodes.get(NODE_IMAGE)
-    if img_node is None:
-        img_node = tree.nodes.new("CompositorNodeImage")
-        img_node.name = img_node.label = NODE_IMAGE
-    if img_node.image != image:
-        img_node.image = image
     if over is None:
         over = tree.nodes.new("CompositorNodeAlphaOver")
         over.name = over.label = NODE_OVER
-        out = _output_socket(tree)
-        src = out.links[0].from_socket if out.is_linked else _render_layers(tree).outputs["Image"]
-        tree.links.new(src, over.inputs[1])
-        tree.links.new(over.outputs[0], out)
-        over.location = (out.node.location.x - 200, out.node.location.y)
-        img_node.location = (over.location.x - 300, over.location.y - 250)
-    if not over.inputs[2].is_linked:
-        tree.links.new(img_node.outputs["Image"], over.inputs[2])
+        rl = _render_layers(tree)
+        background, _foreground = compat.alpha_over_sockets(over)
+        tree.links.new(rl.outputs["Image"], background)
+        over.location = (rl.location.x + 300, rl.location.y + 150)
+        out = compat.compositor_output_socket(tree)
+        if not out.is_linked:  # nothing reached the output: the render does now
+            tree.links.new(over.outputs[0], out)
+    img_node = _image_node(tree, NODE_IMAGE, image,
+                           (over.location.x - 300, over.location.y - 250))
+    _background, foreground = compat.alpha_over_sockets(over)
+    if not foreground.is_linked:
+        tree.links.new(img_node.outputs["Image"], foreground)
+    _route_through(tree, over)
     # The image is already premultiplied: a plain premultiplied 'over'.
-    over.use_premultiply = False
-    over.premul = 0.0
+    compat.alpha_over_premultiplied(over)
     over.mute = False
     return tree
 
 
+def remove_nodes(scene):
+    """Take the Alpha Over and its Image node out of the tree, giving the
+    Alpha Over's links back to whatever fed its background."""
+    tree = compat.compositor_tree(scene, create=False)
+    if tree is None:
+        return
+    over = tree.nodes.get(NODE_OVER)
+    if over is not None:
+        background, _foreground = compat.alpha_over_sockets(over)
+        src = background.links[0].from_socket if background.is_linked else None
+        targets = [link.to_socket for link in over.outputs[0].links]
+        tree.nodes.remove(over)
+        if src is not None:
+            for to in targets:
+                tree.links.new(src, to)
+    node = tree.nodes.get(NODE_IMAGE)
+    if node is not None:
+        tree.nodes.remove(node)
+
+
+def ensure_pass_nodes(scene, width, height):
+    """Separate-layer mode: the pass images at render size and an unlinked
+    Image node per pass, for the user to wire. Returns the images."""
+    tree = compat.compositor_tree(scene)
+    remove_nodes(scene)
+    rl = _render_layers(tree)
+    images = []
+    for i, name in enumerate(PASSES):
+        img = ensure_image(width, height, name)
+        _image_node(tree, name, img, (rl.location.x, rl.location.y - 350 - 250 * i))
+        images.append(img)
+    return images
+
+
+def write_passes(scene, rgba_linear, depth):
+    """Fill the pass images: premultiplied colour, alpha as grey, depth as
+    grey (NO_DEPTH where the volume shows nothing)."""
+    h, w = rgba_linear.shape[:2]
+    color, alpha, zimg = ensure_pass_nodes(scene, w, h)
+    color.pixels.foreach_set(np.ascontiguousarray(rgba_linear, np.float32).ravel())
+    a = rgba_linear[..., 3]
+    one = np.ones_like(a)
+    alpha.pixels.foreach_set(np.ascontiguousarray(np.stack([a, a, a, one], -1), np.float32).ravel())
+    d = np.where(np.isfinite(depth), depth, NO_DEPTH).astype(np.float32)
+    zimg.pixels.foreach_set(np.ascontiguousarray(np.stack([d, d, d, one], -1), np.float32).ravel())
+    for img in (color, alpha, zimg):
+        img.update()
+
+
+def clear_passes(scene):
+    """Separate-layer mode with nothing to show: empty colour and alpha,
+    NO_DEPTH depth, so a user's wiring composites nothing stale."""
+    for name, value in ((PASS_COLOR, 0.0), (PASS_ALPHA, 0.0), (PASS_DEPTH, NO_DEPTH)):
+        img = bpy.data.images.get(name)
+        if img is None:
+            continue
+        px = np.full((img.size[1], img.size[0], 4), value, np.float32)
+        if name != PASS_COLOR:
+            px[..., 3] = 1.0
+        img.pixels.foreach_set(px.ravel())
+        img.update()
+
+
 def mute(scene):
-    tree = scene.compositing_node_group if hasattr(scene, "compositing_node_group") \
-        else scene.node_tree
+    tree = compat.compositor_tree(scene, create=False)
     if tree is not None:
         over = tree.nodes.get(NODE_OVER)
         if over is not None:

@@ -18,7 +18,7 @@ from bpy.props import BoolProperty, FloatProperty, FloatVectorProperty, StringPr
 from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix
 
-from . import import_job, runtime, tf, volume_space
+from . import framing, import_job, orientation, runtime, tf, volume_space
 
 
 def _to_matrix(a):
@@ -83,6 +83,16 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
     series: StringProperty(name="DICOM Series", default="",
                            description="Series of a DICOM folder to import: index or "
                                        "SeriesInstanceUID (empty = the only series)")
+    # orientation.py: 180 degrees about Z, so Front (numpad 1) shows the face.
+    anatomical_views: BoolProperty(
+        name="Blender Views Match Anatomy", default=True,
+        description="Turn the scan so Front (numpad 1) shows the face, Top the top of the head, "
+                    "and Left/Right the patient's right/left side, as for a Blender character. "
+                    "Off keeps the scanner's (RAS) axes. Image stacks and OpenVDB have no anatomy "
+                    "and are never turned")
+    frame_in_view: BoolProperty(name="Frame in View", default=True,
+                                description="Point every 3D viewport at the imported volume "
+                                            "(as View Selected does)")
     # Set by invoke: the file browser path runs modal, scripts block.
     use_modal: BoolProperty(default=False, options={"HIDDEN", "SKIP_SAVE"})
 
@@ -154,23 +164,29 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         dims = info["dims"]
         cursor = context.scene.cursor.location if self.center else None
         unit_scale = 1.0 if import_job.is_vdb(path) else self.unit_scale
-        s_from_v = volume_space.scene_from_voxel(info["affine"], dims, unit_scale, center_at=cursor)
+        turn = orientation.choose(self.anatomical_views, info, import_job.is_vdb(path))
+        s_from_v = volume_space.scene_from_voxel(orientation.oriented_affine(info["affine"], turn),
+                                                 dims, unit_scale, center_at=cursor)
         obj = bpy.data.objects.new(import_job.display_name(path), None)
         try:
             obj.empty_display_type = "CUBE"
             obj.empty_display_size = 1.0
-            # Drawn in the "in front" pass: its wire cube then stays out of the
-            # depth buffer the viewport reads at POST_VIEW, so rays do not stop
-            # at the volume's own outline.
-            obj.show_in_front = True
+            # Not "in front": Blender then depth-tests the wire cube against the
+            # scene, so meshes hide it (in front, it drew over them). Its lines
+            # enter the depth buffer the viewport reads at POST_VIEW, and rays
+            # stop at them: right, since that is where the lines are (a back
+            # edge stops rays behind everything inside the box, a front edge
+            # hides what is behind it, like any wire in front).
+            obj.show_in_front = False
             obj.matrix_world = _to_matrix(volume_space.object_matrix(s_from_v, dims))
             # Blender keeps loc/rot/scale only; whatever it could not hold
             # (shear) stays in voxel_to_local so the render remains exact.
             v2l = volume_space.voxel_to_local(s_from_v, np.array(obj.matrix_world))
             fill_volume_properties(obj, path, info, v2l, unit_scale)
             obj.voxlight.series = self.series
+            obj.voxlight.orientation = turn
             context.collection.objects.link(obj)
-            tf.ensure_texture(obj)  # grey ramp until a preset or the user edits it
+            tf.ensure_texture(obj, info)  # the preset that suits the data, fitted to it
         except Exception:
             tex = obj.voxlight.tf_texture
             if tex is not None:
@@ -181,7 +197,36 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             o.select_set(False)
         obj.select_set(True)
         context.view_layer.objects.active = obj
+        if self.frame_in_view:
+            frame_in_views(context, obj)
         return obj
+
+
+def frame_in_views(context, obj):
+    """Points every 3D viewport of every window at the volume's box
+    (framing.py). Views through a camera or locked to an object are left
+    alone: moving them would move the user's camera or fight the lock.
+    Headless (no windows) there is nothing to do."""
+    model = np.array(obj.matrix_world, np.float64) @ \
+        np.array(obj.voxlight.voxel_to_local, np.float64).reshape(4, 4).T
+    corners = volume_space.world_corners(model, tuple(obj.voxlight.dims))
+    for win in context.window_manager.windows:
+        for area in win.screen.areas:
+            if area.type != "VIEW_3D":
+                continue
+            space = area.spaces.active
+            if getattr(space, "lock_object", None) is not None:
+                continue
+            for region in area.regions:
+                r3d = region.data if region.type == "WINDOW" else None
+                if r3d is None or r3d.view_perspective == "CAMERA" or region.width < 1 \
+                        or region.height < 1:
+                    continue
+                centre, dist = framing.frame(corners, space.lens, region.width, region.height,
+                                             perspective=r3d.view_perspective == "PERSP")
+                r3d.view_location = tuple(centre)
+                r3d.view_distance = dist
+            area.tag_redraw()
 
 
 def menu_import(self, context):

@@ -15,23 +15,33 @@ Conventions kept from the header:
 """
 
 import ctypes
+import errno
+import fcntl
 import hashlib
 import os
+import shutil
+import tempfile
 import time
 
 import numpy as np
 
 ABI_VERSION = 1
 LIBRARY_NAME = "libvoxlight.so"
-# The process that reads .vdb files for the library, next to it (csrc/vdb_spawn.c).
-VDB_HELPER_NAME = "voxlight-vdb-read"
+# The reader processes the library starts, found next to the library itself
+# (csrc/reader_spawn.c, csrc/reader_stream.h): voxlight-read-oiio (TIFF/PNG
+# stacks and OpenVDB) and voxlight-read-dicom; every voxlight-read-* file is
+# shipped and copied with the library.
+HELPER_PREFIX = "voxlight-read-"
+VDB_HELPER_NAME = "voxlight-read-oiio"  # the one that reads .vdb files
+OLD_VDB_HELPER_NAME = "voxlight-vdb-read"  # its name in older builds
 
 # The names this binding was written against (VXL_FILTER_* / VXL_PRESET_*
 # order). The library is the authority: Library.filter_names() reads
 # vxl_filter_name() up to the first NULL, so a filter added to the library
 # shows up in the add-on without editing this file; these tuples are only
 # the fallback when no library can be loaded (the UI still registers).
-FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed", "cubic")
+FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed", "cubic",
+           "cubic-smooth")
 PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
 BACKENDS = ("auto", "osmesa", "egl")
 STORAGES = ("auto", "dense", "bricked", "sparse", "compressed")  # VXL_STORAGE_*
@@ -295,10 +305,13 @@ def _declare(lib):
 
 
 class Library:
-    """A loaded, ABI-checked libvoxlight."""
+    """A loaded, ABI-checked libvoxlight. .path is the file mapped into the
+    process; .source_path the one it was copied from (the same when loaded
+    in place)."""
 
-    def __init__(self, path):
+    def __init__(self, path, source_path=None):
         self.path = path
+        self.source_path = source_path or path
         # Plain dlopen (RTLD_LOCAL). RTLD_DEEPBIND would crash Blender
         # (jemalloc), and the library fetches GL through get-proc-address,
         # so Blender's global libGL cannot capture its GL calls.
@@ -392,7 +405,9 @@ _library_error = None
 
 def load_library(path=None, reload=False):
     """Return the Library, loading it on first use. Raises LibraryUnavailable
-    with a message that names every place that was tried."""
+    with a message that names every place that was tried. The file that is
+    mapped is a private copy (private_copy), so installing a new add-on over
+    this one never writes over a mapped library."""
     global _library, _library_error
     if _library is not None and not reload and path is None:
         return _library
@@ -401,20 +416,209 @@ def load_library(path=None, reload=False):
         if not os.path.isfile(p):
             errors.append("%s: not found" % p)
             continue
+        for helper in helper_names(os.path.dirname(p)):
+            restore_execute_bit(os.path.join(os.path.dirname(p), helper))
+        copy = private_copy(p)
         try:
-            lib = Library(p)
+            try:
+                lib = Library(copy or p, source_path=p)
+            except LibraryUnavailable as e:
+                # A cache on a noexec mount cannot be mapped: load in place.
+                if not copy or not e.args[0].startswith("cannot load"):
+                    raise
+                copy = None
+                lib = Library(p)
         except LibraryUnavailable as e:
-            errors.append(str(e))
+            errors.append(str(e).replace(copy, p) if copy else str(e))
             # An explicitly named library that is broken is an error by itself;
             # falling back would hide it.
             if p == path:
                 break
             continue
-        restore_execute_bit(os.path.join(os.path.dirname(p), VDB_HELPER_NAME))
         _library, _library_error = lib, None
         return lib
     _library_error = "libvoxlight not usable: " + "; ".join(errors)
     raise LibraryUnavailable(_library_error)
+
+
+# ------------------------------------------------- private library copies
+#
+# Installing an add-on over itself writes the new files where the old ones
+# are; if libvoxlight.so were mapped from there, the running Blender would
+# crash at its next call into it. So the library is loaded from a copy in a
+# cache folder named by the content's hash, together with the reader helpers
+# it starts from its own folder (found with dladdr, csrc/reader_spawn.c). An
+# updated add-on has another hash, hence a new folder and a fresh dlopen
+# (dlopen of the old path would hand back the old, already loaded library).
+# Each process holds a shared flock on the folder it uses; a folder nobody
+# holds is stale and removed by the next load.
+
+_LOCK_NAME = ".in-use"
+_held_locks = {}  # folder -> open lock file, kept for the life of the process
+
+
+def helper_names(folder):
+    """The helper executables shipped next to the library in folder."""
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    return sorted(n for n in names
+                  if (n.startswith(HELPER_PREFIX) or n == OLD_VDB_HELPER_NAME)
+                  and os.path.isfile(os.path.join(folder, n)))
+
+
+# Set by the add-on when Blender gives it a folder of its own (an
+# extension's user folder, 4.2+; compat.private_data_dir).
+CACHE_DIR = None
+
+
+def cache_roots():
+    """Where private copies may go, best first: VOXLIGHT_CACHE_DIR, the
+    add-on's own folder (CACHE_DIR), the XDG cache folder, then the
+    temporary folder."""
+    roots = []
+    for d in (os.environ.get("VOXLIGHT_CACHE_DIR"), CACHE_DIR):
+        if d:
+            roots.append(d)
+    xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    roots.append(os.path.join(xdg, "voxlight", "lib"))
+    roots.append(os.path.join(tempfile.gettempdir(), "voxlight-%d" % os.getuid(), "lib"))
+    return roots
+
+
+def _content_key(files):
+    h = hashlib.sha256()
+    for f in files:
+        h.update(os.path.basename(f).encode() + b"\0")
+        with open(f, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+        h.update(b"\0")
+    return h.hexdigest()[:24]
+
+
+def _hold(folder):
+    """Take a shared lock on folder's lock file; False when the folder went
+    away meanwhile (a cleaner removed it)."""
+    if folder in _held_locks:
+        return True
+    lock = os.path.join(folder, _LOCK_NAME)
+    try:
+        fd = os.open(lock, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH)
+        st, held = os.stat(lock), os.fstat(fd)
+        if (st.st_dev, st.st_ino) != (held.st_dev, held.st_ino):
+            raise OSError(errno.ESTALE, "%s was replaced" % lock)
+    except OSError:
+        os.close(fd)
+        return False
+    _held_locks[folder] = fd
+    return True
+
+
+def _complete(folder, files):
+    return all(os.path.isfile(os.path.join(folder, os.path.basename(f))) and
+               os.path.getsize(os.path.join(folder, os.path.basename(f))) == os.path.getsize(f)
+               for f in files)
+
+
+def _make_copy(root, key, files):
+    """root/key holding a copy of files (made atomically by renaming a
+    finished folder into place); returns the folder."""
+    folder = os.path.join(root, key)
+    if os.path.isdir(folder) and _complete(folder, files) and _hold(folder):
+        return folder
+    os.makedirs(root, exist_ok=True)
+    stage = tempfile.mkdtemp(prefix=".stage-", dir=root)
+    try:
+        for i, f in enumerate(files):
+            dest = os.path.join(stage, os.path.basename(f))
+            shutil.copyfile(f, dest)
+            os.chmod(dest, 0o644 if i == 0 else 0o755)  # files[0] is the library
+        open(os.path.join(stage, _LOCK_NAME), "w").close()
+        try:
+            os.rename(stage, folder)
+        except OSError:
+            # Another process put it in place first, or a broken copy is in
+            # the way: use this process's own copy under another name.
+            if os.path.isdir(folder) and _complete(folder, files) and _hold(folder):
+                shutil.rmtree(stage, ignore_errors=True)
+                return folder
+            folder = "%s-%d" % (folder, os.getpid())
+            shutil.rmtree(folder, ignore_errors=True)
+            os.rename(stage, folder)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    if not _hold(folder):
+        raise OSError(errno.ENOENT, "%s vanished" % folder)
+    return folder
+
+
+def clean_stale_copies(root):
+    """Remove copies no process holds (their flock is free). Safe while
+    other Blenders run: a held folder is never touched."""
+    try:
+        names = os.listdir(root)
+    except OSError:
+        return
+    for name in names:
+        folder = os.path.join(root, name)
+        if folder in _held_locks or not os.path.isdir(folder):
+            continue
+        if name.startswith(".stage-"):
+            # A copy being made now, or left by a crash: only old ones go.
+            try:
+                if time.time() - os.path.getmtime(folder) > 3600:
+                    shutil.rmtree(folder, ignore_errors=True)
+            except OSError:
+                pass
+            continue
+        try:
+            fd = os.open(os.path.join(folder, _LOCK_NAME), os.O_RDONLY)
+        except OSError:
+            continue  # not ours (no lock file): leave it
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue  # in use by a running process
+        try:
+            # Unlink the lock file last, so that a loader that opened it
+            # before the removal sees it gone (_hold compares inodes).
+            for entry in os.listdir(folder):
+                if entry != _LOCK_NAME:
+                    os.unlink(os.path.join(folder, entry))
+            os.unlink(os.path.join(folder, _LOCK_NAME))
+            os.rmdir(folder)
+        except OSError:
+            pass
+        finally:
+            os.close(fd)
+
+
+def private_copy(path):
+    """The path of a private copy of the library at path, with the helpers
+    that sit next to it, or None when no cache folder is writable (the
+    library is then loaded in place)."""
+    src = os.path.dirname(os.path.abspath(path))
+    files = [os.path.abspath(path)] + [os.path.join(src, n) for n in helper_names(src)]
+    try:
+        key = _content_key(files)
+    except OSError:
+        return None
+    for root in cache_roots():
+        try:
+            folder = _make_copy(root, key, files)
+        except OSError:
+            continue
+        clean_stale_copies(root)
+        return os.path.join(folder, os.path.basename(path))
+    return None
 
 
 def restore_execute_bit(path):
@@ -447,7 +651,7 @@ def library_status():
         lib = load_library()
     except LibraryUnavailable as e:
         return False, str(e)
-    return True, "libvoxlight ABI %d at %s" % (lib.abi_version, lib.path)
+    return True, "libvoxlight ABI %d at %s" % (lib.abi_version, lib.source_path)
 
 
 # --------------------------------------------------------------- helpers

@@ -1,14 +1,20 @@
 """Properties editor UI: Object tab "Voxlight" (only for Voxlight volumes)
 and Render tab "Voxlight" (scene-wide settings). Library problems are shown
-here rather than failing at add-on import."""
+here rather than failing at add-on import.
+
+The object panel is Blender-style: the volume's file and size on top, then
+sub-panels (Transfer Function, Rendering, Lighting, and Advanced and
+Statistics collapsed), all with the property-split layout so labels fit at
+the editor's default width."""
 
 import bpy
 
-from . import native, runtime, tf
+from . import histogram_image, runtime, tf
 from .properties import FIXED_TAP_FILTERS
 
 
 def _draw_library_status(layout):
+    from . import native
     ok, msg = native.library_status()
     if not ok:
         box = layout.box()
@@ -19,9 +25,19 @@ def _draw_library_status(layout):
     return ok
 
 
-class VOXLIGHT_PT_volume(bpy.types.Panel):
-    bl_label = "Voxlight"
-    bl_idname = "VOXLIGHT_PT_volume"
+def _split(layout, decorate=True):
+    """Blender's own panel layout: label column, value column and (for
+    animatable properties) the keyframe dots."""
+    layout.use_property_split = True
+    layout.use_property_decorate = decorate
+    return layout
+
+
+_KIND_TEXT = {"ct": "CT (Hounsfield units)", "mr": "MR (arbitrary units)",
+              "pet": "PET/NM (arbitrary units)", "other": "arbitrary units"}
+
+
+class _VolumePanel:
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "object"
@@ -31,11 +47,14 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
         obj = context.object
         return obj is not None and obj.voxlight.is_volume
 
+
+class VOXLIGHT_PT_volume(_VolumePanel, bpy.types.Panel):
+    bl_label = "Voxlight"
+    bl_idname = "VOXLIGHT_PT_volume"
+
     def draw(self, context):
-        layout = self.layout
+        layout = _split(self.layout, decorate=False)
         p = context.object.voxlight
-        layout.use_property_split = True
-        layout.use_property_decorate = True  # keyframe dots: everything is animatable
         if _draw_library_status(layout):
             err = runtime.last_failure(bpy.path.abspath(p.filepath), p.series)
             if err:
@@ -45,98 +64,196 @@ class VOXLIGHT_PT_volume(bpy.types.Panel):
                 box.operator("voxlight.reload_volume", icon="FILE_REFRESH")
         layout.prop(p, "filepath")
         col = layout.column(align=True)
-        col.label(text="%d x %d x %d voxels, data range %.4g .. %.4g"
-                  % (*p.dims, p.data_min, p.data_max))
+        col.label(text="%d x %d x %d voxels" % tuple(p.dims), icon="VOLUME_DATA")
+        col.label(text="Values %.4g .. %.4g, %s" % (p.data_min, p.data_max,
+                                                   _KIND_TEXT.get(tf.kind_of(p), "")))
         if p.series:
             col.label(text="DICOM series %s" % p.series)
         if p.frame_count > 1:  # 4D: which volume frame the scene frame shows
-            col = layout.column(align=True)
+            col = _split(layout.column(align=True), decorate=True)
             col.label(text="%d volume frames" % p.frame_count)
             col.prop(p, "frame_mode")
             col.prop(p, "frame_offset" if p.frame_mode == "TIMELINE" else "fixed_frame")
 
-        layout.separator()
+
+# ------------------------------------------------------- transfer function
+
+_previews = None   # bpy.utils.previews collection of the histogram pictures
+_picture_keys = {}  # object name -> what its picture shows (redrawn when it changes)
+PICTURE_SIZE = (256, 224)  # wide enough to align, tall enough to read
+
+
+def histogram_icon(obj):
+    """icon_id of the object's histogram picture (histogram_image.render),
+    regenerated when the histogram, the window or the ramp changed."""
+    global _previews
+    from bpy.utils import previews
+    if _previews is None:
+        _previews = previews.new()
+    p = obj.voxlight
+    counts, lo, hi = tf.histogram_of(obj)
+    table = tf.table(p, 64)
+    key = (counts.tobytes(), lo, hi, p.window_low, p.window_high,
+           table.tobytes() if table is not None else b"")
+    name = obj.name
+    if _picture_keys.get(name) != key or name not in _previews:
+        if name in _previews:
+            del _previews[name]  # a fresh preview: the icon cache sees the new pixels
+        w, h = PICTURE_SIZE
+        img = histogram_image.render(counts, lo, hi, p.window_low, p.window_high, table, w, h)
+        pv = _previews.new(name)
+        pv.image_size = (w, h)
+        pv.image_pixels_float.foreach_set(img.ravel())  # 15x faster than a list
+        _picture_keys[name] = key
+    return _previews[name].icon_id
+
+
+class VOXLIGHT_PT_volume_tf(_VolumePanel, bpy.types.Panel):
+    bl_label = "Transfer Function"
+    bl_idname = "VOXLIGHT_PT_volume_tf"
+    bl_parent_id = "VOXLIGHT_PT_volume"
+
+    def draw(self, context):
+        obj = context.object
+        p = obj.voxlight
+        layout = self.layout
+        name, modified = tf.preset_state(p)
+        label = (name + (" (modified)" if modified else "")) if name else "Custom"
+        layout.menu("VOXLIGHT_MT_tf_presets", text=label, icon="PRESET")
+        tex = p.tf_texture
+        if tex is None or not tex.use_color_ramp:
+            layout.operator("voxlight.tf_ramp", icon="ADD")
+            return
+        layout.template_color_ramp(tex, "color_ramp", expand=True)
+        # The histogram over the window, aligned with the ramp above it, and
+        # the whole data range with the window marked (histogram_image).
+        # Blender draws a preview icon as the largest square its button
+        # holds, so the button is as wide as the ramp and square.
+        ui = 20.0 * context.preferences.view.ui_scale
+        width_units = max(context.region.width / ui - 1.5, 4.0) \
+            if context.region is not None else 14.0
+        layout.template_icon(icon_value=histogram_icon(obj), scale=width_units)
+        col = _split(layout.column(align=True))
+        col.prop(p, "window_low", text="Window")
+        col.prop(p, "window_high", text="High")
+        layout.operator("voxlight.tf_fit_window", icon="FULLSCREEN_EXIT")
+        _split(layout).prop(p, "opacity_scale")
+
+
+class VOXLIGHT_PT_volume_rendering(_VolumePanel, bpy.types.Panel):
+    bl_label = "Rendering"
+    bl_idname = "VOXLIGHT_PT_volume_rendering"
+    bl_parent_id = "VOXLIGHT_PT_volume"
+
+    def draw(self, context):
+        p = context.object.voxlight
+        layout = _split(self.layout)
         col = layout.column()
-        col.prop(p, "filter")
-        sub = col.column()
-        sub.active = p.filter not in FIXED_TAP_FILTERS
-        sub.prop(p, "sample_distance", slider=True)
-        col.prop(p, "reuse_gradients")
-        if p.filter == "precomputed":
-            col.prop(p, "gradient_16f")
         col.prop(p, "step")
         col.prop(p, "jitter")
+        col = layout.column()
+        col.prop(p, "filter", text="Normals")
+        sub = col.column()
+        sub.active = p.filter not in FIXED_TAP_FILTERS
+        sub.prop(p, "sample_distance", text="Distance", slider=True)
 
-        layout.separator()
-        col = layout.column()
-        col.prop(p, "use_color_ramp")
-        if p.use_color_ramp:
-            col.operator_menu_enum("voxlight.tf_preset", "preset", text="Load Preset",
-                                   icon="PRESET")
-            if p.tf_texture is not None and p.tf_texture.use_color_ramp:
-                box = layout.box()
-                box.template_color_ramp(p.tf_texture, "color_ramp", expand=True)
-                box.label(text="Stop alpha = opacity per voxel")
-            else:
-                col.operator("voxlight.tf_ramp", icon="ADD")
-        else:
-            col.prop(p, "preset")
-        col = layout.column()
-        col.prop(p, "use_window")
-        sub = col.column(align=True)
-        sub.active = p.use_window
-        sub.prop(p, "window_low")
-        sub.prop(p, "window_high")
-        col.label(text="Data range: %.4g .. %.4g" % (p.data_min, p.data_max))
-        if any(p.histogram):
-            hist = tf.histogram_text(p.histogram)
-            col.label(text="Histogram (log): " + hist)
-            if p.data_max > p.data_min:
-                a = (min(p.window_low, p.window_high) - p.data_min) / (p.data_max - p.data_min)
-                b = (max(p.window_low, p.window_high) - p.data_min) / (p.data_max - p.data_min)
-                i0, i1 = (int(round(min(max(v, 0.0), 1.0) * len(hist))) for v in (a, b))
-                col.label(text="Window:          " + " " * i0 + "▔" * max(i1 - i0, 1))
-        col.prop(p, "opacity_scale")
-        col.prop(p, "classify")
-        col.prop(p, "gradient_opacity")
+
+class VOXLIGHT_PT_volume_lighting(_VolumePanel, bpy.types.Panel):
+    bl_label = "Lighting"
+    bl_idname = "VOXLIGHT_PT_volume_lighting"
+    bl_parent_id = "VOXLIGHT_PT_volume"
+
+    def draw_header(self, context):
+        self.layout.prop(context.object.voxlight, "shading", text="")
+
+    def draw(self, context):
+        p = context.object.voxlight
+        layout = _split(self.layout)
+        col = layout.column(align=True)
+        col.active = p.shading
+        col.prop(p, "ambient", slider=True)
+        col.prop(p, "diffuse", slider=True)
+        col.prop(p, "specular", slider=True)
+        col.prop(p, "shininess")
+
+
+class VOXLIGHT_PT_volume_advanced(_VolumePanel, bpy.types.Panel):
+    bl_label = "Advanced"
+    bl_idname = "VOXLIGHT_PT_volume_advanced"
+    bl_parent_id = "VOXLIGHT_PT_volume"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        p = context.object.voxlight
+        layout = _split(self.layout)
+        layout.prop(p, "classify")
+        layout.prop(p, "gradient_opacity", text="Edges")
         if p.gradient_opacity != "off":
-            sub = col.column(align=True)
-            sub.prop(p, "gradient_ref")
-            sub.prop(p, "gradient_exp")
+            sub = layout.column(align=True)
+            sub.prop(p, "gradient_ref", text="Reference")
+            sub.prop(p, "gradient_exp", text="Exponent")
             if p.gradient_opacity == "iso":
                 sub.prop(p, "iso_value")
-                sub.prop(p, "iso_thickness")
+                sub.prop(p, "iso_thickness", text="Thickness")
+        col = layout.column(heading="Normals")
+        col.prop(p, "reuse_gradients", text="Reuse")
+        if p.filter == "precomputed":
+            col.prop(p, "gradient_16f", text="16-bit Float")
 
-        layout.separator()
-        col = layout.column()
-        col.prop(p, "shading")
-        sub = col.column(align=True)
-        sub.active = p.shading
-        sub.prop(p, "ambient", slider=True)
-        sub.prop(p, "diffuse", slider=True)
-        sub.prop(p, "specular", slider=True)
-        sub.prop(p, "shininess")
 
-        entry = runtime.find_entry(bpy.path.abspath(p.filepath), p.series)
-        frame = entry.last_frame if entry is not None else None
+# -------------------------------------------------------------- statistics
+
+stats_drawn = []  # (object name, frame kind) the Statistics header showed last (tests)
+
+
+def _last_frame(p):
+    entry = runtime.find_entry(bpy.path.abspath(p.filepath), p.series)
+    return entry.last_frame if entry is not None else None
+
+
+_KIND_NAMES = {"refined": "full", "interactive": "preview", "render": "render"}
+
+
+class VOXLIGHT_PT_volume_stats(_VolumePanel, bpy.types.Panel):
+    """What the last frame of this volume cost. The viewport redraws this
+    editor when its full-resolution frame arrives (viewport._poll), so the
+    numbers are the final frame's, not the preview's."""
+    bl_label = "Statistics"
+    bl_idname = "VOXLIGHT_PT_volume_stats"
+    bl_parent_id = "VOXLIGHT_PT_volume"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_header_preset(self, context):
+        frame = _last_frame(context.object.voxlight)
+        kind = frame["kind"] if frame else ""
+        if len(stats_drawn) > 64:
+            del stats_drawn[:32]
+        stats_drawn.append((context.object.name, kind))
         if frame:
-            layout.separator()
-            col = layout.column(align=True)
-            col.label(text="Last frame (%s): %d x %d, %.0f ms, %d call%s"
-                      % (frame["kind"], frame["width"], frame["height"],
-                         frame["seconds"] * 1000.0, frame["calls"],
-                         "" if frame["calls"] == 1 else "s"), icon="INFO")
-            col.label(text="%.2f M samples on %d rays, step %.3g voxels"
-                      % (frame["samples"] / 1e6, frame["rays"], frame["effective_step"]))
-            if frame["bricks_total"]:
-                col.label(text="Occupied bricks: %d of %d (%d³ voxels)"
-                          % (frame["bricks_occupied"], frame["bricks_total"],
-                             frame["brick_size"]))
-            else:
-                col.label(text="Empty-space skipping off")
-            col.label(text=storage_text(frame))
-            if frame.get("lod_level"):
-                col.label(text=lod_text(frame), icon="ERROR")
+            self.layout.label(text="%s, %.0f ms" % (_KIND_NAMES.get(kind, kind),
+                                                    frame.get("seconds", 0.0) * 1000.0))
+
+    def draw(self, context):
+        frame = _last_frame(context.object.voxlight)
+        layout = self.layout
+        if not frame:
+            layout.label(text="No frame rendered yet")
+            return
+        col = layout.column(align=True)
+        col.label(text="Last frame (%s): %d x %d, %.0f ms, %d call%s"
+                  % (_KIND_NAMES.get(frame["kind"], frame["kind"]), frame["width"],
+                     frame["height"], frame.get("seconds", 0.0) * 1000.0, frame.get("calls", 1),
+                     "" if frame.get("calls", 1) == 1 else "s"))
+        col.label(text="%.2f M samples on %d rays, step %.3g voxels"
+                  % (frame["samples"] / 1e6, frame["rays"], frame["effective_step"]))
+        if frame["bricks_total"]:
+            col.label(text="Occupied bricks: %d of %d (%d³ voxels)"
+                      % (frame["bricks_occupied"], frame["bricks_total"], frame["brick_size"]))
+        else:
+            col.label(text="Empty-space skipping off")
+        col.label(text=storage_text(frame))
+        if frame.get("lod_level"):
+            col.label(text=lod_text(frame), icon="ERROR")
 
 
 def storage_text(frame):
@@ -166,27 +283,29 @@ class VOXLIGHT_PT_scene(bpy.types.Panel):
     bl_context = "render"
 
     def draw(self, context):
-        layout = self.layout
+        layout = _split(self.layout, decorate=False)
         s = context.scene.voxlight
-        layout.use_property_split = True
         _draw_library_status(layout)
         col = layout.column(heading="Viewport")
-        col.prop(s, "viewport_enabled")
-        col.prop(s, "viewport_resolution", slider=True)
-        col.prop(s, "interactive_resolution", slider=True)
+        col.prop(s, "viewport_enabled", text="Show")
+        col.prop(s, "viewport_resolution", text="Resolution", slider=True)
+        col.prop(s, "interactive_resolution", text="While Moving", slider=True)
         col.prop(s, "settle_time")
-        col.label(text="Frames rendered: %d (%d library calls, %d stale frames dropped)"
-                  % (runtime.render_count, runtime.call_count, runtime.cancelled_count))
         col = layout.column(heading="Render")
-        col.prop(s, "render_enabled")
-        col.prop(s, "render_occlusion")
+        col.prop(s, "render_enabled", text="Composite")
+        col.prop(s, "render_occlusion", text="Mesh Occlusion")
+        col.prop(s, "render_separate_layer", text="Separate Layer")
         layout.prop(s, "use_scene_lights")
         layout.prop(s, "backend")
         layout.prop(s, "storage")
-        layout.prop(s, "memory_budget_mib")
+        layout.prop(s, "memory_budget_mib", text="Budget (MiB)")
+        layout.label(text="Frames: %d (%d library calls, %d stale dropped)"
+                     % (runtime.render_count, runtime.call_count, runtime.cancelled_count))
 
 
-_classes = (VOXLIGHT_PT_volume, VOXLIGHT_PT_scene)
+_classes = (VOXLIGHT_PT_volume, VOXLIGHT_PT_volume_rendering, VOXLIGHT_PT_volume_tf,
+            VOXLIGHT_PT_volume_lighting, VOXLIGHT_PT_volume_advanced, VOXLIGHT_PT_volume_stats,
+            VOXLIGHT_PT_scene)
 
 
 def register():
@@ -195,5 +314,11 @@ def register():
 
 
 def unregister():
+    global _previews
     for c in reversed(_classes):
         bpy.utils.unregister_class(c)
+    if _previews is not None:
+        from bpy.utils import previews
+        previews.remove(_previews)
+        _previews = None
+    _picture_keys.clear()

@@ -18,8 +18,13 @@ def model_matrix(obj):
 def look_kwargs(props, fast=False):
     """The properties that decide how the volume looks, as make_params
     keyword arguments. `fast` doubles the step for interactive frames."""
+    # The ColorRamp and the window are the transfer function. Volumes not
+    # converted yet (tf_version 0: appended from an old file) keep the old
+    # switches: library preset unless Use ColorRamp, preset window unless
+    # Custom Window.
+    legacy = props.tf_version < _tf.TF_VERSION
     window = None
-    if props.use_window:
+    if props.use_window or not legacy:
         lo, hi = sorted((props.window_low, props.window_high))
         if hi <= lo:
             hi = lo + max(abs(lo), 1.0) * 1e-6
@@ -37,7 +42,7 @@ def look_kwargs(props, fast=False):
         opacity_scale=props.opacity_scale,
         shading=props.shading,
         material=(props.ambient, props.diffuse, props.specular, props.shininess),
-        tf_rgba=_tf.table(props) if props.use_color_ramp else None,
+        tf_rgba=_tf.table(props) if props.use_color_ramp or not legacy else None,
         classify=props.classify,
         gradient_opacity=props.gradient_opacity,
         gradient_ref=props.gradient_ref,

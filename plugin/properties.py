@@ -6,32 +6,43 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, IntVectorProperty, PointerProperty, StringProperty)
 
-from . import native
+from . import native, tf
 
 # UI names of the filters this add-on knows. The list itself comes from the
 # library (vxl_filter_name up to VXL_FILTER_COUNT), so a filter added there
 # appears in the panel without editing this file; each item's number is the
 # library's VXL_FILTER_* value, so saved files and keyframes stay valid.
 _FILTER_UI = {
-    "central": ("Central", "Central differences, 6 taps"),
-    "forward3": ("Forward", "Forward differences, 3 taps against the centre sample"),
-    "sobel8": ("Sobel 8", "8 trilinear taps at (±d, ±d, ±d)"),
-    "sobel14": ("Sobel 14", "6 face and 8 corner taps"),
-    "sobel26": ("Sobel 26", "Classic weighted 26-neighbour Sobel"),
-    "precomputed": ("Precomputed", "Blur + Sobel once per volume, stored in a texture"),
-    "cubic": ("Cubic B-spline", "Analytic derivative of the interpolating cubic B-spline "
-                                "(prefiltered once per volume), 24 fetches"),
+    "central": ("Central", "Central: fast, good on clean data (6 samples per step)"),
+    "forward3": ("Forward", "Forward: the fastest, normals slightly shifted; for quick previews "
+                            "(3 samples)"),
+    "sobel8": ("Sobel 8", "Sobel 8: a little smoother than Central at about the same cost "
+                          "(8 samples)"),
+    "sobel14": ("Sobel 14", "Sobel 14: smoother, for mildly noisy scans (14 samples)"),
+    "sobel26": ("Sobel 26", "Sobel 26: smooth normals on noisy scans (26 samples, slower)"),
+    "precomputed": ("Precomputed", "Precomputed: blurred normals worked out once per volume "
+                                   "and stored; smooth and fast while orbiting, costs GPU "
+                                   "memory"),
+    "cubic": ("Cubic B-spline", "Cubic B-spline: normals of a cubic through every voxel; "
+                                "detailed surfaces on clean or synthetic data, grainy on noisy "
+                                "scans (64 voxels per sample)"),
+    "cubic-smooth": ("Cubic Smooth", "Cubic Smooth: an approximating B-spline that smooths as it "
+                                     "reconstructs; the smoothest cubic normals on real scans "
+                                     "(no extra memory)"),
 }
 # Filters whose taps do not depend on sampleDistance.
-FIXED_TAP_FILTERS = {"precomputed", "cubic"}
+FIXED_TAP_FILTERS = {"precomputed", "cubic", "cubic-smooth"}
 
+# The library's presets by name: the old "Transfer Function" enum, kept so
+# files and scripts that set it keep working (tf.on_legacy_preset loads the
+# chosen preset into the ColorRamp).
 _PRESET_UI = {
-    "auto": ("Auto", "MRI or CT default, chosen from the data range"),
-    "gray": ("Gray", "Gray ramp"),
-    "bone": ("Bone", "Bone"),
-    "hot": ("Hot", "Hot metal"),
-    "mri": ("MRI", "MRI default"),
-    "ct": ("CT", "CT default"),
+    "auto": ("Auto", "The preset that suits the data (CT or MRI)"),
+    "gray": ("Gray", "Grey ramp"),
+    "bone": ("Bone", "Ivory surfaces"),
+    "hot": ("Hot", "Heat map"),
+    "mri": ("MRI", "Warm skin fading to white"),
+    "ct": ("CT", "Soft tissue faint red, bone ivory"),
 }
 
 
@@ -66,7 +77,8 @@ def tag_redraw(self=None, context=None):
 
 class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     # --- identity, set by the importer (not animatable: they are data, not looks)
-    is_volume: BoolProperty(name="Voxlight Volume", default=False, options=set())
+    is_volume: BoolProperty(name="Voxlight Volume", default=False, options=set(),
+                            description="This object is a volume Voxlight renders")
     filepath: StringProperty(name="File", subtype="FILE_PATH", options=set(),
                              description="The file (or folder) this volume renders",
                              update=tag_redraw)
@@ -75,9 +87,16 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     voxel_to_local: FloatVectorProperty(
         name="Voxel to Local", size=16, options=set(),
         description="Voxel -> object local matrix, column-major (set by the importer)")
-    dims: IntVectorProperty(name="Dimensions", size=3, options=set())
-    data_min: FloatProperty(name="Data Minimum", options=set())
-    data_max: FloatProperty(name="Data Maximum", options=set())
+    dims: IntVectorProperty(name="Dimensions", size=3, options=set(),
+                            description="Voxels along x, y and z")
+    data_min: FloatProperty(name="Data Minimum", options=set(),
+                            description="Lowest value in the volume (data units)")
+    data_max: FloatProperty(name="Data Maximum", options=set(),
+                            description="Highest value in the volume (data units)")
+    data_kind: StringProperty(name="Kind of Data", options=set(),
+                              description="ct, mr, pet or other: decides how presets are "
+                                          "placed (set at import from the DICOM modality or "
+                                          "the value range)")
     histogram: IntVectorProperty(name="Histogram", size=32, options=set(),
                                  description="Voxel counts in 32 bins over the data range "
                                              "(computed at import)")
@@ -85,9 +104,19 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     series: StringProperty(name="DICOM Series", options=set(), update=tag_redraw,
                            description="Series of a DICOM folder: index or SeriesInstanceUID "
                                        "(empty = the only one)")
+    # Set by the importer (orientation.py); the turn is baked into the
+    # object's matrix, so reloads keep it and this records which it was.
+    orientation: EnumProperty(
+        name="Orientation", default="FILE", options=set(),
+        description="How the import placed the file's axes in the scene",
+        items=[("FILE", "File Axes", "As in the file: scanner RAS (face toward +Y) for medical "
+                                     "formats, the data's own axes for stacks and OpenVDB", 0),
+               ("BLENDER_VIEWS", "Blender Views", "Turned 180 degrees about Z so Blender's Front "
+                                                  "view shows the face", 1)])
     frame_count: IntProperty(name="Volume Frames", default=1, min=1, options=set(),
                              description="Volumes in the file (4D: fMRI, cardiac phases)")
     frame_mode: EnumProperty(name="Frame", default="TIMELINE", update=tag_redraw,
+                             description="Which volume of a 4D series is shown",
                              items=[("TIMELINE", "Follow Timeline",
                                      "Scene frame Start Frame + n shows volume frame n", 0),
                                     ("FIXED", "Fixed", "Always show Volume Frame", 1)])
@@ -98,78 +127,114 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
 
     # --- gradients
     filter: EnumProperty(name="Gradient Filter", items=FILTER_ITEMS, default="central",
+                         description="How the surface normals that lighting needs are worked "
+                                     "out: smoother filters hide scanner noise, cost more",
                          update=tag_redraw)
     sample_distance: FloatProperty(name="Sample Distance", default=1.0, min=0.25, max=3.0,
-                                   description="Gradient tap offset in voxels",
+                                   description="How far apart, in voxels, the filter's samples "
+                                               "are: larger is smoother, smaller keeps fine "
+                                               "detail",
                                    update=tag_redraw)
     reuse_gradients: BoolProperty(name="Reuse Gradients", default=False,
-                                  description="Keep the previous sample's gradient direction "
-                                              "when the gradient magnitude drops",
+                                  description="Where the surface normal becomes unreliable "
+                                              "(flat regions), keep the last good one: fewer "
+                                              "speckles inside uniform tissue",
                                   update=tag_redraw)
     gradient_16f: BoolProperty(name="16-bit Float Gradients", default=False,
-                               description="Store precomputed gradients as 16-bit float "
-                                           "instead of 8 bit", update=tag_redraw)
+                               description="Store the precomputed normals more precisely "
+                                           "(16-bit float instead of 8 bit): smoother shading, "
+                                           "twice the memory", update=tag_redraw)
     # --- sampling
     step: FloatProperty(name="Step", default=0.5, min=0.05, max=4.0, soft_min=0.1, soft_max=2.0,
-                        description="Ray step in voxels (smaller = higher quality, slower)",
+                        description="Distance between samples along each ray, in voxels: "
+                                    "smaller is finer and slower",
                         update=tag_redraw)
     jitter: BoolProperty(name="Jitter", default=True,
-                         description="Jitter ray starts to remove wood-grain banding",
+                         description="Start each ray at a slightly different depth: trades "
+                                     "wood-grain banding for fine noise",
                          update=tag_redraw)
     # --- classification
-    preset: EnumProperty(name="Transfer Function", items=PRESET_ITEMS, default="auto",
-                         update=tag_redraw)
+    preset: EnumProperty(name="Library Preset", items=PRESET_ITEMS, default="auto",
+                         description="Old files and scripts: setting it loads that preset into "
+                                     "the ColorRamp", update=tf.on_legacy_preset)
     use_color_ramp: BoolProperty(name="Use ColorRamp", default=False,
-                                 description="Use the volume's ColorRamp (colour stops and "
-                                             "their alpha = opacity) instead of the library "
-                                             "preset", update=tag_redraw)
+                                 description="Old files and scripts: the ColorRamp is always the "
+                                             "transfer function now; switching this off loads "
+                                             "the Library Preset into it",
+                                 update=tf.on_legacy_use_ramp)
+    tf_preset: StringProperty(name="Loaded Preset", options=set(),
+                              description="The preset last loaded into the ColorRamp")
+    tf_preset_signature: StringProperty(options={"HIDDEN"},
+                                        description="The ramp as the preset left it (to tell "
+                                                    "when it has been edited)")
+    tf_version: IntProperty(options={"HIDDEN"}, default=0,
+                            description="1: transfer function in the ColorRamp only; 0: a file "
+                                        "from before, converted when opened")
     tf_texture: PointerProperty(type=bpy.types.Texture, name="Transfer Function",
                                 options=set(),
                                 description="Hidden Blend texture whose ColorRamp is this "
                                             "volume's transfer function")
     classify: EnumProperty(
         name="Classification", default="post", update=tag_redraw,
-        items=[("post", "Post", "Interpolate the value, then look it up", 0),
-               ("pre", "Pre", "Classify voxels, then interpolate colour and opacity", 1),
-               ("preint", "Pre-integrated", "Pre-integrated segments (sharp transfer "
-                                            "functions without slabs)", 2)])
+        description="When the transfer function is applied: to each sample (sharp) or to "
+                    "the voxels before sampling (soft)",
+        items=[("post", "Post", "Post: look up each sample's value; sharp, the usual choice", 0),
+               ("pre", "Pre", "Pre: colour the voxels, then blend between them; softer, "
+                              "blockier edges", 1),
+               ("preint", "Pre-integrated", "Pre-integrated: exact between samples; for "
+                                            "narrow spikes in the ramp (no slab artefacts)",
+                2)])
     gradient_opacity: EnumProperty(
         name="Gradient Opacity", default="off", update=tag_redraw,
+        description="Make opacity depend on how fast values change, not only on the value",
         items=[("off", "Off", "Opacity from the transfer function only", 0),
-               ("boundary", "Boundary", "Scale opacity by gradient magnitude "
-                                        "(Levoy's boundary emphasis)", 1),
-               ("iso", "Iso-surface", "Levoy's iso-value contour surface", 2)])
+               ("boundary", "Boundary", "Boundary: only where values change (edges between "
+                                        "tissues) stays opaque; uniform regions fade", 1),
+               ("iso", "Iso-surface", "Iso-surface: a thin shell at one value, like a "
+                                      "surface mesh", 2)])
     gradient_ref: FloatProperty(name="Gradient Reference", default=0.05, min=0.0001,
                                 soft_max=1.0, update=tag_redraw,
-                                description="Gradient magnitude (normalised value per "
-                                            "voxel) that gives full opacity")
+                                description="How sharp an edge must be for full opacity "
+                                            "(change of the normalised value per voxel)")
     gradient_exp: FloatProperty(name="Gradient Exponent", default=1.0, min=0.01, max=16.0,
                                 update=tag_redraw,
-                                description="Exponent of the gradient-magnitude term")
+                                description="Above 1, weak edges fade faster; below 1, "
+                                            "they stay visible")
     iso_value: FloatProperty(name="Iso Value", default=0.0, update=tag_redraw,
-                             description="Data value of the iso-surface")
+                             description="The value, in data units, the surface is drawn "
+                                         "at")
     iso_thickness: FloatProperty(name="Iso Thickness", default=1.0, min=0.01, max=16.0,
                                  update=tag_redraw,
-                                 description="Thickness of the iso-surface in voxels")
-    use_window: BoolProperty(name="Custom Window", default=False,
-                             description="Map the transfer function onto Low..High instead of "
-                                         "the preset's default window", update=tag_redraw)
+                                 description="How thick the surface is, in voxels")
+    use_window: BoolProperty(name="Custom Window", default=False, update=tag_redraw,
+                             description="Old files and scripts: the window is always used "
+                                         "now (files from before are converted when opened)")
     window_low: FloatProperty(name="Low", default=0.0, update=tag_redraw,
-                              description="Data value at the start of the transfer function")
+                              description="The data value at the ramp's left end: lower values "
+                                          "take the leftmost colour")
     window_high: FloatProperty(name="High", default=1.0, update=tag_redraw,
-                               description="Data value at the end of the transfer function")
+                               description="The data value at the ramp's right end: higher "
+                                           "values take the rightmost colour")
     opacity_scale: FloatProperty(name="Opacity", default=1.0, min=0.0, soft_max=4.0, max=100.0,
-                                 description="Multiplies the transfer function's opacity",
+                                 description="Makes the whole volume more (above 1) or less "
+                                             "(below 1) opaque",
                                  update=tag_redraw)
     # --- shading
     shading: BoolProperty(name="Shading", default=True,
-                          description="Phong shading from the scene's lights; off = pure "
-                                      "emission-absorption", update=tag_redraw)
-    ambient: FloatProperty(name="Ambient", default=0.3, min=0.0, max=1.0, update=tag_redraw)
-    diffuse: FloatProperty(name="Diffuse", default=0.7, min=0.0, max=1.0, update=tag_redraw)
-    specular: FloatProperty(name="Specular", default=0.3, min=0.0, max=1.0, update=tag_redraw)
+                          description="Light the volume's surfaces with the scene's lights; "
+                                      "off shows the colours unlit, like an X-ray in colour",
+                          update=tag_redraw)
+    ambient: FloatProperty(name="Ambient", default=0.3, min=0.0, max=1.0, update=tag_redraw,
+                           description="Light everywhere, even in shadow: higher is flatter")
+    diffuse: FloatProperty(name="Diffuse", default=0.7, min=0.0, max=1.0, update=tag_redraw,
+                           description="Light that depends on the surface facing the lamp: "
+                                       "shows shape")
+    specular: FloatProperty(name="Specular", default=0.3, min=0.0, max=1.0, update=tag_redraw,
+                            description="Strength of the shiny highlights")
     shininess: FloatProperty(name="Shininess", default=24.0, min=1.0, max=256.0,
-                             update=tag_redraw)
+                             update=tag_redraw,
+                             description="Size of the highlights: higher is smaller and "
+                                         "sharper, like a glossier surface")
 
 
 BACKEND_ITEMS = [("auto", "Auto", "EGL on a GPU, then OSMesa, then EGL on Mesa"),
@@ -178,14 +243,16 @@ BACKEND_ITEMS = [("auto", "Auto", "EGL on a GPU, then OSMesa, then EGL on Mesa")
 
 
 class VoxlightSceneProperties(bpy.types.PropertyGroup):
-    viewport_enabled: BoolProperty(name="Show in Viewport", default=True, update=tag_redraw)
+    viewport_enabled: BoolProperty(name="Show in Viewport", default=True, update=tag_redraw,
+                                   description="Draw Voxlight volumes in the 3D viewports")
     viewport_resolution: FloatProperty(
         name="Viewport Resolution", default=1.0, min=0.05, max=1.0, subtype="FACTOR",
         description="Fraction of the viewport's pixels rendered once the view is still",
         update=tag_redraw)
     interactive_resolution: FloatProperty(
         name="Interactive Resolution", default=0.35, min=0.05, max=1.0, subtype="FACTOR",
-        description="Fraction of the pixels rendered while the view moves", update=tag_redraw)
+        description="Most of the viewport's resolution used while the view moves; lowered "
+                    "automatically to keep about 10 frames a second", update=tag_redraw)
     settle_time: FloatProperty(name="Refine After", default=0.3, min=0.0, max=5.0,
                                subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE",
                                description="Seconds without view change before the "
@@ -196,11 +263,17 @@ class VoxlightSceneProperties(bpy.types.PropertyGroup):
     render_enabled: BoolProperty(name="Composite in Renders", default=True,
                                  description="Render volumes in F12/animation renders and "
                                              "composite them over the render")
+    render_separate_layer: BoolProperty(
+        name="Volume as Separate Layer", default=False,
+        description="Leave the compositing nodes alone and give the volume as images to wire "
+                    "yourself (Voxlight Color, Alpha, Depth). Off: the volume is laid into the "
+                    "render before your own compositing nodes, so they affect it too")
     render_occlusion: BoolProperty(name="Mesh Occlusion", default=True,
                                    description="Rasterise the scene's meshes so rays stop at "
                                                "them in F12 renders")
     backend: EnumProperty(name="Backend", items=BACKEND_ITEMS, default="auto",
-                          description="OpenGL backend for new renderers")
+                          description="How the library reaches OpenGL; Auto picks the GPU when "
+                                      "there is one (volumes loaded later use it)")
     storage: EnumProperty(name="Storage", default="auto",
                           items=[("auto", "Auto", "One texture when it fits the texture limit and "
                                   "the budget, else bricked"),

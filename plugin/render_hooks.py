@@ -2,7 +2,8 @@
 scene's volumes with the scene camera at the render resolution (render_pre
 arms, the pipeline's own frame_change_post renders), write them into a
 float Image, and the compositor (compositor.py) lays that image over the
-engine's output. Works in background mode, where gpu drawing and draw
+engine's output before the user's own compositing nodes (or, with "Volume
+as Separate Layer", fills one image per pass for the user to wire). Works in background mode, where gpu drawing and draw
 handlers are unavailable, because the library renders on its own context.
 """
 
@@ -36,12 +37,24 @@ def display_to_linear(rgba):
 _pending = False  # a render job is between render_pre and its compositing
 
 
+def _prepare_nodes(scene):
+    w, h = offline.render_size(scene)
+    if scene.voxlight.render_separate_layer:
+        compositor.ensure_pass_nodes(scene, w, h)
+    else:
+        compositor.ensure_nodes(scene, compositor.ensure_image(w, h))
+
+
+def _show_nothing(scene):
+    compositor.mute(scene)
+    compositor.clear_passes(scene)
+
+
 @persistent
 def on_render_init(scene, *args):
     """Nodes must exist before the pipeline decides whether to composite."""
     if scene.voxlight.render_enabled and _volumes_present(scene) and scene.camera:
-        w, h = offline.render_size(scene)
-        compositor.ensure_nodes(scene, compositor.ensure_image(w, h))
+        _prepare_nodes(scene)
 
 
 @persistent
@@ -49,11 +62,10 @@ def on_render_pre(scene, *args):
     global _pending
     s = scene.voxlight
     if not s.render_enabled or not _volumes_present(scene) or scene.camera is None:
-        compositor.mute(scene)
+        _show_nothing(scene)
         _pending = False
         return
-    w, h = offline.render_size(scene)
-    compositor.ensure_nodes(scene, compositor.ensure_image(w, h))
+    _prepare_nodes(scene)
     _pending = True
 
 
@@ -77,13 +89,16 @@ def on_frame_change_post(scene, depsgraph=None, *args):
     except native.VoxlightError as e:
         last_error = str(e)
         print("Voxlight: render failed: %s" % e)
-        compositor.mute(scene)
+        _show_nothing(scene)
         return
     last_error = ""
     if result is None or not result[0][..., 3].any():  # nothing, or all outside the frame
-        compositor.mute(scene)
+        _show_nothing(scene)
         return
-    rgba, _depth = result
+    rgba, depth = result
+    if s.render_separate_layer:
+        compositor.write_passes(scene, display_to_linear(rgba), depth)
+        return
     img = compositor.ensure_image(w, h)
     img.pixels.foreach_set(display_to_linear(rgba).ravel())
     img.update()

@@ -19,7 +19,7 @@ import os
 import threading
 import time
 
-from . import frames, native
+from . import frames, native, tf_fit
 
 _lock = threading.Lock()
 render_count = 0
@@ -277,7 +277,10 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
         if stop():
             return None
         renderer.set_volume(vol)
-        info = dict(vol.info, histogram=vol.histogram(32))  # for the panel, from any format
+        # For the panel (32 bins, saved with the object) and for fitting presets
+        # to the data (tf_fit); the library counts them for every format.
+        info = dict(vol.info, histogram=vol.histogram(32),
+                    histogram_fine=vol.histogram(tf_fit.HISTOGRAM_BINS))
         if stop():
             return None
         entry = VolumeEntry(path, renderer, info, series, {"storage": storage, "memory_budget": memory_budget})

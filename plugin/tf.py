@@ -1,4 +1,5 @@
-"""The transfer function as Blender's own ColorRamp, and medical presets.
+"""The transfer function: one editor, Blender's own ColorRamp, and the
+presets that load into it.
 
 Each volume owns a hidden Blend texture (Object.voxlight.tf_texture, named
 ".VXL TF <object>") whose ColorRamp is the transfer function: stop colours
@@ -8,100 +9,121 @@ library as vxl_render_params.tf_rgba; the window (Low/High) maps the ramp's
 [0, 1] onto data values. The sampled table is part of the frame key
 (native.params_digest hashes the arrays a params struct points at), so
 editing a stop re-renders the viewport; F12 builds its params the same way.
+
+Presets (tf_presets: the library's built-in tables and 3D Slicer's) are
+placed on the volume's data by tf_fit (Hounsfield units on CT, the data's
+histogram otherwise) and written into the ramp; the panel names the loaded
+preset and says when the ramp has been edited since.
+
+Files and scripts from before the single editor: the old "Transfer
+Function" enum (Object.voxlight.preset) and "Use ColorRamp" still exist.
+Setting the enum loads that preset into the ramp; a file saved with them
+is converted when it is opened (migrate_legacy) so it looks as it did.
 """
+
+import os
 
 import bpy
 import numpy as np
 
-TABLE_SIZE = 256
+from . import runtime, tf_fit, tf_presets
 
-# Scalar-opacity and colour-transfer points copied from 3D Slicer,
-# Modules/Loadable/VolumeRendering/Resources/presets.xml (VolumeProperty
-# "scalarOpacity" = x, opacity pairs; "colorTransfer" = x, r, g, b
-# quadruples; x in data units: Hounsfield units for CT).
-SLICER_PRESETS = {
-    "CT_BONE": {
-        "name": "CT Bone", "slicer": "CT-Bone",
-        "opacity": [(-3024, 0), (-16.4458, 0), (641.385, 0.715686), (3071, 0.705882)],
-        "color": [(-3024, 0, 0, 0), (-16.4458, 0.729412, 0.254902, 0.301961),
-                  (641.385, 0.905882, 0.815686, 0.552941), (3071, 1, 1, 1)],
-    },
-    "CT_SOFT_TISSUE": {
-        "name": "CT Soft Tissue", "slicer": "CT-Soft-Tissue",
-        "opacity": [(-2048, 0), (-167.01, 0), (-160, 1), (240, 1), (3661, 1)],
-        "color": [(-2048, 0, 0, 0), (-167.01, 0, 0, 0),
-                  (-160, 0.0556356, 0.0556356, 0.0556356), (240, 1, 1, 1), (3661, 1, 1, 1)],
-    },
-    "CT_LUNG": {
-        "name": "CT Lung", "slicer": "CT-Lung",
-        "opacity": [(-1000, 0), (-600, 0), (-599, 0.15), (-400, 0.15), (-399, 0), (2952, 0)],
-        "color": [(-1000, 0.3, 0.3, 1), (-600, 0, 0, 1), (-530, 0.134704, 0.781726, 0.0724558),
-                  (-460, 0.929244, 1, 0.109473), (-400, 0.888889, 0.254949, 0.0240258),
-                  (2952, 1, 0.3, 0.3)],
-    },
-    "MR_DEFAULT": {
-        "name": "MR Default", "slicer": "MR-Default",
-        "opacity": [(0, 0), (20, 0), (40, 0.15), (120, 0.3), (220, 0.375), (1024, 0.5)],
-        "color": [(0, 0, 0, 0), (20, 0.168627, 0, 0), (40, 0.403922, 0.145098, 0.0784314),
-                  (120, 0.780392, 0.607843, 0.380392), (220, 0.847059, 0.835294, 0.788235),
-                  (1024, 1, 1, 1)],
-    },
-    "MR_ANGIO": {
-        "name": "MR Angio", "slicer": "MR-Angio",
-        "opacity": [(-2048, 0), (151.354, 0), (158.279, 0.4375), (190.112, 0.580357),
-                    (200.873, 0.732143), (3661, 0.741071)],
-        "color": [(-2048, 0, 0, 0), (151.354, 0, 0, 0), (158.279, 0.74902, 0.376471, 0),
-                  (190.112, 1, 0.866667, 0.733333), (200.873, 0.937255, 0.937255, 0.937255),
-                  (3661, 1, 1, 1)],
-    },
-}
-PRESET_ITEMS = [(k, v["name"], "3D Slicer's %s volume-rendering preset" % v["slicer"])
-                for k, v in SLICER_PRESETS.items()]
+TABLE_SIZE = tf_presets.TABLE_SIZE
+TF_VERSION = 1  # Object.voxlight.tf_version of volumes that use the single editor
+
+# Kept for scripts written against the ColorRamp presets of issue 6.
+SLICER_PRESETS = tf_presets.SLICER_PRESETS
+PRESET_ITEMS = [(k, p.name, p.description) for k, p in tf_presets.PRESETS.items()]
 
 
-def preset_stops(key):
-    """(window_low, window_high, [(position, (r, g, b, a)), ...]) for a
-    preset: stops at the union of the opacity and colour points, positions
-    normalised to the window. The window starts at the last point before
-    the opacity first rises (everything below is transparent and the table
-    clamps), so the 256 entries are spent where the preset changes."""
-    pr = SLICER_PRESETS[key]
-    op = np.array(pr["opacity"], np.float64)
-    co = np.array(pr["color"], np.float64)
-    xs = np.unique(np.concatenate([op[:, 0], co[:, 0]]))
-    first_visible = np.nonzero(op[:, 1] > 0)[0]
-    lo = op[max(first_visible[0] - 1, 0), 0] if len(first_visible) else xs[0]
-    hi = xs[-1]
-    xs = xs[xs >= lo]
-    stops = []
-    for x in xs:
-        rgb = [float(np.interp(x, co[:, 0], co[:, c])) for c in (1, 2, 3)]
-        a = float(np.interp(x, op[:, 0], op[:, 1]))
-        stops.append((float((x - lo) / (hi - lo)), (*rgb, a)))
-    return float(lo), float(hi), stops
+# ------------------------------------------------------------------ data
+
+def kind_of(p):
+    """The volume's kind of data ('ct', 'mr', 'pet', 'other'), as guessed
+    at import; volumes from older files are guessed from their range."""
+    return p.data_kind or tf_fit.guess_kind(p.data_min, p.data_max)
 
 
-def ensure_texture(obj):
-    """The object's ColorRamp texture, created (grey ramp) when missing."""
+def stats_of(obj, info=None):
+    """tf_fit.DataStats of the volume: the fine histogram of its live
+    entry (or of `info`, during import) when there is one, else the
+    32-bin histogram saved with the object."""
+    p = obj.voxlight
+    if info is None:
+        entry = runtime.find_entry(bpy.path.abspath(p.filepath), p.series)
+        info = entry.info if entry is not None else None
+    if info is not None and info.get("histogram_fine") is not None:
+        return tf_fit.DataStats(info["histogram_fine"], info["value_min"], info["value_max"])
+    return tf_fit.DataStats(list(p.histogram), p.data_min, p.data_max)
+
+
+def histogram_of(obj):
+    """(counts, lo, hi) for the panel's picture: the finest one at hand."""
+    s = stats_of(obj)
+    return s.counts, s.lo, s.hi
+
+
+def dicom_modality(path, series="", dims=None):
+    """The DICOM Modality (0008,0060) of the imported series, "" when the
+    input is not DICOM or the library does not say. Without a series
+    choice: the only series, or the one of the volume's size `dims`."""
+    from . import native
+    low = path.lower()
+    if not (os.path.isdir(path) or low.endswith(".dcm") or os.path.basename(low) == "dicomdir"):
+        return ""
+    try:
+        found = native.list_dicom_series(path)
+    except Exception:  # a modality is a hint; its absence is not an error
+        return ""
+    if not found:
+        return ""
+    pick = None
+    if series:
+        for i, s in enumerate(found):
+            if series in (str(i), s["uid"]):
+                pick = s
+    elif len(found) == 1:
+        pick = found[0]
+    elif dims is not None:
+        same = [s for s in found if tuple(s["dims"]) == tuple(dims)]
+        pick = same[0] if len(same) == 1 else None
+    return (pick or {}).get("modality", "") or ""
+
+
+# ------------------------------------------------------------------ ramp
+
+def ensure_texture(obj, info=None):
+    """The object's ColorRamp texture. A volume without one gets it, loaded
+    with the preset that suits its data (tf_fit.default_preset: from the
+    DICOM modality, the value range and the histogram). `info` is the
+    import's volume info while the entry is not registered yet."""
     p = obj.voxlight
     tex = p.tf_texture
-    if tex is None or not tex.use_color_ramp:
-        tex = bpy.data.textures.new(".VXL TF %s" % obj.name, type="BLEND")
-        tex.use_color_ramp = True
-        ramp = tex.color_ramp
-        ramp.interpolation = "LINEAR"
-        ramp.elements[0].position, ramp.elements[0].color = 0.0, (0.0, 0.0, 0.0, 0.0)
-        ramp.elements[1].position, ramp.elements[1].color = 1.0, (1.0, 1.0, 1.0, 1.0)
-        p.tf_texture = tex
+    if tex is not None and tex.use_color_ramp:
+        return tex
+    tex = bpy.data.textures.new(".VXL TF %s" % obj.name, type="BLEND")
+    tex.use_color_ramp = True
+    ramp = tex.color_ramp
+    ramp.interpolation = "LINEAR"
+    ramp.elements[0].position, ramp.elements[0].color = 0.0, (0.0, 0.0, 0.0, 0.0)
+    ramp.elements[1].position, ramp.elements[1].color = 1.0, (1.0, 1.0, 1.0, 1.0)
+    p.tf_texture = tex
+    if not p.data_kind:
+        p.data_kind = tf_fit.guess_kind(p.data_min, p.data_max,
+                                        dicom_modality(bpy.path.abspath(p.filepath), p.series,
+                                                       tuple(p.dims)))
+    p.tf_version = TF_VERSION
+    load_preset(obj, tf_fit.default_preset(p.data_kind), info=info)
     return tex
 
 
 def set_ramp(ramp, stops):
-    """Replace a ColorRamp's stops with [(position, rgba), ...]."""
+    """Replace a ColorRamp's stops with [(position, rgba), ...] (at most
+    32, Blender's limit)."""
     els = ramp.elements
     while len(els) > 1:
         els.remove(els[-1])
-    els[0].position = stops[0][0]
+    els[0].position = min(max(stops[0][0], 0.0), 1.0)
     els[0].color = stops[0][1]
     for pos, rgba in stops[1:]:
         e = els.new(min(max(pos, 0.0), 1.0))
@@ -112,16 +134,60 @@ def set_ramp(ramp, stops):
     ramp.color_mode = "RGB"
 
 
-def apply_preset(obj, key):
-    """Rewrite the object's ramp from a preset and set its window."""
-    lo, hi, stops = preset_stops(key)
-    tex = ensure_texture(obj)
-    set_ramp(tex.color_ramp, stops)
+def ramp_signature(ramp):
+    """A string that changes when any stop, colour or the interpolation of
+    the ramp changes (the panel's "modified" mark)."""
+    parts = [ramp.interpolation, ramp.color_mode]
+    for e in ramp.elements:
+        parts.append("%.4f:%.4f,%.4f,%.4f,%.4f" % (e.position, *e.color))
+    return ";".join(parts)
+
+
+def preset_state(p):
+    """(name of the loaded preset or "", edited since it was loaded)."""
+    pr = tf_presets.PRESETS.get(p.tf_preset)
+    if pr is None:
+        return "", True
+    tex = p.tf_texture
+    modified = tex is None or not tex.use_color_ramp or \
+        ramp_signature(tex.color_ramp) != p.tf_preset_signature
+    return pr.name, modified
+
+
+def load_preset(obj, key, info=None):
+    """Write preset `key` (tf_presets.PRESETS), placed on this volume's
+    data, into its ramp, and set the window."""
     p = obj.voxlight
+    lo, hi, stops = tf_fit.place(key, kind_of(p), stats_of(obj, info))
+    tex = p.tf_texture
+    if tex is None or not tex.use_color_ramp:
+        tex = ensure_texture(obj, info)  # creates, then loads the default: reloaded below
+    set_ramp(tex.color_ramp, stops)
     p.window_low, p.window_high = lo, hi
-    p.use_window = True
-    p.use_color_ramp = True
+    _set_legacy_flags(p)
+    p.tf_preset = key
+    p.tf_preset_signature = ramp_signature(tex.color_ramp)
     tex.update_tag()
+
+
+def apply_preset(obj, key):
+    """Kept for scripts of issue 6: load a preset (now fitted to the data)."""
+    load_preset(obj, key)
+
+
+def fit_window(obj, low_quantile=0.0, high_quantile=0.995):
+    """Place the window by the data's histogram. An unedited preset is
+    placed again as loading it would; an edited ramp keeps its stops and is
+    stretched over the non-background voxels from low_quantile to
+    high_quantile. Returns (low, high)."""
+    p = obj.voxlight
+    name, modified = preset_state(p)
+    if name and not modified:
+        load_preset(obj, p.tf_preset)
+    else:
+        p.window_low, p.window_high = tf_fit.fit_window(stats_of(obj), low_quantile,
+                                                        high_quantile)
+    return p.window_low, p.window_high
 
 
 def table(props, size=TABLE_SIZE):
@@ -137,38 +203,140 @@ def table(props, size=TABLE_SIZE):
     return out
 
 
-_BARS = " ▁▂▃▄▅▆▇█"
+# ------------------------------------------------ files and scripts before TF_VERSION 1
+
+_quiet = False  # set while this module writes the legacy flags itself
 
 
-def histogram_text(counts):
-    """One line of block characters, log-scaled counts."""
-    c = np.log1p(np.asarray(counts, np.float64))
-    if c.max() <= 0:
-        return ""
-    lv = np.round(c / c.max() * (len(_BARS) - 1)).astype(int)
-    return "".join(_BARS[i] for i in lv)
+def _set_legacy_flags(p):
+    """The old switches say what is now always true: the window and the
+    ramp are in use."""
+    global _quiet
+    _quiet = True
+    try:
+        if not p.use_window:
+            p.use_window = True
+        if not p.use_color_ramp:
+            p.use_color_ramp = True
+    finally:
+        _quiet = False
 
+
+def _legacy_window(p, key):
+    """The window the library used when the old settings gave none."""
+    if p.use_window:
+        return p.window_low, p.window_high
+    if key == "CT":  # vxl_preset_window: Hounsfield air to dense bone
+        return -1000.0, 2000.0
+    return p.data_min, p.data_max
+
+
+def _legacy_key(p):
+    if p.preset == "auto":  # vxl_preset_resolve
+        return "CT" if p.data_min <= -500 else "MRI"
+    return tf_presets.LEGACY_ENUM.get(p.preset, "MRI")
+
+
+def migrate_legacy(obj):
+    """Convert a volume saved before the single editor so it looks the same:
+    a library preset becomes its table in the ramp, and the window the
+    library chose becomes the explicit window."""
+    p = obj.voxlight
+    key = _legacy_key(p)
+    had_ramp = p.use_color_ramp and p.tf_texture is not None and p.tf_texture.use_color_ramp
+    p.window_low, p.window_high = _legacy_window(p, key)
+    if not had_ramp:
+        tex = p.tf_texture
+        if tex is None or not tex.use_color_ramp:
+            tex = bpy.data.textures.new(".VXL TF %s" % obj.name, type="BLEND")
+            tex.use_color_ramp = True
+            p.tf_texture = tex
+        set_ramp(tex.color_ramp, tf_presets.table_to_stops(tf_presets.builtin_table(key.lower())))
+        p.tf_preset = key
+        p.tf_preset_signature = ramp_signature(tex.color_ramp)
+    _set_legacy_flags(p)
+    if not p.data_kind:
+        p.data_kind = tf_fit.guess_kind(p.data_min, p.data_max)
+    p.tf_version = TF_VERSION
+
+
+def on_legacy_preset(props, context):
+    """Update of the old "Transfer Function" enum: load that preset."""
+    if _quiet:
+        return
+    obj = props.id_data
+    if isinstance(obj, bpy.types.Object) and props.is_volume:
+        key = _legacy_key(props) if props.preset != "auto" else \
+            tf_fit.default_preset(kind_of(props))
+        load_preset(obj, key)
+    _redraw()
+
+
+def on_legacy_use_ramp(props, context):
+    """Update of the old "Use ColorRamp": off meant the library preset,
+    which now means loading it into the ramp."""
+    if _quiet:
+        return
+    if not props.use_color_ramp:
+        on_legacy_preset(props, context)
+    else:
+        _redraw()
+
+
+# ------------------------------------------------------------- operators
 
 class VOXLIGHT_OT_tf_preset(bpy.types.Operator):
-    """Rewrite the volume's ColorRamp and window from a 3D Slicer preset"""
+    """Load a transfer-function preset into the volume's ColorRamp, placed on its data"""
     bl_idname = "voxlight.tf_preset"
     bl_label = "Load Transfer-Function Preset"
     bl_options = {"REGISTER", "UNDO"}
 
-    preset: bpy.props.EnumProperty(name="Preset", items=PRESET_ITEMS)
+    preset: bpy.props.EnumProperty(name="Preset", items=PRESET_ITEMS,
+                                   description="The preset to load")
+
+    @classmethod
+    def poll(cls, context):
+        return context.object is not None and context.object.voxlight.is_volume
+
+    @classmethod
+    def description(cls, context, properties):
+        pr = tf_presets.PRESETS.get(properties.preset)
+        return pr.description if pr is not None else cls.__doc__
+
+    def execute(self, context):
+        load_preset(context.object, self.preset)
+        _redraw()
+        return {"FINISHED"}
+
+
+class VOXLIGHT_OT_tf_fit_window(bpy.types.Operator):
+    """Place the window by the data's histogram: an unedited preset is placed again, an edited ramp is stretched over the non-background values"""
+    bl_idname = "voxlight.tf_fit_window"
+    bl_label = "Fit Window to Data"
+    bl_options = {"REGISTER", "UNDO"}
+
+    low_quantile: bpy.props.FloatProperty(
+        name="Low", default=0.0, min=0.0, max=1.0, subtype="FACTOR",
+        description="Share of the non-background voxels below the window's start "
+                    "(edited ramps)")
+    high_quantile: bpy.props.FloatProperty(
+        name="High", default=0.995, min=0.0, max=1.0, subtype="FACTOR",
+        description="Share of the non-background voxels below the window's end "
+                    "(edited ramps)")
 
     @classmethod
     def poll(cls, context):
         return context.object is not None and context.object.voxlight.is_volume
 
     def execute(self, context):
-        apply_preset(context.object, self.preset)
+        lo, hi = sorted((self.low_quantile, self.high_quantile))
+        fit_window(context.object, lo, hi)
         _redraw()
         return {"FINISHED"}
 
 
 class VOXLIGHT_OT_tf_ramp(bpy.types.Operator):
-    """Give the volume a ColorRamp transfer function (grey ramp)"""
+    """Give the volume a ColorRamp transfer function again (with the preset that suits its data)"""
     bl_idname = "voxlight.tf_ramp"
     bl_label = "Create ColorRamp"
     bl_options = {"REGISTER", "UNDO"}
@@ -179,14 +347,33 @@ class VOXLIGHT_OT_tf_ramp(bpy.types.Operator):
 
     def execute(self, context):
         ensure_texture(context.object)
-        context.object.voxlight.use_color_ramp = True
         _redraw()
         return {"FINISHED"}
+
+
+class VOXLIGHT_MT_tf_presets(bpy.types.Menu):
+    """Presets by the data they are made for"""
+    bl_idname = "VOXLIGHT_MT_tf_presets"
+    bl_label = "Transfer-Function Presets"
+
+    def draw(self, context):
+        layout = self.layout
+        for i, (heading, presets) in enumerate(tf_presets.menu_sections()):
+            if i:
+                layout.separator()
+            layout.label(text=heading)
+            for pr in presets:
+                layout.operator(VOXLIGHT_OT_tf_preset.bl_idname, text=pr.name).preset = pr.key
 
 
 def _redraw():
     from .properties import tag_redraw
     tag_redraw()
+    wm = getattr(bpy.context, "window_manager", None)
+    for win in (wm.windows if wm is not None else ()):
+        for area in win.screen.areas:
+            if area.type == "PROPERTIES":
+                area.tag_redraw()
 
 
 @bpy.app.handlers.persistent
@@ -197,20 +384,35 @@ def _on_depsgraph_update(scene, depsgraph=None):
         _redraw()
 
 
-_classes = (VOXLIGHT_OT_tf_preset, VOXLIGHT_OT_tf_ramp)
+@bpy.app.handlers.persistent
+def _on_load_post(*_args):
+    for obj in bpy.data.objects:
+        p = getattr(obj, "voxlight", None)
+        if p is not None and p.is_volume and p.tf_version < TF_VERSION and obj.library is None:
+            migrate_legacy(obj)
+
+
+_classes = (VOXLIGHT_OT_tf_preset, VOXLIGHT_OT_tf_fit_window, VOXLIGHT_OT_tf_ramp,
+            VOXLIGHT_MT_tf_presets)
+_handlers = (("depsgraph_update_post", _on_depsgraph_update), ("load_post", _on_load_post))
 
 
 def register():
     for c in _classes:
         bpy.utils.register_class(c)
-    if _on_depsgraph_update not in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph_update)
+    for name, fn in _handlers:
+        lst = getattr(bpy.app.handlers, name)
+        if fn not in lst:
+            lst.append(fn)
 
 
 def unregister():
-    for h in list(bpy.app.handlers.depsgraph_update_post):
-        if getattr(h, "__name__", "") == "_on_depsgraph_update" and \
-                getattr(h, "__module__", "").startswith(__name__.rsplit(".", 1)[0]):
-            bpy.app.handlers.depsgraph_update_post.remove(h)
+    pkg = __name__.rsplit(".", 1)[0]
+    for name, fn in _handlers:
+        lst = getattr(bpy.app.handlers, name)
+        for h in list(lst):
+            if getattr(h, "__name__", "") == fn.__name__ and \
+                    getattr(h, "__module__", "").startswith(pkg):
+                lst.remove(h)
     for c in reversed(_classes):
         bpy.utils.unregister_class(c)

@@ -12,13 +12,18 @@ Per region and volume, on every redraw:
      Equal hash = the image on screen is still right: nothing is rendered.
   4. Otherwise, progressive refinement:
        * an interactive frame (reduced resolution, doubled step) is
-         rendered synchronously so the view follows the mouse;
-       * once the view has been still for "Refine After" seconds, the full
-         frame is queued on the renderer's background worker
-         (runtime.Worker), which renders it in bands and drops it between
-         bands as soon as it is stale (the view or anything else changed);
-         a timer polls for the result and redraws. The draw handler never
-         waits for a full frame: at most for the band in flight.
+         rendered synchronously so the view follows the mouse; its
+         resolution adapts to the measured frame time so a moving view
+         keeps about 10 frames a second (resolution_policy.ScalePolicy,
+         at most the "While Moving" resolution);
+       * once the view has been still for "Refine After" seconds, refined
+         frames are queued on the renderer's background worker
+         (runtime.Worker): half the still resolution first (when that is
+         sharper than the preview), then the full still resolution. The
+         worker renders them in bands and drops one between bands as soon
+         as it is stale (the view or anything else changed); a timer polls
+         for the result and redraws. The draw handler never waits for a
+         refined frame: at most for the band in flight.
   5. Draw a full-screen quad with gl_FragDepth from the library's depth,
      depth test LESS_EQUAL and premultiplied blending (no depth writes).
      Where the volume has no hit the fragment gets the scene's own depth,
@@ -37,7 +42,7 @@ from bpy.app.handlers import persistent
 from gpu_extras.batch import batch_for_shader
 
 from . import depth as _depth
-from . import native, params, runtime, volume_space
+from . import native, params, resolution_policy, runtime, volume_space
 
 _handle = None
 _shader = None
@@ -58,9 +63,10 @@ class _Image:
     """One rendered frame, uploaded: GPUTextures must outlive the draw call
     that samples them, so they live here until replaced."""
 
-    def __init__(self, key, rgba, vdepth, win_small, proj, full):
+    def __init__(self, key, rgba, vdepth, win_small, proj, full, scale=1.0):
         self.key = key
         self.full = full
+        self.scale = scale
         self.height, self.width = rgba.shape[:2]
         self.vdepth = vdepth
         self.proj = proj
@@ -90,7 +96,10 @@ class _State:
         self.moved_at = -1e9
         self.used_at = 0.0
         self.fast = None      # latest interactive _Image
+        self.half = None      # latest refined _Image at half the still resolution
         self.full = None      # latest full-resolution _Image
+        self.policy = None    # resolution_policy.ScalePolicy of the interactive frames
+        self.pixels_at_scale_1 = 0  # the volume's footprint at scale 1, from the last preview
         self.shown = None     # the _Image drawn last
         self.job = None       # runtime.Job of the full frame being refined
         self.job_entry = None
@@ -190,6 +199,14 @@ def _tag_region(region_ptr):
                 area.tag_redraw()
 
 
+def _tag_properties():
+    wm = getattr(bpy.context, "window_manager", None)
+    for win in (wm.windows if wm is not None else ()):
+        for area in win.screen.areas:
+            if area.type == "PROPERTIES":
+                area.tag_redraw()
+
+
 def _poll():
     """Main-thread timer: redraw the regions whose refined frame is ready."""
     global _poll_registered
@@ -228,8 +245,9 @@ def busy():
 class _Frame:
     """Everything one render of one volume at one size needs, and its key."""
 
-    def __init__(self, ob, entry, w, h, view, proj, model, raw_depth, lights, fast):
+    def __init__(self, ob, entry, w, h, view, proj, model, raw_depth, lights, fast, scale=1.0):
         self.w, self.h = w, h
+        self.scale = scale
         dims = tuple(ob.voxlight.dims)
         self.rect = volume_space.screen_rect(model, dims, view, proj, w, h)
         self.win_small = None
@@ -247,6 +265,15 @@ class _Frame:
 
 def _size(W, H, frac):
     return max(1, round(W * frac)), max(1, round(H * frac))
+
+
+def _frame_at(scale, ob, entry, W, H, view, proj, model, raw_depth, lights, fast):
+    w, h = _size(W, H, scale)
+    return _Frame(ob, entry, w, h, view, proj, model, raw_depth, lights, fast, scale)
+
+
+def _rect_pixels(rect):
+    return 0 if rect is None else (rect[2] - rect[0]) * (rect[3] - rect[1])
 
 
 def _draw_image(img, shader, batch):
@@ -362,47 +389,89 @@ def _draw():
 def _update(st, ob, entry, W, H, view, proj, model, raw_depth, lights, moving, owner):
     """Decide what to show for one volume; render only what is missing."""
     s = bpy.context.scene.voxlight
+    if st.policy is None:
+        st.policy = resolution_policy.ScalePolicy(s.interactive_resolution)
+    args = (ob, entry, W, H, view, proj, model, raw_depth, lights)
     if not moving:
-        fw, fh = _size(W, H, s.viewport_resolution)
-        full = _Frame(ob, entry, fw, fh, view, proj, model, raw_depth, lights, fast=False)
-        job = st.job
-        if job is not None and job.done and job.key == full.key and job.result is not None:
-            rgba, vdepth, _stats = job.result
-            st.full = _Image(full.key, rgba, vdepth, full.win_small, proj, True)
-            st.job = None
-        elif job is not None and job.done and job.key == full.key and job.error is not None:
-            st.job = None
-            st.error_key = full.key
-            raise native.VoxlightError(str(job.error))
-        if st.full is not None and st.full.key == full.key:
-            st.full.update_depth(full.win_small)
-            st.cancel_job()
-            return st.full
-        if st.error_key == full.key:
-            return None
-        if full.rect is None:  # nothing of the box on screen at this size
-            return None
-        if st.job is None or st.job.key != full.key or (st.job.done and st.job.result is None):
-            st.cancel_job()
-            st.job = entry.worker.submit(runtime.Job(owner, full.key, full.params, full.rect))
-            st.job_entry = entry
-            st.announced = False
-            _ensure_poll()
+        decided, shown = _refine_still(st, s, args, owner)
+        if decided:
+            return shown
     else:
         st.cancel_job()
-    iw, ih = _size(W, H, s.interactive_resolution)
-    fast = _Frame(ob, entry, iw, ih, view, proj, model, raw_depth, lights, fast=True)
-    if st.fast is None or st.fast.key != fast.key:
-        if fast.rect is None or st.error_key == fast.key:
-            return None  # off screen, or failed with exactly these inputs: no retry per redraw
-        try:
-            rgba, vdepth, _stats = runtime.render_rect(entry, fast.params, fast.rect)
-        except native.VoxlightError:
-            st.error_key = fast.key
-            raise
-        st.fast = _Image(fast.key, rgba, vdepth, fast.win_small, proj, False)
-    else:
+    return _preview(st, s, args)
+
+
+def _refine_still(st, s, args, owner):
+    """The view is still: collect a finished refined frame, queue the next
+    step (half, then full still resolution) and return the sharpest image
+    ready for this view. Returns (True, image or None to show nothing), or
+    (False, None) to show the preview."""
+    preview_scale = st.fast.scale if st.fast is not None else st.policy.scale
+    steps = resolution_policy.refine_scales(preview_scale, s.viewport_resolution)
+    frames = [_frame_at(sc, *args, fast=False) for sc in steps]
+    full = frames[-1]
+    job = st.job
+    if job is not None and job.done:
+        for fr in frames:
+            if job.key != fr.key:
+                continue
+            if job.result is not None:
+                rgba, vdepth, _stats = job.result
+                img = _Image(fr.key, rgba, vdepth, fr.win_small, args[5], fr is full, fr.scale)
+                st.job = None
+                if fr is full:
+                    st.full = img
+                    _tag_properties()  # the Statistics panel shows this final frame, not the preview
+                else:
+                    st.half = img
+            elif job.error is not None:
+                st.job = None
+                st.error_key = fr.key
+                raise native.VoxlightError(str(job.error))
+    if st.full is not None and st.full.key == full.key:
+        st.full.update_depth(full.win_small)
+        st.cancel_job()
+        return True, st.full
+    if st.error_key in [fr.key for fr in frames] or full.rect is None:
+        return True, None  # failed with exactly these inputs, or nothing on screen
+    half = frames[0] if len(frames) > 1 else None
+    have_half = half is not None and st.half is not None and st.half.key == half.key
+    step = full if half is None or have_half else half
+    if st.job is None or st.job.key != step.key or (st.job.done and st.job.result is None):
+        st.cancel_job()
+        st.job = args[1].worker.submit(runtime.Job(owner, step.key, step.params, step.rect))
+        st.job_entry = args[1]
+        st.announced = False
+        _ensure_poll()
+    if have_half:
+        st.half.update_depth(half.win_small)
+        return True, st.half
+    return False, None
+
+
+def _preview(st, s, args):
+    """The interactive frame at the policy's scale: rendered synchronously
+    when missing, timed, and the time fed back to the policy."""
+    fast = _frame_at(st.policy.scale, *args, fast=True)
+    if st.fast is not None and st.fast.key == fast.key:
         st.fast.update_depth(fast.win_small)
+        return st.fast
+    # A new frame is needed anyway: the scale may adapt first.
+    scale = st.policy.next_scale(st.pixels_at_scale_1, s.interactive_resolution)
+    if scale != fast.scale:
+        fast = _frame_at(scale, *args, fast=True)
+    if fast.rect is None or st.error_key == fast.key:
+        return None  # off screen, or failed with exactly these inputs: no retry per redraw
+    t = time.perf_counter()
+    try:
+        rgba, vdepth, _stats = runtime.render_rect(args[1], fast.params, fast.rect)
+    except native.VoxlightError:
+        st.error_key = fast.key
+        raise
+    pixels = _rect_pixels(fast.rect)
+    st.policy.observe(time.perf_counter() - t, pixels)
+    st.pixels_at_scale_1 = pixels / (fast.scale * fast.scale)
+    st.fast = _Image(fast.key, rgba, vdepth, fast.win_small, args[5], False, fast.scale)
     return st.fast
 
 

@@ -46,9 +46,9 @@ def _switch_on(ob, backend):
     fill_volume_properties(ob, path, entry.info, entry.info["affine"], 1.0)
     tf.ensure_texture(ob)
     ob.display_type = "BOUNDS"
-    # As for imported volumes: drawn "in front", the box stays out of the
-    # depth buffer the viewport reads, so rays do not stop at it.
-    ob.show_in_front = True
+    # As for imported volumes: not "in front", so meshes in front of the box
+    # hide it (importer.py says why rays stopping at its lines is right).
+    ob.show_in_front = False
 
 
 def _switch_off(ob):

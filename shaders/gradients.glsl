@@ -1,7 +1,8 @@
 // gradients.glsl - the gradient filters, one chosen per program by a define:
 // FILTER_CENTRAL, FILTER_FORWARD3, FILTER_SOBEL8, FILTER_SOBEL14,
-// FILTER_SOBEL26, FILTER_PRECOMPUTED, FILTER_CUBIC. Every filter returns the gradient in
-// voxel space (normalised value per voxel) and is exact on a linear ramp.
+// FILTER_SOBEL26, FILTER_PRECOMPUTED, FILTER_CUBIC, FILTER_CUBIC_SMOOTH. Every
+// filter returns the gradient in voxel space (normalised value per voxel) and
+// is exact on a linear ramp.
 #include "common.glsl"
 
 uniform float u_sample_distance; // tap offset d, in voxels
@@ -27,59 +28,79 @@ vec3 paged_gradient(vec3 p)
 #endif
 #endif
 
-#ifdef FILTER_CUBIC
-uniform sampler3D u_bspline; // interpolating cubic B-spline coefficients, trilinear
-
-// Sigg & Hadwiger (GPU Gems 2, ch. 20): a cubic B-spline over 4 samples is
-// two linear fetches. For voxel coordinate x, the pair offsets (relative to
-// floor(x)) and weights of the B-spline (w) and of its derivative (dw).
-void bspline_pairs(float x, out vec2 h, out vec2 g, out vec2 dh, out vec2 dg)
+#if defined(FILTER_CUBIC) || defined(FILTER_CUBIC_SMOOTH)
+// Cubic B-spline derivative over the 4x4x4 coefficients around p, read
+// texel-exact (texelFetch) and weighted in float here. The two-fetch trick
+// (Sigg & Hadwiger) would let the texture unit blend pairs, but GPUs blend
+// with fixed-point weights (8 fractional bits is common), an error of the
+// order of a small gradient; exact costs ~15% more on llvmpipe
+// (docs/filters_on_scans.md).
+vec4 bspline_weights(float a)
 {
-    float a = x - floor(x), a2 = a * a, a3 = a2 * a, b = 1.0 - a;
-    float w0 = b * b * b / 6.0, w1 = (3.0 * a3 - 6.0 * a2 + 4.0) / 6.0;
-    float w2 = (-3.0 * a3 + 3.0 * a2 + 3.0 * a + 1.0) / 6.0, w3 = a3 / 6.0;
-    g = vec2(w0 + w1, w2 + w3);
-    h = vec2(-1.0 + w1 / g.x, 1.0 + w3 / g.y);
-    // derivative weights: w0', w1' <= 0 and w2', w3' >= 0 on [0,1), so each
-    // pair is a convex blend and one linear fetch still serves it
-    float d0 = -0.5 * b * b, d1 = 0.5 * (3.0 * a2 - 4.0 * a);
-    float d2 = 0.5 * (-3.0 * a2 + 2.0 * a + 1.0), d3 = 0.5 * a2;
-    dg = vec2(d0 + d1, d2 + d3);
-    dh = vec2(-1.0 + d1 / dg.x, 1.0 + d3 / dg.y);
+    float b = 1.0 - a, a2 = a * a, a3 = a2 * a;
+    return vec4(b * b * b, 3.0 * a3 - 6.0 * a2 + 4.0, -3.0 * a3 + 3.0 * a2 + 3.0 * a + 1.0, a3) / 6.0;
 }
-
-#ifndef PAGED
-float coeff(vec3 q) { return textureLod(u_bspline, voxel_to_tex(q), 0.0).r; }
-#else
-// Bricked storage: u_bspline is a pool of coefficient bricks with a one-voxel
-// ghost, u_cpage its page table (w >= 0: a brick whose coefficients are all
-// that value), laid out brick for brick like the data (paged_bspline.c).
-// q is a level position.
-uniform sampler3D u_cpage;
-uniform vec3 u_cpool_dims;
-
-float coeff(vec3 q)
+vec4 bspline_dweights(float a)
 {
-    vec4 e = page_entry(u_cpage, q);
-    return e.w >= 0.0 ? e.w : textureLod(u_bspline, (q + 0.5) / u_cpool_dims, 0.0).r;
+    float b = 1.0 - a, a2 = a * a;
+    return vec4(-b * b, 3.0 * a2 - 4.0 * a, -3.0 * a2 + 2.0 * a + 1.0, a2) * 0.5;
 }
 #endif
 
-// One gradient component: derivative pairs along axis `a`, value pairs on
-// the other two; 8 trilinear fetches.
-float bspline_partial(vec3 base, vec2 h[3], vec2 g[3], vec2 dh[3], vec2 dg[3], int a)
+#ifdef FILTER_CUBIC
+// Interpolating spline: coefficients from the prefilter (bspline.c,
+// paged_bspline.c), float. Clamped indices reproduce clamp-to-edge.
+uniform sampler3D u_bspline;
+#ifndef PAGED
+float spline_coeff(ivec3 c) { return texelFetch(u_bspline, clamp(c, ivec3(0), ivec3(u_dims) - 1), 0).r; }
+#else
+// Bricked storage: u_bspline is a pool of coefficient bricks, u_cpage its
+// page table (w >= 0: a brick whose coefficients are all that value), laid
+// out brick for brick like the data (paged_bspline.c); c is a level voxel.
+uniform sampler3D u_cpage;
+
+float spline_coeff(ivec3 c)
 {
-    float s = 0.0;
-    for (int i = 0; i < 8; i++) {
-        ivec3 k = ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
-        vec3 q, w;
-        for (int c = 0; c < 3; c++) {
-            q[c] = base[c] + (c == a ? dh[c][k[c]] : h[c][k[c]]);
-            w[c] = c == a ? dg[c][k[c]] : g[c][k[c]];
+    c = clamp(c, ivec3(0), ivec3(u_page_dims) - 1);
+    int n = int(u_page_brick);
+    ivec3 b = c / n;
+    vec4 e = texelFetch(u_cpage, b, 0);
+    return e.w >= 0.0 ? e.w : texelFetch(u_bspline, ivec3(e.xyz) + c - b * n, 0).r;
+}
+#endif
+#endif
+
+#ifdef FILTER_CUBIC_SMOOTH
+// Approximating spline: the voxels themselves are the coefficients (no
+// prefilter), so the spline smooths (its response at grid points is
+// [1 4 1]/6 per axis) instead of passing every voxel's noise on. The stored
+// texels are read exactly: llvmpipe's linear filter of unorm8 textures
+// returns lerps rounded to 1/255.
+#ifndef PAGED
+float spline_coeff(ivec3 c) { return texelFetch(u_volume, clamp(c, ivec3(0), ivec3(u_dims) - 1), 0).r; }
+#else
+float spline_coeff(ivec3 c) { return paged_fetch(clamp(c, ivec3(0), ivec3(u_page_dims) - 1)); }
+#endif
+#endif
+
+#if defined(FILTER_CUBIC) || defined(FILTER_CUBIC_SMOOTH)
+// q in (level) voxels; per row of 4 coefficients along x, the value and
+// x-derivative sums, then the y and z weights.
+vec3 bspline_gradient(vec3 q)
+{
+    vec3 fq = floor(q), a = q - fq;
+    ivec3 b = ivec3(fq) - 1;
+    vec4 wx = bspline_weights(a.x), wy = bspline_weights(a.y), wz = bspline_weights(a.z);
+    vec4 dx = bspline_dweights(a.x), dy = bspline_dweights(a.y), dz = bspline_dweights(a.z);
+    vec3 g = vec3(0.0);
+    for (int k = 0; k < 4; k++)
+        for (int j = 0; j < 4; j++) {
+            vec4 row = vec4(spline_coeff(b + ivec3(0, j, k)), spline_coeff(b + ivec3(1, j, k)),
+                            spline_coeff(b + ivec3(2, j, k)), spline_coeff(b + ivec3(3, j, k)));
+            float v = dot(wx, row);
+            g += vec3(dot(dx, row) * wy[j] * wz[k], v * dy[j] * wz[k], v * wy[j] * dz[k]);
         }
-        s += w.x * w.y * w.z * coeff(q);
-    }
-    return s;
+    return g;
 }
 #endif
 
@@ -133,20 +154,14 @@ vec3 gradient_at(vec3 p, float centre)
     return paged_gradient(p) * u_gradient_scale;
 #elif defined(FILTER_PRECOMPUTED)
     return textureLod(u_gradient, voxel_to_tex(p), 0.0).xyz * u_gradient_scale;
-#elif defined(FILTER_CUBIC)
-    // Analytic derivative of the interpolating cubic B-spline: 24 fetches.
+#elif defined(FILTER_CUBIC) || defined(FILTER_CUBIC_SMOOTH)
+    // Analytic derivative of the cubic B-spline (interpolating or
+    // approximating): 64 texel reads.
 #ifdef PAGED
-    vec3 q = level_position(p); // a coarser level's spline, per level voxel
-    float per_voxel = 1.0 / u_lod_scale;
+    return bspline_gradient(level_position(p)) / u_lod_scale; // a coarser level's spline, per level voxel
 #else
-    vec3 q = p;
-    float per_voxel = 1.0;
+    return bspline_gradient(p);
 #endif
-    vec3 base = floor(q);
-    vec2 h[3], g[3], dh[3], dg[3];
-    for (int c = 0; c < 3; c++) bspline_pairs(q[c], h[c], g[c], dh[c], dg[c]);
-    return vec3(bspline_partial(base, h, g, dh, dg, 0), bspline_partial(base, h, g, dh, dg, 1),
-                bspline_partial(base, h, g, dh, dg, 2)) * per_voxel;
 #else
 #error "no FILTER_* define"
 #endif

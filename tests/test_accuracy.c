@@ -107,7 +107,7 @@ TEST(renders_converge_to_the_reference)
 
 int main(void)
 {
-    R = make_renderer(VXL_BACKEND_OSMESA);
+    R = make_renderer(software_backend());
     if (!R) {
         printf("0 passed, 1 failed\n");
         return 1;

@@ -126,7 +126,7 @@ TEST(scaling_and_int_types)
 
 TEST(renderer_errors_are_reported)
 {
-    vxl_renderer *r = make_renderer(VXL_BACKEND_OSMESA);
+    vxl_renderer *r = make_renderer(software_backend());
     REQUIRE(r);
     static float img[16 * 16 * 4];
     vxl_render_params p = default_params(16, 16);
@@ -165,7 +165,7 @@ TEST(renderer_errors_are_reported)
 
 TEST(renderer_budget_and_defaults)
 {
-    vxl_renderer_options o = {.struct_size = sizeof o, .backend = VXL_BACKEND_OSMESA, .memory_budget_bytes = 4096};
+    vxl_renderer_options o = {.struct_size = sizeof o, .backend = software_backend(), .memory_budget_bytes = 4096};
     vxl_renderer *r = NULL;
     REQUIRE(vxl_renderer_create(&o, &r) == VXL_OK);
     double prm[4] = {0.1, 0, 0, 0};
@@ -189,17 +189,44 @@ TEST(backend_environment_override)
     vxl_renderer *r = NULL;
     CHECK(vxl_renderer_create(NULL, &r) == VXL_ERR_INVALID_ARGUMENT && r == NULL);
     CHECK(strstr(vxl_last_error(), "VOXLIGHT_BACKEND") != NULL);
-    setenv("VOXLIGHT_BACKEND", "osmesa", 1);
+    uint32_t sw = software_backend();
+    setenv("VOXLIGHT_BACKEND", sw == VXL_BACKEND_OSMESA ? "osmesa" : "egl", 1);
     CHECK(vxl_renderer_create(NULL, &r) == VXL_OK);
-    vxl_renderer_info info;
-    CHECK(r && vxl_renderer_get_info(r, &info) == VXL_OK && info.backend == VXL_BACKEND_OSMESA);
+    vxl_renderer_info info = {.struct_size = sizeof info};
+    CHECK(r && vxl_renderer_get_info(r, &info) == VXL_OK && info.backend == sw);
     vxl_renderer_destroy(r);
     unsetenv("VOXLIGHT_BACKEND");
 }
 
+/* auto takes a GPU through EGL, else OSMesa, else Mesa's surfaceless EGL: on
+ * a machine without OSMesa it must still open (on EGL), and asking for
+ * OSMesa there is a clear error naming the package. */
+TEST(auto_uses_what_is_installed)
+{
+    vxl_renderer *r = make_renderer(VXL_BACKEND_AUTO);
+    REQUIRE(r);
+    vxl_renderer_info info = {.struct_size = sizeof info};
+    CHECK(vxl_renderer_get_info(r, &info) == VXL_OK);
+    fprintf(stderr, "    auto: %s\n", info.backend_name);
+    if (osmesa_installed())
+        CHECKF(!strcmp(info.backend_name, "osmesa") || !strcmp(info.backend_name, "egl-device"), "auto chose %s",
+               info.backend_name);
+    else
+        CHECKF(info.backend == VXL_BACKEND_EGL, "auto chose %s without OSMesa", info.backend_name);
+    vxl_renderer_destroy(r);
+    r = make_renderer(VXL_BACKEND_OSMESA);
+    if (osmesa_installed()) {
+        CHECK(r != NULL);
+    } else {
+        CHECK(r == NULL);
+        CHECKF(strstr(vxl_last_error(), "libosmesa6") != NULL, "error: %s", vxl_last_error());
+    }
+    vxl_renderer_destroy(r);
+}
+
 TEST(shader_dir_override_loads_from_disk)
 {
-    vxl_renderer_options o = {.struct_size = sizeof o, .backend = VXL_BACKEND_OSMESA, .shader_dir = "/nonexistent"};
+    vxl_renderer_options o = {.struct_size = sizeof o, .backend = software_backend(), .shader_dir = "/nonexistent"};
     vxl_renderer *r = NULL;
     REQUIRE(vxl_renderer_create(&o, &r) == VXL_OK);
     double prm[4] = {0.1, 0, 0, 0};
@@ -224,6 +251,7 @@ int main(void)
     RUN(renderer_errors_are_reported);
     RUN(renderer_budget_and_defaults);
     RUN(backend_environment_override);
+    RUN(auto_uses_what_is_installed);
     RUN(shader_dir_override_loads_from_disk);
     return TEST_SUMMARY();
 }

@@ -256,7 +256,7 @@ TEST(gradient_opacity_units_agree_across_filters)
 
 int main(void)
 {
-    R = make_renderer(VXL_BACKEND_OSMESA);
+    R = make_renderer(software_backend());
     if (!R) {
         printf("0 passed, 1 failed\n");
         return 1;

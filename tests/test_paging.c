@@ -22,7 +22,7 @@ static vxl_renderer *make_stored_in(uint32_t storage, uint32_t page_brick, uint6
     vxl_renderer_options o;
     memset(&o, 0, sizeof o);
     o.struct_size = sizeof o;
-    o.backend = VXL_BACKEND_OSMESA;
+    o.backend = software_backend();
     o.storage = storage;
     o.page_brick = page_brick;
     o.memory_budget_bytes = budget;

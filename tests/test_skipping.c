@@ -73,7 +73,7 @@ TEST(skipping_never_changes_the_image)
 
 int main(void)
 {
-    R = make_renderer(VXL_BACKEND_OSMESA);
+    R = make_renderer(software_backend());
     if (!R) {
         printf("0 passed, 1 failed\n");
         return 1;

@@ -57,9 +57,11 @@
 #define WATCHDOG_S 180         /* a render running longer than this is a hang */
 
 /* "sparse" is OSMesa with sparse storage in page bricks of 8: every case
- * through the page table, the derived filters' brick pools included. */
+ * through the page table, the derived filters' brick pools included. On a
+ * machine without OSMesa, "osmesa" does not run and "sparse" is on EGL
+ * (main sets this from software_backend()). */
 enum { BACKEND_OSMESA, BACKEND_EGL, BACKEND_SPARSE, BACKEND_N };
-static const uint32_t backend_ids[BACKEND_N] = {VXL_BACKEND_OSMESA, VXL_BACKEND_EGL, VXL_BACKEND_OSMESA};
+static uint32_t backend_ids[BACKEND_N] = {VXL_BACKEND_OSMESA, VXL_BACKEND_EGL, VXL_BACKEND_OSMESA};
 static const char *const backend_names[BACKEND_N] = {"osmesa", "egl", "sparse"};
 static vxl_renderer *R[BACKEND_N];
 static int backend_enabled[BACKEND_N] = {1, 1, 1};
@@ -505,7 +507,7 @@ static vxl_renderer *make_sparse_renderer(void)
     vxl_renderer_options o;
     memset(&o, 0, sizeof o);
     o.struct_size = sizeof o;
-    o.backend = VXL_BACKEND_OSMESA;
+    o.backend = backend_ids[BACKEND_SPARSE];
     o.storage = VXL_STORAGE_SPARSE;
     o.page_brick = 8;
     vxl_renderer *r = NULL;
@@ -578,6 +580,13 @@ int main(int argc, char **argv)
                     argv[0]);
             return 2;
         }
+    }
+    backend_ids[BACKEND_SPARSE] = software_backend();
+    if (!osmesa_installed() && backend_enabled[BACKEND_OSMESA] && backend_enabled[BACKEND_EGL]) {
+        /* the default matrix: no OSMesa to run, EGL and sparse-on-EGL remain
+         * (an explicit --backend osmesa still asks for it, and fails) */
+        backend_enabled[BACKEND_OSMESA] = 0;
+        fprintf(stderr, "stress: no OSMesa on this machine: backends egl and sparse (on egl)\n");
     }
     stress_env_init(&ENV, full);
     for (int i = 0; i < 256; i++) {

@@ -3,8 +3,10 @@
 #ifndef VXL_TEST_UTIL_H
 #define VXL_TEST_UTIL_H
 
+#include <dlfcn.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -62,6 +64,35 @@ static inline double angle_deg(const float *a, const double *b)
     double c = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb);
     c = c > 1 ? 1 : c < -1 ? -1 : c;
     return acos(c) * 180.0 / M_PI;
+}
+
+/* 1 if Mesa's OSMesa can be loaded, as the library loads it (same soname).
+ * The handle stays open: llvmpipe is not safe to unload, and the library
+ * then finds it loaded. */
+static inline int osmesa_installed(void)
+{
+    static int known, have;
+    if (!known) {
+        known = 1;
+        have = dlopen("libOSMesa.so.8", RTLD_NOW | RTLD_LOCAL) != NULL;
+    }
+    return have;
+}
+
+/* The software backend the tests render on: OSMesa where it is installed,
+ * else Mesa's surfaceless EGL, which is what `auto` and every user get on a
+ * release without OSMesa (Mesa 25.1 removed it). The fallback is announced on
+ * stdout, which ./build.sh test shows, so a log says which backend ran. */
+static inline uint32_t software_backend(void)
+{
+    static int announced;
+    if (osmesa_installed()) return VXL_BACKEND_OSMESA;
+    if (!announced) {
+        announced = 1;
+        printf("software backend: egl (libOSMesa.so.8 is not installed: the tests render on Mesa's EGL)\n");
+        fflush(stdout);
+    }
+    return VXL_BACKEND_EGL;
 }
 
 static inline vxl_renderer *make_renderer(uint32_t backend)

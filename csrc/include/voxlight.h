@@ -69,8 +69,10 @@ extern "C" {
 #define VXL_FILTER_SOBEL14 3     /* 6 faces + 8 corners */
 #define VXL_FILTER_SOBEL26 4     /* classic weighted 26-neighbour Sobel */
 #define VXL_FILTER_PRECOMPUTED 5 /* blur + Sobel once per volume, stored */
-#define VXL_FILTER_CUBIC 6       /* derivative of the interpolating cubic B-spline, 24 fetches */
-#define VXL_FILTER_COUNT 7
+#define VXL_FILTER_CUBIC 6       /* derivative of the interpolating cubic B-spline, 64 texel reads */
+#define VXL_FILTER_CUBIC_SMOOTH 7 /* derivative of the approximating cubic B-spline (no prefilter):
+                                     smooth normals on noisy and 8-bit scans, 64 texel reads */
+#define VXL_FILTER_COUNT 8
 
 /* ---- classification modes ---- */
 #define VXL_CLASSIFY_POST 0    /* interpolate the value, then look it up (default) */

@@ -33,19 +33,90 @@ def zip_path():
     return os.environ.get("VOXLIGHT_ZIP", os.path.join(build, "voxlight-blender.zip"))
 
 
-def install_addon():
-    """Install the built zip the way a user does, then enable it."""
-    z = zip_path()
+# The add-on's module name: "voxlight" as a legacy add-on (3.x),
+# "bl_ext.<repo>.voxlight" as an extension (4.2+). Set by install_addon().
+MODULE = None
+EXTENSION_REPO = "user_default"  # the local repo every 4.2+ Blender starts with
+
+
+def uses_extensions():
+    """Blender 4.2+ installs the zip as an extension (manifest read and
+    validated); older ones as a legacy add-on (bl_info)."""
+    return bpy.app.version >= (4, 2, 0)
+
+
+def installed_module():
+    return sys.modules[MODULE]
+
+
+def install_addon(path=None, check_library=True, legacy=False):
+    """Install the zip the way a user does (overwriting an installed copy,
+    which may be enabled), enable it and return the add-on's package
+    module. legacy: install as a legacy add-on even where Blender has
+    extensions (4.2+ still offers "Install legacy Add-on")."""
+    global MODULE
+    z = path or zip_path()
     assert os.path.isfile(z), "%s missing: run tools/package_addon.sh" % z
-    bpy.ops.preferences.addon_install(filepath=z, overwrite=True)
-    bpy.ops.preferences.addon_enable(module="voxlight")
-    import voxlight
-    ok, msg = voxlight.library_status()
-    assert ok, msg
-    # The library must be the one shipped inside the installed add-on.
-    lib_dir = os.path.dirname(voxlight.native.load_library().path)
-    assert lib_dir == os.path.dirname(voxlight.__file__), (lib_dir, voxlight.__file__)
-    return voxlight
+    t = time.time()
+    as_extension = uses_extensions() and not legacy
+    if as_extension:
+        repos = bpy.context.preferences.extensions.repos
+        repo = next(r for r in repos if r.module == EXTENSION_REPO)
+        assert not repo.use_remote_url, "%s is not a local repository" % EXTENSION_REPO
+        private = os.environ.get("BLENDER_USER_EXTENSIONS")
+        if private:  # never touch the user's own extensions
+            assert os.path.realpath(repo.directory).startswith(os.path.realpath(private)), \
+                repo.directory
+        MODULE = "bl_ext.%s.voxlight" % EXTENSION_REPO
+        import addon_utils
+        # Over an enabled add-on, Blender disables, replaces and enables it;
+        # a first install is enabled separately, to time the add-on's load.
+        was_enabled = addon_utils.check(MODULE)[1]
+        res = bpy.ops.extensions.package_install_files(
+            filepath=z, repo=EXTENSION_REPO, enable_on_install=was_enabled, overwrite=True)
+        assert res == {"FINISHED"}, res
+        if not was_enabled:
+            enable()
+    else:
+        res = bpy.ops.preferences.addon_install(filepath=z, overwrite=True)
+        assert res == {"FINISHED"}, res
+        MODULE = "voxlight"
+        import addon_utils
+        if addon_utils.check(MODULE)[1]:
+            disable()  # an update: the user unticks and ticks the add-on
+        enable()
+    import addon_utils
+    assert addon_utils.check(MODULE)[1], "%s is not enabled" % MODULE
+    print("install_addon: Blender %s, %s as %s in %.2f s" % (
+        bpy.app.version_string, "extension" if as_extension else "legacy add-on", MODULE,
+        time.time() - t), flush=True)
+    mod = installed_module()
+    if check_library:
+        ok, msg = mod.library_status()
+        assert ok, msg
+        # The library must be the one shipped inside the installed add-on.
+        lib_dir = os.path.dirname(mod.native.load_library().source_path)
+        assert lib_dir == os.path.dirname(mod.__file__), (lib_dir, mod.__file__)
+    return mod
+
+
+def enable():
+    """Enable the installed add-on; returns its module."""
+    t = time.time()
+    res = bpy.ops.preferences.addon_enable(module=MODULE)
+    assert res == {"FINISHED"}, res
+    print("enable: %.3f s" % (time.time() - t), flush=True)
+    return installed_module()
+
+
+def disable():
+    res = bpy.ops.preferences.addon_disable(module=MODULE)
+    assert res == {"FINISHED"}, res
+
+
+def is_ours(module_name):
+    """Whether a function's __module__ belongs to the add-on."""
+    return module_name == MODULE or (module_name or "").startswith(MODULE + ".")
 
 
 def ball_file(name="ball.nii.gz", n=32, spacing=(2.0, 2.0, 2.0)):
@@ -116,11 +187,16 @@ def add_plane(size, location, rotation=(0.0, 0.0, 0.0), name="Plane", color=(0.1
     ob.rotation_euler = rotation
     mat = bpy.data.materials.new(name)
     mat.diffuse_color = (*color, 1.0)
-    mat.use_nodes = True
+    if bpy.app.version < (5, 0, 0):  # 5.0: materials always use nodes (use_nodes deprecated)
+        mat.use_nodes = True
     bsdf = mat.node_tree.nodes.get("Principled BSDF")
     if bsdf is not None:
         bsdf.inputs["Base Color"].default_value = (*color, 1.0)
-        bsdf.inputs["Emission"].default_value = (*color, 1.0)
+        # "Emission" became "Emission Color" in 4.0, whose strength is 0 by default.
+        emission = bsdf.inputs.get("Emission Color") or bsdf.inputs["Emission"]
+        emission.default_value = (*color, 1.0)
+        if "Emission Strength" in bsdf.inputs:
+            bsdf.inputs["Emission Strength"].default_value = 1.0
     me.materials.append(mat)
     bpy.context.scene.collection.objects.link(ob)
     return ob

@@ -44,7 +44,7 @@ def _scene():
     scene = u.reset_scene()
     scene.render.resolution_x = scene.render.resolution_y = SIZE
     scene.render.resolution_percentage = 100
-    ob = u.import_volume(_moving_cube_file())
+    ob = u.import_volume(_moving_cube_file(), anatomical_views=False)  # the file's +x = screen right
     ob.voxlight.jitter = False
     u.add_camera((0.0, -3.0, 0.0))  # looks along +Y: volume x is image x
     return scene, ob

@@ -21,27 +21,18 @@ import sys
 import time
 
 import bpy
-import gpu
 import numpy as np
 from mathutils import Euler, Quaternion
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _gui  # noqa: E402
 import _util as u  # noqa: E402
 
-START = time.time()
-LIMIT_S = 500
-results = []
-capture = {"want": False, "img": None}
+RUN = _gui.Run("test_gui", limit_s=500)
+check = RUN.check
+finish = RUN.finish
+capture = _gui.Capture()
 
-
-def _capture_handler():
-    if not capture["want"]:
-        return
-    region = bpy.context.region
-    fb = gpu.state.active_framebuffer_get()
-    buf = fb.read_color(0, 0, region.width, region.height, 4, 0, "FLOAT")
-    capture["img"] = np.array(buf.to_list(), np.float32).reshape(region.height, region.width, 4)
-    capture["want"] = False
 
 
 def view3d():
@@ -59,23 +50,13 @@ def redraw(types=None):
                 area.tag_redraw()
 
 
-def check(name, cond, detail=""):
-    results.append((name, bool(cond)))
-    print("%s %s %s" % ("PASS" if cond else "FAIL", name, detail), flush=True)
-
-
-def finish():
-    failed = sum(1 for _, ok in results if not ok)
-    print("RESULT test_gui: %d passed, %d failed" % (len(results) - failed, failed), flush=True)
-    sys.stdout.flush()
-    os._exit(1 if failed else 0)
 
 
 def steps():
     """A generator: each yield is the delay (s) before the next step."""
     vx = u.install_addon()
     rt, vp = vx.runtime, vx.viewport
-    bpy.types.SpaceView3D.draw_handler_add(_capture_handler, (), "WINDOW", "POST_PIXEL")
+    capture.install()
     scene = u.reset_scene()
     scene.voxlight.viewport_resolution = 0.5  # llvmpipe: keep each render short
     scene.voxlight.settle_time = 0.3
@@ -94,7 +75,7 @@ def steps():
     yield 0.5
 
     def grab():
-        capture["want"], capture["img"] = True, None
+        capture.request()
         redraw(("VIEW_3D",))
 
     def settled():
@@ -105,7 +86,7 @@ def steps():
         for _ in range(40):
             grab()
             yield 0.5
-            if capture["img"] is not None and not vp.busy() and rt.render_count == last:
+            if capture.img is not None and not vp.busy() and rt.render_count == last:
                 return
             last = rt.render_count
 
@@ -115,15 +96,15 @@ def steps():
     # 1. The scene before the volume exists.
     grab()
     yield 1.0
-    empty = capture["img"]
+    empty = capture.img
     check("capture_works", empty is not None)
     if empty is None:
         return
 
     with bpy.context.temp_override(window=win, area=area):
-        ob = u.import_volume(u.CH2)
+        ob = u.import_volume(u.CH2, frame_in_view=False)  # this test sets its own view
     yield from settled()
-    vol = capture["img"]
+    vol = capture.img
     h, w = vol.shape[:2]
     cy, cx = h // 2, w // 2
     diff = np.abs(vol[..., :3] - empty[..., :3]).max(axis=2)
@@ -197,10 +178,10 @@ def steps():
     plane.scale = (1.0, 2.0, 1.0)
     ob.hide_set(True)
     yield from settled()
-    plane_only = capture["img"]
+    plane_only = capture.img
     ob.hide_set(False)
     yield from settled()
-    both = capture["img"]
+    both = capture.img
     left = (cy, cx - 40)
     right = (cy, cx + 40)
     d_left = np.abs(both[left][:3] - plane_only[left][:3]).max()
@@ -233,7 +214,7 @@ def steps():
         for _ in range(3):
             grab()
             yield 0.4
-        gone = capture["img"]
+        gone = capture.img
         f_b, c_b, d_b = counts()
         no_volume = gone is not None and np.abs(gone[..., :3] - empty[..., :3]).max() < 0.02
         check("no_render_when_" + label, c_b == c_a and d_b > d_a and no_volume,
@@ -241,7 +222,7 @@ def steps():
               % (c_a, c_b, d_a, d_b, no_volume))
         show()
         yield from settled()
-        back = capture["img"]
+        back = capture.img
         f_c, c_c, _ = counts()
         same = np.abs(back[..., :3] - vol[..., :3]).max() < 0.02
         check("cached_frame_when_back_from_" + label, c_c == c_b and same,
@@ -269,14 +250,14 @@ def steps():
 
     # 5. Orbiting changes the image, first coarse then refined.
     yield from settled()
-    before = capture["img"]
+    before = capture.img
     n = rt.render_count
     r3d.view_rotation = Quaternion((0, 0, 1), math.radians(35)) @ r3d.view_rotation
     grab()
     yield 0.05
     moving_w = st.shown.width if st.shown is not None else 0
     yield from settled()
-    after = capture["img"]
+    after = capture.img
     change = np.abs(after[..., :3] - before[..., :3]).max(axis=2).mean()
     check("orbit_changes_image", change > 0.01, "mean change %.4f" % change)
     check("refined_after_moving", rt.render_count >= n + 2 and moving_w < st.shown.width
@@ -337,18 +318,18 @@ def steps():
         o.hide_set(True)
     scene.voxlight.viewport_resolution = 0.5
     yield from settled()
-    blank = capture["img"]
+    blank = capture.img
     smoke = volume_object_with_ball(scene)
     smoke.voxlight_vdb.enabled = True
     yield from settled()
-    diff = np.abs(capture["img"][..., :3] - blank[..., :3]).max(axis=2)
+    diff = np.abs(capture.img[..., :3] - blank[..., :3]).max(axis=2)
     h, w = diff.shape
     check("volume_object_in_viewport", diff[h // 2 - 10:h // 2 + 10, w // 2 - 10:w // 2 + 10].mean() > 0.1
           and diff[:30, :30].mean() < 0.02, "centre %.3f corner %.3f"
           % (diff[h // 2 - 10:h // 2 + 10, w // 2 - 10:w // 2 + 10].mean(), diff[:30, :30].mean()))
     smoke.voxlight_vdb.enabled = False
     yield from settled()
-    diff = np.abs(capture["img"][..., :3] - blank[..., :3]).max(axis=2)
+    diff = np.abs(capture.img[..., :3] - blank[..., :3]).max(axis=2)
     check("volume_object_off_draws_nothing", diff.mean() < 0.01, "mean %.4f" % diff.mean())
 
 
@@ -386,7 +367,8 @@ def gui_import_steps(vx, win, area):
     try:
         before = set(bpy.data.objects)
         with bpy.context.temp_override(window=win, area=area):
-            res = bpy.ops.voxlight.import_volume("EXEC_DEFAULT", filepath=u.CH2, use_modal=True)
+            res = bpy.ops.voxlight.import_volume("EXEC_DEFAULT", filepath=u.CH2, use_modal=True,
+                                               frame_in_view=False)
         check("import_runs_modal", res == {"RUNNING_MODAL"} and set(bpy.data.objects) == before, str(res))
         for _ in range(120):
             yield 0.25
@@ -400,7 +382,8 @@ def gui_import_steps(vx, win, area):
         before = set(bpy.data.objects)
         n_made = len(made)
         with bpy.context.temp_override(window=win, area=area):
-            bpy.ops.voxlight.import_volume("EXEC_DEFAULT", filepath=u.ball_file("esc.nii.gz"), use_modal=True)
+            bpy.ops.voxlight.import_volume("EXEC_DEFAULT", filepath=u.ball_file("esc.nii.gz"), use_modal=True,
+                                               frame_in_view=False)
         yield 0.3
         win.event_simulate(type="ESC", value="PRESS")
         win.event_simulate(type="ESC", value="RELEASE")
@@ -419,23 +402,4 @@ def gui_import_steps(vx, win, area):
         native.Renderer.__init__, native.Volume.load = real_init, real_load
 
 
-def main():
-    it = steps()
-
-    def tick():
-        if time.time() - START > LIMIT_S:
-            check("finished_in_time", False)
-            finish()
-        try:
-            return next(it)
-        except StopIteration:
-            finish()
-        except Exception:
-            import traceback
-            traceback.print_exc()
-            check("no_exception", False)
-            finish()
-    bpy.app.timers.register(tick, first_interval=1.0)
-
-
-main()
+RUN.start(steps())

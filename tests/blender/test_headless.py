@@ -36,7 +36,7 @@ def _diff(a, b):
 
 def _is_our_menu(f):
     return getattr(f, "__name__", "") == "menu_import" and \
-        getattr(f, "__module__", "").startswith("voxlight")
+        u.is_ours(getattr(f, "__module__", ""))
 
 
 @test
@@ -58,8 +58,8 @@ def import_synthetic_bounds_match_affine():
     # Drawn cube [-1, 1]^3 spans 32 voxels * spacing mm * 0.01 units/mm.
     assert np.allclose(np.array(ob.scale) * 2, [0.32, 0.64, 0.96], atol=1e-5), ob.scale
     assert np.allclose(ob.location, bpy.context.scene.cursor.location, atol=1e-6)
-    # Without centring, scanner coordinates are kept (mm -> units).
-    ob2 = u.import_volume(path, unit_scale=0.001, center=False)
+    # Without centring and turning, scanner coordinates are kept (mm -> units).
+    ob2 = u.import_volume(path, unit_scale=0.001, center=False, anatomical_views=False)
     corner = ob2.matrix_world @ __import__("mathutils").Vector((-1, -1, -1))
     assert np.allclose(corner, [-0.0155 - 0.0005, -0.031 - 0.001, -0.0465 - 0.0015], atol=1e-6)
     assert bpy.context.view_layer.objects.active == ob2
@@ -103,7 +103,6 @@ def every_panel_property_changes_the_render():
     scene, ob = _scene_with_ball()
     p = ob.voxlight
     p.jitter = False
-    p.window_low, p.window_high = 40.0, 90.0  # inactive until use_window
     ref = _render(ob)
     changes = [
         ("filter", "sobel26"), ("filter", "forward3"), ("filter", "sobel8"),
@@ -111,7 +110,8 @@ def every_panel_property_changes_the_render():
         ("filter", "cubic"), ("filter", "central"), ("sample_distance", 2.5),
         ("reuse_gradients", True),
         ("step", 1.5), ("jitter", True), ("preset", "hot"), ("preset", "bone"),
-        ("use_window", True), ("window_low", 20.0), ("window_high", 70.0),
+        ("window_low", 40.0), ("window_high", 90.0), ("window_low", 20.0),
+        ("window_high", 70.0),
         ("opacity_scale", 0.4), ("ambient", 0.8), ("diffuse", 0.2), ("specular", 0.9),
         ("shininess", 4.0), ("shading", False),
     ]
@@ -131,8 +131,9 @@ def filter_choices_come_from_the_library():
     prop = bpy.types.Object.bl_rna.properties["voxlight"].fixed_type.properties["filter"]
     items = [(i.identifier, i.value) for i in prop.enum_items]
     assert items == [(n, i) for i, n in enumerate(lib.filter_names())], items
-    assert ("cubic", 6) in items and len(items) == 7
-    assert "cubic" in vx.properties.FIXED_TAP_FILTERS  # sampleDistance greyed out
+    assert ("cubic", 6) in items and len(items) == len(vx.native.FILTERS)
+    assert ("cubic-smooth", 7) in items  # issue 14: the approximating B-spline
+    assert {"cubic", "cubic-smooth"} <= vx.properties.FIXED_TAP_FILTERS  # sampleDistance greyed out
 
 
 @test
@@ -318,25 +319,24 @@ def large_phantom_renders_bricked_within_the_budget():
 @test
 def unregister_and_register_again():
     import addon_utils
-    bpy.ops.preferences.addon_disable(module="voxlight")
+    u.disable()
     assert not hasattr(bpy.types.Object, "voxlight")
     assert not hasattr(bpy.types.Scene, "voxlight")
     assert "VOXLIGHT_PT_volume" not in dir(bpy.types)
     for lst in (bpy.app.handlers.render_pre, bpy.app.handlers.render_init,
                 bpy.app.handlers.frame_change_post, bpy.app.handlers.load_pre):
-        assert not [h for h in lst if "voxlight" in getattr(h, "__module__", "")], lst
+        assert not [h for h in lst if u.is_ours(getattr(h, "__module__", ""))], lst
     funcs = bpy.types.TOPBAR_MT_file_import._dyn_ui_initialize()
     assert not any(_is_our_menu(f) for f in funcs)
-    bpy.ops.preferences.addon_enable(module="voxlight")
-    assert addon_utils.check("voxlight")[1]
-    import voxlight
+    voxlight = u.enable()
+    assert addon_utils.check(u.MODULE)[1]
     scene = u.reset_scene()
     ob = u.import_volume(u.ball_file())
     u.add_camera((0.0, -2.5, 0.3))
     assert voxlight.render_volume(ob, resolution=(32, 32))[..., 3].max() > 0.5
     # And once more, to be sure the second unregister is as clean as the first.
-    bpy.ops.preferences.addon_disable(module="voxlight")
-    bpy.ops.preferences.addon_enable(module="voxlight")
+    u.disable()
+    u.enable()
     assert hasattr(bpy.types.Object, "voxlight")
 
 

@@ -148,8 +148,8 @@ def failure_while_creating_the_object_removes_it():
     path = u.ball_file()
     real = vx.tf.ensure_texture
 
-    def broken(obj):
-        real(obj)  # the texture exists, then the step fails
+    def broken(obj, *args):
+        real(obj, *args)  # the texture exists, then the step fails
         raise RuntimeError("simulated failure")
     vx.tf.ensure_texture = broken
     try:

@@ -43,7 +43,7 @@ def _scene(opacity=1.0):
     scene.render.resolution_percentage = 100
     scene.render.film_transparent = False
     scene.world.color = (0.0, 0.0, 0.0)
-    if scene.world.use_nodes:
+    if scene.world.node_tree is not None:  # (World.use_nodes is deprecated in 5.0)
         scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
     scene.view_settings.view_transform = "Standard"
     scene.view_settings.look = "None"
@@ -164,6 +164,30 @@ def animation_render_follows_the_frame():
         w = img[..., :3].max(axis=2).sum(axis=0)
         return (w * xs).sum() / w.sum()
     assert cx(f1) < SIZE / 2 - 8 and cx(f2) > SIZE / 2 + 8, (cx(f1), cx(f2))
+
+
+@test
+def users_compositing_tree_is_used_and_kept():
+    """F12 composites into the scene's own compositing tree: in 5.0 the
+    node group the user assigned (scene.compositing_node_group), before it
+    scene.node_tree; the user's nodes stay."""
+    scene, ob = _scene()
+    if hasattr(scene, "compositing_node_group"):  # 5.0+
+        tree = bpy.data.node_groups.new("User Compositing", "CompositorNodeTree")
+        tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+        rl = tree.nodes.new("CompositorNodeRLayers")
+        out = tree.nodes.new("NodeGroupOutput")
+        tree.links.new(rl.outputs["Image"], out.inputs[0])
+        scene.compositing_node_group = tree
+    else:
+        scene.use_nodes = True
+        tree = scene.node_tree
+    tree.nodes.new("CompositorNodeBlur").name = "User Blur"
+    img = _f12(scene, "user_tree")
+    assert img[C, C, :3].max() > 0.05, img[C, C]  # the volume is there
+    now = scene.compositing_node_group if hasattr(scene, "compositing_node_group") else scene.node_tree
+    assert now == tree and "User Blur" in tree.nodes, [n.name for n in now.nodes]
+    assert vx.compositor.NODE_OVER in tree.nodes
 
 
 @test

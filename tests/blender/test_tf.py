@@ -1,5 +1,7 @@
-"""Headless Blender: the ColorRamp transfer function, 3D Slicer presets,
-classification modes, gradient opacity and the import histogram (issue 6).
+"""Headless Blender: the transfer function has one editor, the ColorRamp
+(issue 14): presets load into it placed on the data, are named in the panel
+and marked when edited; files and scripts using the old "Transfer Function"
+enum keep working; classification modes and gradient opacity (issue 6).
 
 blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_tf.py
 """
@@ -11,7 +13,7 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import _util as u  # noqa: E402
+import _util as u  # noqa: E402  (also puts tests/python on sys.path)
 from _util import test  # noqa: E402
 
 vx = u.install_addon()
@@ -40,8 +42,13 @@ def _diff(a, b):
     return float(np.abs(a - b).max())
 
 
+def _load(ob, key):
+    with bpy.context.temp_override(object=ob, active_object=ob):
+        assert bpy.ops.voxlight.tf_preset(preset=key) == {"FINISHED"}
+
+
 @test
-def import_gives_ramp_and_histogram():
+def import_loads_a_fitted_preset_into_the_ramp():
     ob = _volume("hist.nii.gz")
     p = ob.voxlight
     tex = p.tf_texture
@@ -50,32 +57,77 @@ def import_gives_ramp_and_histogram():
     h = np.array(p.histogram)
     assert h.sum() == 32 ** 3, h.sum()
     assert h[0] > h[-1] > 0  # mostly background zeros, some bright ball voxels
-    from voxlight import tf
-    assert len(tf.histogram_text(h)) == 32
+    # 0..120 float data: arbitrary units, the MRI preset, placed inside the data
+    assert p.data_kind == "mr" and p.tf_preset == "MRI", (p.data_kind, p.tf_preset)
+    assert vx.tf.preset_state(p) == ("MRI", False)
+    assert p.data_min <= p.window_low < p.window_high <= p.data_max
+    assert p.window_low > p.data_min  # the background zeros are left out
+    assert _render(ob)[..., 3].max() > 0.2
 
 
 @test
-def editing_a_ramp_stop_changes_the_render():
+def ct_range_imports_as_ct_with_hounsfield_window():
+    ob = _volume("ct.nii.gz", -1024.0, 2000.0)
+    p = ob.voxlight
+    assert p.data_kind == "ct" and p.tf_preset == "CT"
+    lo, hi, _stops = vx.tf_fit.place("CT", "ct", vx.tf.stats_of(ob))
+    assert abs(p.window_low - lo) < 1e-3 and p.window_high == 2000.0
+
+
+@test
+def every_preset_round_trips_through_the_colorramp():
+    """Loading a preset into the ramp and sampling the ramp (what the
+    library gets) gives the preset's own table, placed on the data."""
+    for name, lo, hi in (("rt_mr.nii.gz", 0.0, 130.0), ("rt_ct.nii.gz", -1024.0, 2500.0)):
+        ob = _volume(name, lo, hi)
+        p = ob.voxlight
+        stats = vx.tf.stats_of(ob)
+        for key in vx.tf_presets.PRESETS:
+            _load(ob, key)
+            wlo, whi, stops = vx.tf_fit.place(key, p.data_kind, stats)
+            assert abs(p.window_low - wlo) < 1e-3 * max(1.0, abs(wlo)), (key, p.window_low, wlo)
+            assert abs(p.window_high - whi) < 1e-3 * max(1.0, abs(whi)), (key, p.window_high, whi)
+            want = vx.tf_presets.stops_table(stops)
+            got = vx.tf.table(p)
+            err = float(np.abs(got - want).max())
+            assert err < 0.01, (key, err)
+            assert len(p.tf_texture.color_ramp.elements) == len(stops), key
+            assert vx.tf.preset_state(p) == (vx.tf_presets.PRESETS[key].name, False), key
+        # built-in presets on CT reproduce the library's own table over its window
+        if p.data_kind == "ct":
+            _load(ob, "BONE")
+            lib_ct = vx.tf_presets.builtin_table("ct")
+            _load(ob, "CT")
+            wlo, whi = p.window_low, p.window_high
+            hu = np.linspace(-1000.0, 2000.0, 301)
+            ramp = p.tf_texture.color_ramp
+            got = np.array([ramp.evaluate(float(np.clip((v - wlo) / (whi - wlo), 0, 1)))
+                            for v in hu])
+            x = np.linspace(0.0, 1.0, len(lib_ct))
+            ref = np.stack([np.interp((hu + 1000.0) / 3000.0, x, lib_ct[:, c])
+                            for c in range(4)], 1)
+            assert float(np.abs(got - ref).max()) < 0.01
+
+
+@test
+def editing_the_ramp_marks_the_preset_modified_and_rerenders():
     ob = _volume("ramp.nii.gz")
     p = ob.voxlight
-    p.use_window, p.window_low, p.window_high = True, 0.0, 120.0
-    ref = _render(ob)
-    p.use_color_ramp = True
-    img = _render(ob)
-    assert _diff(img, ref) > 1e-3, "ColorRamp did not replace the preset"
+    p.window_low, p.window_high = 0.0, 120.0
+    _load(ob, "GRAY")
     ramp = p.tf_texture.color_ramp
-    prev = img
+    prev = _render(ob)
     for what, edit in (("colour", lambda: setattr(ramp.elements[1], "color", (1, 0, 0, 1))),
                        ("alpha", lambda: setattr(ramp.elements[1], "alpha", 0.1)),
                        ("position", lambda: setattr(ramp.elements[0], "position", 0.5)),
                        ("new stop", lambda: setattr(ramp.elements.new(0.8), "color",
                                                     (0, 0, 1, 1)))):
         edit()
+        assert vx.tf.preset_state(p) == ("Gray", True), what
         img = _render(ob)
         assert _diff(img, prev) > 1e-3, "ramp %s edit did not change the image" % what
         prev = img
-    # Red stop: the image is red where the ball is.
-    assert img[..., 0].max() > 0.2
+    assert img[..., 0].max() > 0.2  # red stop: red where the ball is
     # The sampled table is part of the viewport's frame key.
     view, proj = np.eye(4), np.eye(4)
     k1 = vx.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
@@ -83,58 +135,108 @@ def editing_a_ramp_stop_changes_the_render():
     k2 = vx.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
     k3 = vx.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
     assert k1 != k2 and k2 == k3
-    # Back to the library preset: the ramp is ignored.
-    p.use_color_ramp = False
-    assert _diff(_render(ob), ref) < 1e-5
+    # Fit Window on an edited ramp keeps the stops and spans the foreground.
+    before = vx.tf.table(p)
+    with bpy.context.temp_override(object=ob, active_object=ob):
+        assert bpy.ops.voxlight.tf_fit_window() == {"FINISHED"}
+    assert np.array_equal(vx.tf.table(p), before)
+    assert p.data_min < p.window_low < p.window_high <= p.data_max
 
 
-# Each preset on a volume whose values lie where the preset shows something.
-PRESET_DATA = {"CT_BONE": (-1000.0, 1000.0), "CT_SOFT_TISSUE": (-1000.0, 100.0),
+@test
+def old_enum_and_use_colorramp_still_work_from_scripts():
+    ob = _volume("legacy_script.nii.gz")
+    p = ob.voxlight
+    p.preset = "hot"  # the old "Transfer Function" enum loads that preset
+    assert p.tf_preset == "HOT" and vx.tf.preset_state(p) == ("Hot", False)
+    hot = _render(ob)
+    p.preset = "bone"
+    assert p.tf_preset == "BONE" and _diff(_render(ob), hot) > 1e-3
+    p.tf_texture.color_ramp.elements[0].color = (0, 0, 1, 1)
+    p.use_color_ramp = False  # "use the library preset" = load it again
+    assert vx.tf.preset_state(p) == ("Bone", False)
+    p.use_color_ramp = True
+    assert p.tf_preset == "BONE"
+
+
+@test
+def old_files_open_looking_the_same():
+    """A volume saved before the single editor (library preset, no custom
+    window) is converted when the file opens: its preset's table goes into
+    the ramp and the library's window becomes explicit."""
+    for preset, lo, hi in (("bone", 0.0, 120.0), ("auto", -1024.0, 2000.0)):
+        ob = _volume("legacy_%s.nii.gz" % preset, lo, hi)
+        p = ob.voxlight
+        vx.tf._quiet = True  # write the old state without the legacy callbacks
+        try:
+            p.tf_version = 0
+            p.use_color_ramp = False
+            p.use_window = False
+            p.preset = preset
+            p.window_low, p.window_high = 12.0, 34.0  # ignored without use_window
+        finally:
+            vx.tf._quiet = False
+        before = _render(ob)  # the library's preset and window, as before
+        name = ob.name
+        path = os.path.join(u.TMP, "legacy_%s.blend" % preset)
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        vx.runtime.release_all()
+        bpy.ops.wm.open_mainfile(filepath=path)
+        ob = bpy.data.objects[name]
+        p = ob.voxlight
+        assert p.tf_version == vx.tf.TF_VERSION and p.use_color_ramp and p.use_window
+        key = {"bone": "BONE", "auto": "CT"}[preset]
+        assert p.tf_preset == key, (preset, p.tf_preset)
+        want = (-1000.0, 2000.0) if key == "CT" else (p.data_min, p.data_max)
+        assert abs(p.window_low - want[0]) < 1e-3 and abs(p.window_high - want[1]) < 1e-3
+        after = _render(ob)
+        assert _diff(after, before) < 0.02, (preset, _diff(after, before))
+
+
+@test
+def dicom_modality_decides_the_kind_of_data():
+    """Values 76..87 look like arbitrary units, but a DICOM series that says
+    CT is CT (Hounsfield units, CT preset); its MR sibling is MR."""
+    from dicom_write import write_dicom
+    u.reset_scene()
+    d = os.path.join(u.TMP, "modality")
+    os.makedirs(d, exist_ok=True)
+    px = np.arange(12, dtype=np.uint16).reshape(3, 4) + 1100  # 76..87 after the -1024 intercept
+    for k in range(4):
+        write_dicom(os.path.join(d, "c%d.dcm" % k), "1.2.9.1", px, 2.0 * k)
+    for k in range(2):
+        write_dicom(os.path.join(d, "m%d.dcm" % k), "1.2.9.2", px, 2.0 * k, modality="MR")
+    ct = u.import_volume(os.path.join(d, "c0.dcm"))  # the file's series, by its size
+    mr = u.import_volume(os.path.join(d, "m0.dcm"), series="1.2.9.2")
+    assert (ct.voxlight.data_kind, ct.voxlight.tf_preset) == ("ct", "CT")
+    assert (mr.voxlight.data_kind, mr.voxlight.tf_preset) == ("mr", "MRI")
+    assert vx.tf_fit.guess_kind(76.0, 87.0) == "mr"  # what the range alone would say
+
+
+# Each Slicer preset on a volume whose values lie where the preset shows something.
+PRESET_DATA = {"CT_BONE": (-1000.0, 1000.0), "CT_SOFT_TISSUE": (-1000.0, 400.0),
                "CT_LUNG": (-1000.0, -500.0), "MR_DEFAULT": (0.0, 300.0),
                "MR_ANGIO": (0.0, 300.0)}
 
 
 @test
-def presets_rewrite_the_ramp_and_render():
-    from voxlight import tf
-    assert set(PRESET_DATA) == set(tf.SLICER_PRESETS)
-    images = {}
+def slicer_presets_render():
+    assert set(PRESET_DATA) == set(vx.tf.SLICER_PRESETS)
     for key, (lo, hi) in PRESET_DATA.items():
         ob = _volume("preset_%s.nii.gz" % key.lower(), lo, hi)
-        p = ob.voxlight
-        with bpy.context.temp_override(object=ob, active_object=ob):
-            assert bpy.ops.voxlight.tf_preset(preset=key) == {"FINISHED"}
-        wlo, whi, stops = tf.preset_stops(key)
-        assert p.use_color_ramp and p.use_window
-        assert abs(p.window_low - wlo) < 1e-3 and abs(p.window_high - whi) < 1e-3
-        els = p.tf_texture.color_ramp.elements
-        assert len(els) == len(stops), (key, len(els), len(stops))
-        # The ramp reproduces the preset's opacity at its own points.
-        pr = tf.SLICER_PRESETS[key]
-        for x, a in pr["opacity"]:
-            if wlo <= x <= whi:
-                got = p.tf_texture.color_ramp.evaluate((x - wlo) / (whi - wlo))[3]
-                assert abs(got - a) < 0.02, (key, x, a, got)
+        _load(ob, key)
         img = _render(ob)
-        assert img[..., 3].max() > 0.2, (key, img[..., 3].max())
+        assert img[..., 3].max() > 0.05, (key, img[..., 3].max())
         assert img[0, 0, 3] < 0.05, key
-        images[key] = img
-    keys = list(images)
-    for i in range(len(keys)):
-        for j in range(i + 1, len(keys)):
-            assert images[keys[i]].shape == images[keys[j]].shape
 
 
 @test
 def classification_and_gradient_opacity_change_the_render():
     ob = _volume("classify.nii.gz")
     p = ob.voxlight
-    p.use_window, p.window_low, p.window_high = True, 20.0, 110.0
-    p.use_color_ramp = True
+    p.window_low, p.window_high = 20.0, 110.0
     ramp = p.tf_texture.color_ramp
-    # A sharp ramp: pre-integration matters most there.
-    ramp.elements[0].position, ramp.elements[0].color = 0.55, (1, 0.5, 0.2, 0.0)
-    ramp.elements[1].position, ramp.elements[1].color = 0.6, (1, 1, 1, 0.8)
+    vx.tf.set_ramp(ramp, [(0.55, (1, 0.5, 0.2, 0.0)), (0.6, (1, 1, 1, 0.8))])  # sharp
     prev = _render(ob)
     for name, value in (("classify", "pre"), ("classify", "preint"), ("classify", "post"),
                         ("gradient_opacity", "boundary"), ("gradient_ref", 0.5),
@@ -156,12 +258,9 @@ def f12_uses_the_ramp():
     scene.render.resolution_x = scene.render.resolution_y = 48
     scene.render.engine = "BLENDER_WORKBENCH"
     p = ob.voxlight
-    p.use_window, p.window_low, p.window_high = True, 0.0, 120.0
-    p.use_color_ramp = True
+    p.window_low, p.window_high = 0.0, 120.0
     ramp = p.tf_texture.color_ramp
-    for e in ramp.elements:
-        e.color = (0.0, 1.0, 0.0, e.color[3])
-    ramp.elements[1].alpha = 1.0
+    vx.tf.set_ramp(ramp, [(0.0, (0, 1, 0, 0)), (1.0, (0, 1, 0, 1))])
     out = os.path.join(u.TMP, "f12_ramp.png")
     scene.render.filepath = out
     scene.render.image_settings.file_format = "PNG"
@@ -171,50 +270,159 @@ def f12_uses_the_ramp():
     assert centre[1] > centre[0] + 0.1 and centre[1] > centre[2] + 0.1, centre
 
 
-class _AnyLayout:
-    """Stands in for a UILayout: accepts every call and records prop names."""
+def _box_pixels(ob, camera, w, h):
+    """Mask of the pixels the volume's box covers on screen (convex hull of
+    its projected corners)."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    view, proj = vx.offline.camera_matrices(camera, depsgraph, w, h, bpy.context.scene)
+    model = vx.params.model_matrix(ob)
+    c = np.c_[vx.native.voxel_box_corners(tuple(ob.voxlight.dims)), np.ones(8)]
+    clip = (proj @ view @ model @ c.T).T
+    pts = (clip[:, :2] / clip[:, 3:4] * 0.5 + 0.5) * [w, h]
+    pts = sorted(map(tuple, pts))
 
-    def __init__(self, log):
+    def half(ps):  # Andrew's monotone chain
+        out = []
+        for q in ps:
+            while len(out) >= 2 and np.cross(np.subtract(out[-1], out[-2]),
+                                             np.subtract(q, out[-2])) <= 0:
+                out.pop()
+            out.append(q)
+        return out[:-1]
+    hull = np.array(half(pts) + half(pts[::-1]))
+    yy, xx = np.mgrid[0:h, 0:w] + 0.5
+    inside = np.ones((h, w), bool)
+    for a, b in zip(hull, np.roll(hull, -1, axis=0)):
+        inside &= (b[0] - a[0]) * (yy - a[1]) - (b[1] - a[1]) * (xx - a[0]) >= 0
+    return inside
+
+
+@test
+def default_import_of_arbitrary_units_covers_part_of_the_box():
+    """ch2better (values 0..130): the default import's window lies inside
+    the data and its render covers between 5% and 60% of the box's screen
+    area (not fog filling the box, not nothing)."""
+    scene = u.reset_scene()
+    ob = u.import_volume(u.CH2)
+    p = ob.voxlight
+    assert p.data_kind == "mr" and p.tf_preset == "MRI"
+    assert p.data_min <= p.window_low < p.window_high <= p.data_max
+    cam = u.add_camera((0.0, -4.0, 0.5))
+    w, h = 96, 96
+    scene.render.resolution_x, scene.render.resolution_y = w, h
+    img = vx.render_volume(ob, camera=cam, resolution=(w, h))
+    box = _box_pixels(ob, cam, w, h)
+    assert box.sum() > 0.1 * w * h
+    coverage = float(img[..., 3][box].sum() / box.sum())
+    print("ch2better default import: window %.1f..%.1f, alpha coverage %.1f%% of the box"
+          % (p.window_low, p.window_high, 100 * coverage))
+    assert 0.05 <= coverage <= 0.60, coverage
+    # A preset that does not fit (CT Bone on MR) is placed by the histogram too.
+    _load(ob, "CT_BONE")
+    assert p.data_min <= p.window_low < p.window_high <= p.data_max
+
+
+class _AnyLayout:
+    """Stands in for a UILayout: accepts every call and records (call, name
+    or text) pairs, and the property-split settings."""
+
+    def __init__(self, log, split):
         self.__dict__["log"] = log
+        self.__dict__["split"] = split
 
     def __getattr__(self, name):
         def call(*args, **kw):
             self.log.append((name, args[1] if len(args) > 1 else kw.get("text")))
-            return _AnyLayout(self.log)
+            if "text" in kw and name in ("prop", "menu", "operator", "label"):
+                self.log.append((name + ":text", kw["text"]))
+            return _AnyLayout(self.log, self.split)
         return call
 
     def __setattr__(self, name, value):
-        pass
+        if name == "use_property_split":
+            self.split.append(value)
+
+
+def _draw_panels(ob):
+    log, split = [], []
+
+    class Ctx:
+        object = ob
+        region = None
+        preferences = bpy.context.preferences
+    for name in ("VOXLIGHT_PT_volume", "VOXLIGHT_PT_volume_rendering", "VOXLIGHT_PT_volume_tf",
+                 "VOXLIGHT_PT_volume_lighting", "VOXLIGHT_PT_volume_advanced",
+                 "VOXLIGHT_PT_volume_stats"):
+        panel = getattr(bpy.types, name)
+        fake = type("P", (), {"layout": _AnyLayout(log, split)})()
+        for fn in ("draw_header", "draw_header_preset", "draw"):
+            if hasattr(panel, fn):
+                getattr(panel, fn)(fake, Ctx)
+    return log, split
 
 
 @test
-def panel_draws_ramp_and_new_properties():
+def panel_has_subpanels_ramp_picture_and_preset_name():
     ob = _volume("panel.nii.gz")
     p = ob.voxlight
-    panel = bpy.types.VOXLIGHT_PT_volume
-    for use_ramp, gop in ((False, "off"), (True, "boundary"), (True, "iso")):
-        p.use_color_ramp, p.gradient_opacity = use_ramp, gop
-        log = []
-
-        class Ctx:
-            object = ob
-        panel.draw(type("P", (), {"layout": _AnyLayout(log)})(), Ctx)
+    subs = [c for c in bpy.types.Panel.__subclasses__()
+            if getattr(c, "bl_parent_id", "") == "VOXLIGHT_PT_volume"]
+    labels = {c.bl_label: c for c in subs}
+    assert set(labels) == {"Rendering", "Transfer Function", "Lighting", "Advanced",
+                           "Statistics"}, set(labels)
+    for name in ("Advanced", "Statistics"):
+        assert "DEFAULT_CLOSED" in labels[name].bl_options
+    for gop in ("off", "boundary", "iso"):
+        p.gradient_opacity = gop
+        log, split = _draw_panels(ob)
         names = {n for _f, n in log}
-        assert "classify" in names and "gradient_opacity" in names
-        assert ("template_color_ramp", "color_ramp") in log or not use_ramp
-        assert (("prop", "preset") in log) == (not use_ramp)
+        assert {"classify", "gradient_opacity", "window_low", "window_high", "filter",
+                "step", "shading", "ambient", "opacity_scale"} <= names, names
+        assert ("template_color_ramp", "color_ramp") in log
+        assert any(f == "template_icon" for f, _n in log)  # the histogram picture
+        assert ("menu:text", "MRI") in log, [x for x in log if x[0] == "menu:text"]
         assert ("iso_value" in names) == (gop == "iso")
-        assert any(isinstance(n, str) and n.startswith("Histogram") for n in names)
+        assert split and all(split), split  # property-split layout everywhere
+        assert "preset" not in names and "use_color_ramp" not in names
+    p.tf_texture.color_ramp.elements[0].position = 0.3
+    log, _split = _draw_panels(ob)
+    assert ("menu:text", "MRI (modified)") in log
+    # every property of the volume and of the scene settings has a tooltip
+    for owner in (bpy.types.Object, bpy.types.Scene):
+        props = owner.bl_rna.properties["voxlight"].fixed_type.properties
+        missing = [q.identifier for q in props
+                   if q.identifier != "rna_type" and not q.is_hidden
+                   and not q.description.strip()]
+        assert not missing, (owner, missing)
+    rna = bpy.types.Object.bl_rna.properties["voxlight"].fixed_type
+    filt = rna.properties["filter"].enum_items
+    assert filt["central"].description.startswith("Central: fast, good on clean data")
+    assert filt["sobel26"].description.startswith("Sobel 26: smooth normals on noisy scans")
 
 
 @test
-def unregister_removes_the_handler():
-    bpy.ops.preferences.addon_disable(module="voxlight")
-    assert not [h for h in bpy.app.handlers.depsgraph_update_post
-                if "voxlight" in getattr(h, "__module__", "")]
-    assert not hasattr(bpy.ops.voxlight, "tf_preset") or \
-        "voxlight.tf_preset" not in dir(bpy.types)
-    bpy.ops.preferences.addon_enable(module="voxlight")
+def histogram_picture_follows_the_window():
+    ob = _volume("picture.nii.gz")
+    p = ob.voxlight
+    a = vx.panels.histogram_icon(ob)
+    pv = vx.panels._previews[ob.name]
+    assert tuple(pv.image_size) == vx.panels.PICTURE_SIZE
+    px1 = np.array(pv.image_pixels_float[:])
+    assert px1.size == 4 * vx.panels.PICTURE_SIZE[0] * vx.panels.PICTURE_SIZE[1]
+    assert vx.panels.histogram_icon(ob) == a  # unchanged: no new picture
+    p.window_high = p.window_high * 0.5
+    vx.panels.histogram_icon(ob)
+    px2 = np.array(vx.panels._previews[ob.name].image_pixels_float[:])
+    assert np.abs(px2 - px1).max() > 0.1
+
+
+@test
+def unregister_removes_the_handlers():
+    u.disable()
+    for lst in (bpy.app.handlers.depsgraph_update_post, bpy.app.handlers.load_post):
+        assert not [h for h in lst if u.is_ours(getattr(h, "__module__", ""))]
+    assert "VOXLIGHT_MT_tf_presets" not in dir(bpy.types)
+    u.enable()
 
 
 u.run("test_tf")

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "helper_main.h"
 #include "voxlight.h"
 
 static char vxl_fuzz_dir[64];
@@ -67,6 +68,19 @@ static inline int vxl_fuzz_load(const uint8_t *data, size_t size, const char *ex
     const char *path = vxl_fuzz_write(data, size, ext);
     vxl_volume *v = NULL;
     vxl_fuzz_check(vxl_volume_load(path, &vxl_fuzz_options, &v), v);
+    return 0;
+}
+
+/* The same through a reader that the library runs in a helper process
+ * (csrc/helper_main.h), called in-process here: libFuzzer sees coverage
+ * only in its own process. */
+typedef int (*vxl_fuzz_reader)(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+
+static inline int vxl_fuzz_read(const uint8_t *data, size_t size, const char *ext, vxl_fuzz_reader read)
+{
+    const char *path = vxl_fuzz_write(data, size, ext);
+    vxl_volume *v = NULL;
+    vxl_fuzz_check(read(path, &vxl_fuzz_options, &v, NULL), v);
     return 0;
 }
 

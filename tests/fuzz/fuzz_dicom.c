@@ -1,8 +1,10 @@
 /* fuzz_dicom.c - libFuzzer target: arbitrary bytes as a .dcm file through
- * vxl_volume_load (dcmtk parses it; the series is the file's own, alone in
- * its folder), under ASan+UBSan (see Makefile 'fuzz', ./build.sh fuzz). */
+ * the DICOM reader (csrc/dicom.cpp, which the library runs in the
+ * voxlight-read-dicom helper), in-process (dcmtk parses it; the series is
+ * the file's own, alone in its folder), under ASan+UBSan (see Makefile
+ * 'fuzz', ./build.sh fuzz). */
 #include "fuzz_common.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) { return vxl_fuzz_load(data, size, "dcm"); }
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) { return vxl_fuzz_read(data, size, "dcm", vxl_dicom_read); }

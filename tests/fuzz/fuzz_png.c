@@ -1,7 +1,9 @@
-/* fuzz_png.c - libFuzzer target: arbitrary bytes as a .png file through
- * vxl_volume_load, under ASan+UBSan (see Makefile 'fuzz', ./build.sh fuzz). */
+/* fuzz_png.c - libFuzzer target: arbitrary bytes as a .png file through the
+ * image stack reader (csrc/image_stack.cpp, which the library runs in the
+ * voxlight-read-oiio helper), in-process, under ASan+UBSan (see Makefile
+ * 'fuzz', ./build.sh fuzz). */
 #include "fuzz_common.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) { return vxl_fuzz_load(data, size, "png"); }
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) { return vxl_fuzz_read(data, size, "png", vxl_image_stack_read); }

@@ -1,8 +1,10 @@
-"""OpenVDB files are read in a helper process (csrc/vdb_spawn.c,
-csrc/vdb_helper_main.c): a file on which libopenvdb aborts gives a clean
-error and this process lives on; the parent trusts nothing the helper
-sends (fake helpers below), leaves no zombie and no descriptor behind, and
-never falls back to reading in-process."""
+"""OpenVDB files (like TIFF/PNG stacks and DICOM) are read in a helper
+process (csrc/reader_spawn.c, csrc/helper_main.c, voxlight-read-oiio): a
+file on which libopenvdb aborts gives a clean error and this process lives
+on; the parent trusts nothing the helper sends (fake helpers below), leaves
+no zombie and no descriptor behind, and never falls back to reading
+in-process. tests/cli/test_reader_helpers.py covers missing helpers and
+libraries per format."""
 
 import os
 import stat
@@ -18,7 +20,15 @@ from vdb_write import write_vdb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ABORTS = os.path.join(ROOT, "tests", "fuzz", "upstream", "openvdb_delayed_load_mask_assert.vdb")
-HEADER = "=8sII3II3d16dQ"  # vxl_vdb_header in csrc/vdb_stream.h
+# vxl_reader_header in csrc/reader_stream.h: magic; status, msg_len, kind,
+# count, record_size, dims[3], src_dtype, texture_bits, nifti_version,
+# affine_source, frame_count, frame, reserved[2]; tex_lo, tex_hi, value_min,
+# value_max; spacing[3]; affine[16]; nan_count, inf_count, storage_bytes,
+# nbytes
+HEADER = "=8s16I4d3d16d4Q"
+HELPER_ENV = "VOXLIGHT_READ_OIIO"
+TIMEOUT_ENV = "VOXLIGHT_READER_TIMEOUT"
+VXL_DTYPE_F32 = 7
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +80,7 @@ def test_valid_file_leaves_no_child_or_descriptor(lib, small_vdb):
 
 
 def _fake_helper(tmp_path, body):
-    """An executable Python script standing in for voxlight-vdb-read."""
+    """An executable Python script standing in for voxlight-read-oiio."""
     p = tmp_path / "fake-helper"
     p.write_text("#!%s\nimport struct, sys, time\nout = sys.stdout.buffer\nHEADER = %r\n%s\n"
                  % (sys.executable, HEADER, body))
@@ -78,25 +88,33 @@ def _fake_helper(tmp_path, body):
     return str(p)
 
 
-def _header(status=0, dims=(4, 3, 2), nbytes=None, msg_len=0, magic=b"VXLVDB1\0"):
+def _header(status=0, dims=(4, 3, 2), nbytes=None, msg_len=0, magic=b"VXLRD01\0", kind=1, affine=None):
     n = dims[0] * dims[1] * dims[2] * 4 if nbytes is None else nbytes
-    return struct.pack(HEADER, magic, status, 7, *dims, msg_len, 1.0, 1.0, 1.0,
-                       *np.eye(4).T.ravel(), n)
+    a = np.eye(4).T.ravel() if affine is None else affine
+    return struct.pack(HEADER, magic, status, msg_len, kind, 0, 0, *dims, VXL_DTYPE_F32, 32, 0, 2, 1, 0, 0, 0,
+                       0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *a, 0, 0, n, n)
+
+
+assert struct.calcsize(HEADER) == 288
 
 
 @pytest.mark.parametrize("body, needle", [
     # a header that claims 2^30 voxels: refused by the budget before allocating
     ("out.write(%r)" % _header(dims=(1024, 1024, 1024)), r"over the memory budget of 1\.0 MiB"),
-    ("out.write(%r + bytes(10))" % _header(), r"output was cut short \(202 of 288 bytes\)"),
-    ("out.write(%r)" % _header(nbytes=5), r"announced 5 bytes for 4x3x2"),
+    ("out.write(%r + bytes(10))" % _header(), r"output of the OpenVDB reader was cut short \(298 of 384 bytes\)"),
+    ("out.write(%r)" % _header(nbytes=5), r"announced 5 bytes for 4x3x2 voxels of 32 bits"),
     ("out.write(b'hello world' * 30)", r"sent no valid header"),
     ("out.write(%r + bytes(96) + b'x')" % _header(), r"more than it announced"),
+    ("out.write(%r + bytes(96))" % _header(kind=2), r"reply of kind 2, not 1"),
+    ("out.write(%r + bytes(96))" % _header(affine=[float("nan")] * 16), r"transform is not finite"),
+    # float texels must lie in [0, 1]: 2.0 is refused, naming the voxel
+    ("out.write(%r + bytes(8) + struct.pack('=f', 2.0) + bytes(84))" % _header(), r"texel outside \[0, 1\] at voxel 2"),
     ("sys.stderr.write('no such grid\\n'); sys.exit(4)", r"failed \(exit 4\): no such grid"),
     ("out.write(%r + b'it is broken'); sys.exit(1)" % _header(status=3, msg_len=12), r"^it is broken$"),
     ("import os, signal; os.kill(os.getpid(), signal.SIGSEGV)", r"crashed \(signal 11: SIGSEGV\)"),
 ])
 def test_parent_trusts_nothing_the_helper_sends(lib, small_vdb, tmp_path, monkeypatch, body, needle):
-    monkeypatch.setenv("VOXLIGHT_VDB_HELPER", _fake_helper(tmp_path, body))
+    monkeypatch.setenv(HELPER_ENV, _fake_helper(tmp_path, body))
     fds = _fds()
     with pytest.raises(native.VoxlightError, match=needle):
         native.Volume.load(small_vdb, memory_budget=1 << 20, lib=lib)
@@ -104,8 +122,8 @@ def test_parent_trusts_nothing_the_helper_sends(lib, small_vdb, tmp_path, monkey
 
 
 def test_hung_helper_is_killed(lib, small_vdb, tmp_path, monkeypatch):
-    monkeypatch.setenv("VOXLIGHT_VDB_HELPER", _fake_helper(tmp_path, "time.sleep(60)"))
-    monkeypatch.setenv("VOXLIGHT_VDB_TIMEOUT", "1")
+    monkeypatch.setenv(HELPER_ENV, _fake_helper(tmp_path, "time.sleep(60)"))
+    monkeypatch.setenv(TIMEOUT_ENV, "1")
     t0 = time.monotonic()
     with pytest.raises(native.VoxlightError, match=r"took longer than 1 s and was stopped"):
         native.Volume.load(small_vdb, lib=lib)
@@ -114,14 +132,14 @@ def test_hung_helper_is_killed(lib, small_vdb, tmp_path, monkeypatch):
 
 
 def test_missing_or_unrunnable_helper_is_an_error_not_a_fallback(lib, small_vdb, tmp_path, monkeypatch):
-    monkeypatch.setenv("VOXLIGHT_VDB_HELPER", str(tmp_path / "nowhere"))
-    with pytest.raises(native.VoxlightError, match=r"helper .*nowhere is missing"):
+    monkeypatch.setenv(HELPER_ENV, str(tmp_path / "nowhere"))
+    with pytest.raises(native.VoxlightError, match=r"OpenVDB files are read by the helper program .*nowhere, which is missing"):
         native.Volume.load(small_vdb, lib=lib)
     plain = tmp_path / "not-executable"
     plain.write_bytes(b"")
     plain.chmod(stat.S_IRUSR | stat.S_IWUSR)
     assert not os.access(plain, os.X_OK)  # root too: no execute bit at all
-    monkeypatch.setenv("VOXLIGHT_VDB_HELPER", str(plain))
+    monkeypatch.setenv(HELPER_ENV, str(plain))
     with pytest.raises(native.VoxlightError, match=r"is not executable"):
         native.Volume.load(small_vdb, lib=lib)
 
@@ -132,13 +150,14 @@ def test_add_on_restores_the_helpers_execute_bit(tmp_path):
     import zipfile
     src = tmp_path / "src"
     src.mkdir()
-    (src / native.VDB_HELPER_NAME).write_bytes(b"#!/bin/sh\nexit 0\n")
-    (src / native.VDB_HELPER_NAME).chmod(0o755)
+    name = "voxlight-read-oiio"
+    (src / name).write_bytes(b"#!/bin/sh\nexit 0\n")
+    (src / name).chmod(0o755)
     with zipfile.ZipFile(tmp_path / "a.zip", "w") as z:
-        z.write(src / native.VDB_HELPER_NAME, native.VDB_HELPER_NAME)
+        z.write(src / name, name)
     with zipfile.ZipFile(tmp_path / "a.zip") as z:
         z.extractall(tmp_path / "installed")
-    helper = tmp_path / "installed" / native.VDB_HELPER_NAME
+    helper = tmp_path / "installed" / name
     assert not os.access(helper, os.X_OK)  # what Blender's install leaves
     assert native.restore_execute_bit(str(helper))
     mode = stat.S_IMODE(helper.stat().st_mode)

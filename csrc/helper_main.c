@@ -1,0 +1,139 @@
+/* helper_main.c - see helper_main.h. The helper is started by
+ * reader_spawn.c with stdin on /dev/null, stdout and stderr on pipes; it
+ * is not meant to be run by hand. */
+#include "helper_main.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "reader_stream.h"
+
+static int write_all(int fd, const void *buf, size_t n)
+{
+    const char *p = buf;
+    while (n) {
+        ssize_t w = write(fd, p, n > (1u << 30) ? (1u << 30) : n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return -1;
+        p += w;
+        n -= (size_t)w;
+    }
+    return 0;
+}
+
+static int parse_u64(const char *s, unsigned long long *out)
+{
+    char *end;
+    errno = 0;
+    *out = strtoull(s, &end, 10);
+    return s[0] >= '0' && s[0] <= '9' && !*end && errno == 0;
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    *out = strtod(s, &end);
+    return *s && !*end && isfinite(*out);
+}
+
+/* argv[3..] into options; 0 when malformed. */
+static int parse_options(char **argv, vxl_load_options *opt)
+{
+    unsigned long long max_dim, budget, frame;
+    memset(opt, 0, sizeof *opt);
+    opt->struct_size = sizeof *opt;
+    if (!parse_u64(argv[3], &max_dim) || max_dim > UINT32_MAX || !parse_u64(argv[4], &budget)) return 0;
+    for (int a = 0; a < 3; a++)
+        if (!parse_double(argv[5 + a], &opt->voxel_size[a])) return 0;
+    if (!parse_u64(argv[8], &frame) || frame > UINT32_MAX) return 0;
+    opt->max_dim = (uint32_t)max_dim;
+    opt->memory_budget_bytes = budget;
+    opt->frame = (uint32_t)frame;
+    opt->series = argv[9][0] ? argv[9] : NULL;
+    return 1;
+}
+
+static void volume_header(const vxl_volume *v, vxl_reader_header *h)
+{
+    h->kind = VXL_REPLY_VOLUME;
+    memcpy(h->dims, v->dims, sizeof h->dims);
+    h->src_dtype = v->src_dtype;
+    h->texture_bits = v->texture_bits;
+    h->nifti_version = v->nifti_version;
+    h->affine_source = v->affine_source;
+    h->frame_count = v->frame_count ? v->frame_count : 1;
+    h->frame = v->frame;
+    h->tex_lo = v->tex_lo;
+    h->tex_hi = v->tex_hi;
+    h->value_min = v->value_min;
+    h->value_max = v->value_max;
+    memcpy(h->spacing, v->spacing, sizeof h->spacing);
+    memcpy(h->affine, v->affine, sizeof h->affine);
+    h->nan_count = v->nan_count;
+    h->inf_count = v->inf_count;
+    h->storage_bytes = v->storage_bytes;
+    h->nbytes = v->storage_bytes;
+}
+
+int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_command *cmds, int n_cmds)
+{
+    const vxl_helper_command *cmd = NULL;
+    for (int i = 0; argc == VXL_HELPER_ARGC && i < n_cmds; i++)
+        if (!strcmp(argv[1], cmds[i].name)) cmd = &cmds[i];
+    vxl_load_options opt;
+    if (!cmd || !parse_options(argv, &opt)) {
+        fprintf(stderr, "usage: %s COMMAND FILE MAX_DIM BUDGET_BYTES VOXEL_X VOXEL_Y VOXEL_Z FRAME SERIES "
+                "(started by libvoxlight; commands:", helper);
+        for (int i = 0; i < n_cmds; i++) fprintf(stderr, " %s", cmds[i].name);
+        fputs(")\n", stderr);
+        return 2;
+    }
+    /* The stream keeps stdout's pipe to itself: whatever the libraries
+     * print goes to stderr instead of into the voxels. */
+    int out = fcntl(1, F_DUPFD_CLOEXEC, 3);
+    if (out < 0 || dup2(2, 1) < 0) {
+        perror(helper);
+        return 3;
+    }
+    const char *path = argv[2];
+    vxl_reader_header h;
+    memset(&h, 0, sizeof h);
+    memcpy(h.magic, VXL_READER_MAGIC, sizeof VXL_READER_MAGIC);
+    vxl_err e = {0};
+    vxl_volume *v = NULL;
+    vxl_dicom_series *list = NULL;
+    const void *body = NULL;
+    if (cmd->read) {
+        h.status = (uint32_t)cmd->read(path, &opt, &v, &e);
+        if (h.status == VXL_OK) {
+            volume_header(v, &h);
+            body = v->texels;
+        }
+    } else {
+        uint32_t count = 0;
+        h.status = (uint32_t)cmd->list(path, &list, &count, &e);
+        if (h.status == VXL_OK) {
+            h.kind = VXL_REPLY_SERIES;
+            h.count = count;
+            h.record_size = sizeof *list;
+            h.nbytes = (uint64_t)count * sizeof *list;
+            body = list;
+        }
+    }
+    int rc;
+    if (h.status != VXL_OK) {
+        if (!e.msg[0]) snprintf(e.msg, sizeof e.msg, "'%s': the reader failed without a message", path);
+        h.msg_len = (uint32_t)strnlen(e.msg, sizeof e.msg);
+        rc = write_all(out, &h, sizeof h) || write_all(out, e.msg, h.msg_len) ? 3 : 1;
+    } else {
+        rc = write_all(out, &h, sizeof h) || write_all(out, body, (size_t)h.nbytes) ? 3 : 0;
+    }
+    vxl_volume_destroy(v);
+    free(list);
+    return rc;
+}

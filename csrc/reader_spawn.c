@@ -1,0 +1,453 @@
+/* reader_spawn.c - vxl_reader_run: one command of a reader helper process.
+ *
+ * The readers that need OpenImageIO or dcmtk run in helper processes found
+ * next to libvoxlight.so (reader_stream.h): the library then links only the
+ * C runtime, a missing library breaks only its own formats, and a reader
+ * that crashes (Debian's libopenvdb aborts on some corrupt files,
+ * tests/fuzz/upstream/README.md) cannot end the host's (Blender's) session.
+ * The helper is started with posix_spawn (never a bare fork in a
+ * multi-threaded host) and streams a header and a body over a pipe. Here
+ * the header is checked and a volume's size passes the memory budget
+ * before anything is allocated, a short stream is an error, a crash becomes
+ * a message naming the signal, a library the dynamic loader cannot find
+ * becomes a message naming it and its Debian package, a hung helper is
+ * killed after a time limit scaled with the input's size, and the child is
+ * always reaped. Nothing is ever written to the child, so SIGPIPE cannot
+ * reach this process, and every descriptor here is O_CLOEXEC. There is no
+ * in-process fallback. */
+#include "reader_spawn.h"
+
+#include <dlfcn.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "loader_util.h"
+
+extern char **environ;
+
+#define STDERR_KEEP 600          /* the tail of the helper's stderr quoted in errors */
+#define MAX_SERIES 100000u       /* dicom.cpp scans at most this many files */
+#define LOADER_SAYS "error while loading shared libraries: "
+
+static int helper_path(const vxl_reader *r, const char *path, char *out, size_t n, vxl_err *e)
+{
+    const char *env = getenv(r->env);
+    if (env && *env) {
+        if (snprintf(out, n, "%s", env) >= (int)n)
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "%s is too long", r->env);
+    } else {
+        Dl_info info;
+        if (!dladdr((void *)&vxl_reader_run, &info) || !info.dli_fname)
+            return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot locate libvoxlight to find %s", path,
+                            r->helper);
+        const char *slash = strrchr(info.dli_fname, '/');
+        int dir_len = slash ? (int)(slash - info.dli_fname) : 1;
+        if (snprintf(out, n, "%.*s/%s", dir_len, slash ? info.dli_fname : ".", r->helper) >= (int)n)
+            return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': the path of %s is too long", path, r->helper);
+    }
+    if (access(out, F_OK))
+        return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': %s are read by the helper program %s, which is missing "
+                        "(it belongs next to libvoxlight.so: reinstall the add-on)", path, r->formats, out);
+    if (access(out, X_OK))
+        return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': the helper program %s that reads %s is not executable "
+                        "(chmod +x it)", path, out, r->formats);
+    return VXL_OK;
+}
+
+/* Seconds the helper may take: generous (OpenVDB decompresses every grid, a
+ * DICOM folder is parsed file by file), one minute plus a second per 4 MiB
+ * of input. */
+static double time_limit(uint64_t input_bytes)
+{
+    const char *env = getenv(VXL_READER_TIMEOUT_ENV);
+    if (env && *env) {
+        char *end;
+        double s = strtod(env, &end);
+        if (!*end && isfinite(s) && s > 0) return s;
+    }
+    return 60.0 + (double)(input_bytes >> 22);
+}
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+/* What came back over the two pipes. */
+typedef struct reply {
+    vxl_reader_header h;
+    size_t h_got;
+    char *body;            /* the message or the body, once the header passed */
+    uint64_t body_len, body_got;
+    int extra;             /* bytes after the announced end */
+    char err_tail[STDERR_KEEP + 1];
+    size_t err_len;
+} reply;
+
+static void keep_stderr(reply *r, const char *buf, size_t n)
+{
+    if (n >= STDERR_KEEP) {
+        memcpy(r->err_tail, buf + n - STDERR_KEEP, STDERR_KEEP);
+        r->err_len = STDERR_KEEP;
+    } else {
+        size_t drop = r->err_len + n > STDERR_KEEP ? r->err_len + n - STDERR_KEEP : 0;
+        memmove(r->err_tail, r->err_tail + drop, r->err_len - drop);
+        memcpy(r->err_tail + r->err_len - drop, buf, n);
+        r->err_len += n - drop;
+    }
+    r->err_tail[r->err_len] = '\0';
+}
+
+static int all_finite(const double *v, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+/* A volume header: every field the rebuilt vxl_volume will hold. */
+static int check_volume_header(const vxl_reader *r, const char *path, const vxl_reader_header *h,
+                               const vxl_load_options *opt, vxl_err *e)
+{
+    if (!vxl_dtype_size(h->src_dtype) || h->texture_bits != vxl_texture_bits_for(h->src_dtype))
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent data type %u with %u-bit texels", path,
+                        r->name, h->src_dtype, h->texture_bits);
+    vxl_err inner = {0};
+    if (vxl_volume_check_limits(h->dims, h->texture_bits / 8, opt, &inner)) return vxl_fail_in(e, path, &inner);
+    const uint64_t nbytes = (uint64_t)h->dims[0] * h->dims[1] * h->dims[2] * (h->texture_bits / 8);
+    if (h->nbytes != nbytes || h->storage_bytes != nbytes)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s announced %llu bytes for %ux%ux%u voxels of %u bits",
+                        path, r->name, (unsigned long long)h->nbytes, h->dims[0], h->dims[1], h->dims[2],
+                        h->texture_bits);
+    if (!all_finite(h->affine, 16))
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': the volume's transform is not finite", path);
+    const double range[4] = {h->tex_lo, h->tex_hi, h->value_min, h->value_max};
+    int spacing_ok = all_finite(h->spacing, 3) && h->spacing[0] > 0 && h->spacing[1] > 0 && h->spacing[2] > 0;
+    if (!spacing_ok || !all_finite(range, 4) || !(h->value_min <= h->value_max) || h->frame_count == 0 ||
+        h->frame >= h->frame_count || h->affine_source > 2 || h->nifti_version > 2 ||
+        h->nan_count + h->inf_count < h->nan_count || h->nan_count + h->inf_count > nbytes)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent an inconsistent volume header", path, r->name);
+    return VXL_OK;
+}
+
+/* Checks a complete header and makes room for what follows it. */
+static int accept_header(const vxl_reader *r, const char *path, reply *rp, uint32_t kind,
+                         const vxl_load_options *opt, vxl_err *e)
+{
+    const vxl_reader_header *h = &rp->h;
+    if (memcmp(h->magic, VXL_READER_MAGIC, sizeof VXL_READER_MAGIC))
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent no valid header", path, r->name);
+    if (h->status != VXL_OK) {
+        if (h->msg_len == 0 || h->msg_len > VXL_READER_MSG_MAX)
+            return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s failed (code %u) with a bad message length %u",
+                            path, r->name, h->status, h->msg_len);
+        rp->body_len = h->msg_len;
+    } else if (h->kind != kind) {
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent a reply of kind %u, not %u", path, r->name,
+                        h->kind, kind);
+    } else if (kind == VXL_REPLY_VOLUME) {
+        int rc = check_volume_header(r, path, h, opt, e);
+        if (rc) return rc;
+        rp->body_len = h->nbytes;
+    } else {
+        if (h->record_size != sizeof(vxl_dicom_series) || h->count > MAX_SERIES ||
+            h->nbytes != (uint64_t)h->count * sizeof(vxl_dicom_series))
+            return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s announced %u series of %u bytes in %llu bytes",
+                            path, r->name, h->count, h->record_size, (unsigned long long)h->nbytes);
+        rp->body_len = h->nbytes;
+    }
+    rp->body = malloc(rp->body_len ? (size_t)rp->body_len : 1);
+    if (!rp->body)
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': out of memory for %llu bytes", path,
+                        (unsigned long long)rp->body_len);
+    return VXL_OK;
+}
+
+/* What a header cannot say: float texels in [0, 1], series records with
+ * terminated strings and sane fields. */
+static int check_body(const vxl_reader *r, const char *path, const reply *rp, vxl_err *e)
+{
+    const vxl_reader_header *h = &rp->h;
+    if (h->kind == VXL_REPLY_VOLUME) {
+        if (h->texture_bits != 32) return VXL_OK;
+        const float *t = (const float *)rp->body;
+        for (uint64_t i = 0; i < h->nbytes / sizeof(float); i++)
+            if (!(t[i] >= 0.0f && t[i] <= 1.0f))
+                return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent a texel outside [0, 1] at voxel "
+                                "%llu", path, r->name, (unsigned long long)i);
+        return VXL_OK;
+    }
+    const vxl_dicom_series *s = (const vxl_dicom_series *)rp->body;
+    for (uint32_t i = 0; i < h->count; i++) {
+        int ok = s[i].struct_size == sizeof s[i] && s[i].loadable <= 1 && isfinite(s[i].gantry_tilt_deg) &&
+                 memchr(s[i].uid, 0, sizeof s[i].uid) && memchr(s[i].modality, 0, sizeof s[i].modality) &&
+                 memchr(s[i].description, 0, sizeof s[i].description) &&
+                 memchr(s[i].problem, 0, sizeof s[i].problem);
+        if (!ok)
+            return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent a malformed series record %u", path,
+                            r->name, i);
+    }
+    return VXL_OK;
+}
+
+/* Reads what is readable on the data pipe; sets *eof at its end. */
+static int read_data(const vxl_reader *r, const char *path, int fd, reply *rp, uint32_t kind,
+                     const vxl_load_options *opt, int *eof, vxl_err *e)
+{
+    char scratch[256];
+    void *dst;
+    size_t want;
+    if (rp->h_got < sizeof rp->h) {
+        dst = (char *)&rp->h + rp->h_got;
+        want = sizeof rp->h - rp->h_got;
+    } else if (rp->body_got < rp->body_len) {
+        dst = rp->body + rp->body_got;
+        uint64_t left = rp->body_len - rp->body_got;
+        want = left > (1u << 24) ? (1u << 24) : (size_t)left;
+    } else {
+        dst = scratch;
+        want = sizeof scratch;
+    }
+    ssize_t n = read(fd, dst, want);
+    if (n < 0) {
+        if (errno == EINTR || errno == EAGAIN) return VXL_OK;
+        return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': reading from %s: %s", path, r->name, strerror(errno));
+    }
+    if (n == 0) {
+        *eof = 1;
+        return VXL_OK;
+    }
+    if (dst == scratch) rp->extra = 1;
+    else if (rp->h_got < sizeof rp->h) {
+        rp->h_got += (size_t)n;
+        if (rp->h_got == sizeof rp->h) return accept_header(r, path, rp, kind, opt, e);
+    } else rp->body_got += (uint64_t)n;
+    return VXL_OK;
+}
+
+/* Moves a descriptor above 0..2, so that a host running with a standard
+ * stream closed cannot make the helper's dup2s below overwrite each other. */
+static int above_stdio(int fd)
+{
+    if (fd > 2) return fd;
+    int moved = fcntl(fd, F_DUPFD_CLOEXEC, 3);
+    close(fd);
+    return moved;
+}
+
+/* Opens a pipe, both ends O_CLOEXEC and above 0..2. */
+static int pipe_above_stdio(int p[2])
+{
+    if (pipe2(p, O_CLOEXEC)) return -1;
+    p[0] = above_stdio(p[0]);
+    p[1] = above_stdio(p[1]);
+    if (p[0] >= 0 && p[1] >= 0) return 0;
+    int saved = errno;
+    if (p[0] >= 0) close(p[0]);
+    if (p[1] >= 0) close(p[1]);
+    errno = saved;
+    return -1;
+}
+
+/* Starts the helper with stdout on data_w, stderr on err_w, stdin on
+ * /dev/null, no other descriptor of ours, default signal handling, and the
+ * load options as argv (reader_stream.h). */
+static int spawn_helper(const vxl_reader *r, const char *helper, const char *command, const char *path,
+                        const vxl_load_options *opt, int data_w, int err_w, pid_t *pid, vxl_err *e)
+{
+    char max_dim[24], budget[24], vs[3][32], frame[16];
+    double voxel[3];
+    vxl_load_voxel_size(opt, voxel);
+    snprintf(max_dim, sizeof max_dim, "%u", opt && opt->max_dim ? opt->max_dim : VXL_DEFAULT_MAX_DIM);
+    snprintf(budget, sizeof budget, "%llu",
+             (unsigned long long)(opt && opt->memory_budget_bytes ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET));
+    for (int a = 0; a < 3; a++) snprintf(vs[a], sizeof vs[a], "%.17g", voxel[a]);
+    snprintf(frame, sizeof frame, "%u", vxl_load_frame(opt));
+    const char *series = vxl_load_series(opt);
+    char *const argv[VXL_HELPER_ARGC + 1] = {(char *)helper, (char *)command, (char *)path, max_dim, budget,
+                                             vs[0], vs[1], vs[2], frame, (char *)(series ? series : ""), NULL};
+    posix_spawn_file_actions_t fa;
+    posix_spawnattr_t at;
+    sigset_t none, all;
+    sigemptyset(&none);
+    sigfillset(&all);
+    int rc = posix_spawn_file_actions_init(&fa);
+    if (rc) return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': %s", path, strerror(rc));
+    rc = posix_spawnattr_init(&at);
+    if (rc) {
+        posix_spawn_file_actions_destroy(&fa);
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': %s", path, strerror(rc));
+    }
+    if (!rc) rc = posix_spawn_file_actions_adddup2(&fa, data_w, 1);
+    if (!rc) rc = posix_spawn_file_actions_adddup2(&fa, err_w, 2);
+    if (!rc) rc = posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    /* the host's own descriptors without O_CLOEXEC stay out of the helper */
+    if (!rc) rc = posix_spawn_file_actions_addclosefrom_np(&fa, 3);
+    if (!rc) rc = posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+    if (!rc) rc = posix_spawnattr_setsigmask(&at, &none);
+    if (!rc) rc = posix_spawnattr_setsigdefault(&at, &all);
+    if (!rc) rc = posix_spawn(pid, helper, &fa, &at, argv, environ);
+    posix_spawnattr_destroy(&at);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc) return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot start %s (%s): %s", path, r->name, helper,
+                            strerror(rc));
+    return VXL_OK;
+}
+
+/* Collects the helper's output until both pipes close, the time limit
+ * passes (*timed_out) or the stream is bad (an error: the caller kills). */
+static int collect(const vxl_reader *r, const char *path, int data_r, int err_r, double limit, uint32_t kind,
+                   const vxl_load_options *opt, reply *rp, int *timed_out, vxl_err *e)
+{
+    const double deadline = now_s() + limit;
+    int data_eof = 0, err_eof = 0;
+    while (!data_eof || !err_eof) {
+        double left = deadline - now_s();
+        if (left <= 0) {
+            *timed_out = 1;
+            return VXL_OK;
+        }
+        struct pollfd p[2] = {{.fd = data_eof ? -1 : data_r, .events = POLLIN},
+                              {.fd = err_eof ? -1 : err_r, .events = POLLIN}};
+        int n = poll(p, 2, left > 1e6 ? 1000000000 : (int)(left * 1000.0) + 1);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': waiting for %s: %s", path, r->name, strerror(errno));
+        }
+        if (p[0].revents) {
+            int rc = read_data(r, path, data_r, rp, kind, opt, &data_eof, e);
+            if (rc) return rc;
+        }
+        if (p[1].revents) {
+            char buf[4096];
+            ssize_t k = read(err_r, buf, sizeof buf);
+            if (k > 0) keep_stderr(rp, buf, (size_t)k);
+            else if (k == 0 || (errno != EINTR && errno != EAGAIN)) err_eof = 1;
+        }
+    }
+    return VXL_OK;
+}
+
+/* The last non-empty line of the helper's stderr, for error messages. */
+static const char *last_line(reply *rp)
+{
+    char *s = rp->err_tail;
+    size_t n = strlen(s);
+    while (n && (s[n - 1] == '\n' || s[n - 1] == '\r' || s[n - 1] == ' ')) s[--n] = '\0';
+    char *nl = strrchr(s, '\n');
+    return nl ? nl + 1 : s;
+}
+
+/* The dynamic loader could not start the helper (exit 127 with "error while
+ * loading shared libraries: X: cannot open shared object file"): names X,
+ * the library the format needs and the package that brings both. */
+static int missing_library(const vxl_reader *r, const char *path, const reply *rp, vxl_err *e)
+{
+    const char *at = strstr(rp->err_tail, LOADER_SAYS);
+    if (!at) return VXL_OK;
+    at += strlen(LOADER_SAYS);
+    int len = (int)strcspn(at, ":\n");
+    if (len > 200) len = 200;
+    if (r->package[0])
+        return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': %s need %s (Debian package %s), and %.*s is missing: "
+                        "apt-get install %s", path, r->formats, r->library, r->package, len, at, r->package);
+    return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': %s need %s (%s), and %.*s is missing: install the package "
+                    "that provides %s", path, r->formats, r->library, r->soname, len, at, r->soname);
+}
+
+/* Turns how the helper ended and what it sent into our result. */
+static int verdict(const vxl_reader *r, const char *path, const char *helper, int status, int reaped,
+                   int timed_out, double limit, reply *rp, vxl_err *e)
+{
+    if (timed_out)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s took longer than %.0f s and was stopped", path,
+                        r->name, limit);
+    if (reaped && WIFEXITED(status) && WEXITSTATUS(status) == 127 && rp->h_got == 0) {
+        int rc = missing_library(r, path, rp, e);
+        if (rc) return rc;
+    }
+    const char *said = last_line(rp);
+    if (reaped && WIFSIGNALED(status)) {
+        int sig = WTERMSIG(status);
+        const char *abbrev = sigabbrev_np(sig);
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s crashed (signal %d: SIG%s) - the file is corrupt "
+                        "or unsupported%s%s%s", path, r->name, sig, abbrev ? abbrev : "?", *said ? " (" : "", said,
+                        *said ? ")" : "");
+    }
+    const int complete = rp->h_got == sizeof rp->h && rp->body && rp->body_got == rp->body_len;
+    if (complete && rp->h.status != VXL_OK) {
+        int code = rp->h.status >= VXL_ERR_INVALID_ARGUMENT && rp->h.status <= VXL_ERR_STATE ? (int)rp->h.status
+                                                                                             : VXL_ERR_FORMAT;
+        return vxl_fail(e, code, "%.*s", (int)rp->body_len, rp->body);
+    }
+    if (reaped && WIFEXITED(status) && WEXITSTATUS(status) != 0)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s (%s) failed (exit %d)%s%s", path, r->name, helper,
+                        WEXITSTATUS(status), *said ? ": " : "", said);
+    if (!complete)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': the output of %s was cut short (%llu of %llu bytes)",
+                        path, r->name, (unsigned long long)(rp->h_got + rp->body_got),
+                        (unsigned long long)(sizeof rp->h + rp->body_len));
+    if (rp->extra)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent more than it announced", path, r->name);
+    return check_body(r, path, rp, e);
+}
+
+int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, const vxl_load_options *opt,
+                   uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, vxl_err *e)
+{
+    *body = NULL;
+    char helper[4096];
+    int rc = helper_path(r, path, helper, sizeof helper, e);
+    if (rc) return rc;
+    int data[2], err[2];
+    if (pipe_above_stdio(data)) return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': pipe: %s", path, strerror(errno));
+    if (pipe_above_stdio(err)) {
+        int saved = errno;
+        close(data[0]);
+        close(data[1]);
+        return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': pipe: %s", path, strerror(saved));
+    }
+    /* a larger pipe: fewer wake-ups for the voxels (best effort; 64 KiB
+     * otherwise) */
+    (void)fcntl(data[1], F_SETPIPE_SZ, 1 << 20);
+    pid_t pid = -1;
+    rc = spawn_helper(r, helper, command, path, opt, data[1], err[1], &pid, e);
+    close(data[1]);
+    close(err[1]);
+    reply rp;
+    memset(&rp, 0, sizeof rp);
+    int timed_out = 0, status = 0, reaped = 0;
+    const double limit = time_limit(input_bytes);
+    if (!rc) {
+        rc = collect(r, path, data[0], err[0], limit, kind, opt, &rp, &timed_out, e);
+        if (rc || timed_out) kill(pid, SIGKILL);
+        pid_t w;
+        while ((w = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {}
+        /* ECHILD: the host reaps children itself (SIGCHLD ignored); the
+         * stream alone then decides */
+        reaped = w == pid;
+        if (!rc) rc = verdict(r, path, helper, status, reaped, timed_out, limit, &rp, e);
+    }
+    close(data[0]);
+    close(err[0]);
+    if (rc) {
+        free(rp.body);
+        return rc;
+    }
+    *h = rp.h;
+    *body = rp.body;
+    return VXL_OK;
+}

@@ -1,0 +1,33 @@
+/* reader_spawn.h - runs one command of a reader helper process
+ * (reader_stream.h) and checks every byte it sends. Used by
+ * remote_readers.c. */
+#ifndef VXL_READER_SPAWN_H
+#define VXL_READER_SPAWN_H
+
+#include <stdint.h>
+
+#include "reader_stream.h"
+#include "volume.h"
+
+/* A helper and what the user is told about it. */
+typedef struct vxl_reader {
+    const char *helper;   /* file name next to libvoxlight.so, VXL_HELPER_* */
+    const char *env;      /* the variable overriding its path */
+    const char *name;     /* "the OpenVDB reader", as messages name it */
+    const char *formats;  /* "OpenVDB files": "<formats> need <library>" */
+    const char *library;  /* "OpenImageIO" */
+    const char *soname;   /* the library's file, "libOpenImageIO.so.2.4" */
+    const char *package;  /* its Debian package; "" when the build could not tell */
+} vxl_reader;
+
+/* Runs `helper command path options` and collects its reply of kind
+ * VXL_REPLY_*. On success *h is the checked header and *body the malloc'd
+ * body of h->nbytes (free() it): for a volume, texels that passed the
+ * limits in opt (checked before allocating) and the value checks; for a
+ * series list, records whose strings are NUL-terminated. input_bytes (what
+ * the helper will read) scales the time limit. The helper is always reaped;
+ * a crash, a hang, a missing library or a bad stream is an error. */
+int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, const vxl_load_options *opt,
+                   uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, vxl_err *e);
+
+#endif

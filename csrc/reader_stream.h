@@ -1,0 +1,67 @@
+/* reader_stream.h - the readers that need heavy C++ libraries run in helper
+ * processes, so that libvoxlight.so links only the C runtime and a reader
+ * that crashes (Debian's libopenvdb aborts on some corrupt files) or whose
+ * library is missing cannot take the host (Blender) down:
+ *   voxlight-read-oiio   TIFF/PNG stacks and OpenVDB, through OpenImageIO
+ *   voxlight-read-dicom  DICOM, through dcmtk
+ * One helper per library, so a missing library breaks only its formats.
+ * reader_spawn.c starts a helper next to libvoxlight.so and checks what it
+ * sends; helper_main.c is the helpers' side. This is the pipe protocol both
+ * sides share. Both ends are the same build on the same machine: native
+ * layout, no versioning beyond the magic. */
+#ifndef VXL_READER_STREAM_H
+#define VXL_READER_STREAM_H
+
+#include <stdint.h>
+
+/* The helpers' file names; they sit next to libvoxlight.so. The variable
+ * named like the file (upper case, '-' as '_') overrides where one is
+ * (tests, unusual installs). */
+#define VXL_HELPER_OIIO "voxlight-read-oiio"
+#define VXL_HELPER_OIIO_ENV "VOXLIGHT_READ_OIIO"
+#define VXL_HELPER_DICOM "voxlight-read-dicom"
+#define VXL_HELPER_DICOM_ENV "VOXLIGHT_READ_DICOM"
+/* Overrides every helper's time limit in seconds (tests). */
+#define VXL_READER_TIMEOUT_ENV "VOXLIGHT_READER_TIMEOUT"
+
+/* The helpers' commands (argv[1]). */
+#define VXL_CMD_STACK "stack"              /* TIFF/PNG stack -> a volume */
+#define VXL_CMD_VDB "vdb"                  /* OpenVDB grid -> a volume */
+#define VXL_CMD_DICOM "dicom"              /* DICOM series -> a volume */
+#define VXL_CMD_DICOM_SERIES "dicom-series" /* DICOM folder -> vxl_dicom_series[] */
+
+/* argv: HELPER COMMAND PATH MAX_DIM BUDGET_BYTES VOXEL_X VOXEL_Y VOXEL_Z
+ * FRAME SERIES (SERIES may be ""): the load options, defaults resolved. */
+#define VXL_HELPER_ARGC 10
+
+#define VXL_READER_MAGIC "VXLRD01"
+#define VXL_READER_MSG_MAX 1024 /* longest error message a helper may send */
+
+#define VXL_REPLY_VOLUME 1u /* body: the volume's texels */
+#define VXL_REPLY_SERIES 2u /* body: count vxl_dicom_series records */
+
+/* The helper writes this header to stdout, then either msg_len bytes of
+ * error message (status != 0) or nbytes of body. For a volume the fields
+ * are those of the vxl_volume the in-process reader built (volume.h). */
+typedef struct vxl_reader_header {
+    char magic[8];          /* VXL_READER_MAGIC, NUL-padded */
+    uint32_t status;        /* VXL_OK or the VXL_ERR_* of the failure */
+    uint32_t msg_len;
+    uint32_t kind;          /* VXL_REPLY_* */
+    uint32_t count;         /* series records (VXL_REPLY_SERIES) */
+    uint32_t record_size;   /* sizeof(vxl_dicom_series) (VXL_REPLY_SERIES) */
+    uint32_t dims[3];
+    uint32_t src_dtype, texture_bits, nifti_version, affine_source;
+    uint32_t frame_count, frame;
+    uint32_t reserved[2];
+    double tex_lo, tex_hi, value_min, value_max;
+    double spacing[3];
+    double affine[16];      /* column-major voxel -> world */
+    uint64_t nan_count, inf_count, storage_bytes;
+    uint64_t nbytes;        /* body bytes that follow */
+} vxl_reader_header;
+
+/* tests/python/test_vdb_isolation.py packs this layout by hand. */
+_Static_assert(sizeof(vxl_reader_header) == 288, "vxl_reader_header layout changed: update the tests' format");
+
+#endif

@@ -1,0 +1,125 @@
+"""The one place that knows how Blender's Python API differs between the
+releases Voxlight supports (3.4 up to 5.x). Everything else calls these
+helpers instead of testing versions itself.
+
+Differences handled here:
+  * 5.0 removed scene.node_tree and scene.use_nodes for the compositor: the
+    compositing tree is a node group data-block (scene.compositing_node_group)
+    whose Group Output replaces the Composite node (also removed);
+  * 5.0 turned Alpha Over's options into input sockets and reordered them
+    (Background, Foreground, Factor, Type, Straight Alpha); before, the
+    inputs were Fac, Image (background), Image (foreground) with
+    use_premultiply/premul properties ("Straight Alpha" exists as a socket
+    from 4.5 as well);
+  * 4.2 made add-ons extensions: the package is then bl_ext.<repo>.voxlight,
+    so code uses __package__, never a hard-coded module name; an extension
+    keeps its files in its own user folder (private_data_dir).
+
+The version gate (unsupported_message) is bpy-free so it can be tested in
+plain Python.
+"""
+
+MIN_BLENDER = (3, 4, 0)
+
+
+def unsupported_message(version):
+    """None when this Blender version is supported, else the sentence the
+    preferences and the console show instead of a traceback."""
+    version = tuple(version)[:3]
+    if version >= MIN_BLENDER:
+        return None
+    return ("Voxlight needs Blender %s or newer; this is Blender %s. "
+            "Install a newer Blender from blender.org to use the add-on."
+            % (".".join(map(str, MIN_BLENDER)), ".".join(map(str, version))))
+
+
+def private_data_dir(package):
+    """A folder Blender gives this add-on for its own files: the extension's
+    user folder (4.2+, kept across updates), or None for a legacy add-on."""
+    bpy = _bpy()
+    if not package.startswith("bl_ext.") or not hasattr(bpy.utils, "extension_path_user"):
+        return None
+    try:
+        return bpy.utils.extension_path_user(package, path="lib", create=True) or None
+    except (OSError, ValueError):
+        return None
+
+
+# ------------------------------------------------------------ compositor
+
+def _bpy():
+    import bpy
+    return bpy
+
+
+def has_compositing_node_group(scene):
+    return hasattr(scene, "compositing_node_group")  # Blender 5.0+
+
+
+def compositor_tree(scene, create=True):
+    """The scene's compositing node tree, made (and turned on) when create
+    is set; None when there is none and create is not set."""
+    if has_compositing_node_group(scene):
+        tree = scene.compositing_node_group
+        if tree is None and create:
+            bpy = _bpy()
+            tree = bpy.data.node_groups.new("Compositing", "CompositorNodeTree")
+            tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+            rl = tree.nodes.new("CompositorNodeRLayers")
+            out = tree.nodes.new("NodeGroupOutput")
+            out.location = (400, 0)
+            tree.links.new(rl.outputs["Image"], out.inputs[0])
+            scene.compositing_node_group = tree
+        return tree
+    if create and not scene.use_nodes:
+        scene.use_nodes = True
+    return scene.node_tree if (create or scene.use_nodes) else None
+
+
+def compositor_output_socket(tree):
+    """The input socket whose image becomes the render result: the
+    Composite node's (up to 4.5) or the Group Output's first (5.0+, where
+    the Composite node no longer exists). Made when missing."""
+    has_composite = hasattr(_bpy().types, "CompositorNodeComposite")
+    kind = "CompositorNodeComposite" if has_composite else "NodeGroupOutput"
+    outs = [n for n in tree.nodes if n.bl_idname == kind and n.inputs]
+    active = [n for n in outs if getattr(n, "is_active_output", True)]
+    if active or outs:
+        return (active or outs)[0].inputs[0]
+    if not has_composite and not [s for s in tree.interface.items_tree
+                                  if getattr(s, "in_out", "") == "OUTPUT"]:
+        tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+    out = tree.nodes.new(kind)
+    out.location = (600, 0)
+    return out.inputs[0]
+
+
+def alpha_over_sockets(node):
+    """(background, foreground) inputs of an Alpha Over node."""
+    if "Background" in node.inputs:  # 5.0+
+        return node.inputs["Background"], node.inputs["Foreground"]
+    return node.inputs[1], node.inputs[2]
+
+
+def alpha_over_premultiplied(node):
+    """Make an Alpha Over a plain premultiplied 'over' (our image is
+    premultiplied already)."""
+    straight = node.inputs.get("Straight Alpha")
+    if straight is not None:
+        straight.default_value = False
+    if hasattr(node, "use_premultiply"):  # up to 4.5
+        node.use_premultiply = False
+        node.premul = 0.0
+
+
+def wrap(text, width):
+    """Lines of at most width characters, broken at spaces (UI labels do
+    not wrap by themselves)."""
+    lines, line = [], ""
+    for word in text.split():
+        if line and len(line) + 1 + len(word) > width:
+            lines.append(line)
+            line = word
+        else:
+            line = "%s %s" % (line, word) if line else word
+    return lines + [line] if line else lines

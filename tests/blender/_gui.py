@@ -1,0 +1,85 @@
+"""Shared harness of the GUI test scripts (test_gui*.py, run under Xvfb).
+
+A GUI script cannot end through --python-exit-code: its steps run from a
+timer once the window exists, and a timer's exception never reaches Blender's
+exit code. So each script records checks here and ends the process itself,
+with a watchdog against hangs:
+
+    g = _gui.Run("test_gui_panel", limit_s=300)
+    g.check("labels_fit", ok, detail)
+    g.start(steps())   # steps(): a generator; each yield is the delay (s)
+                       # before the next step
+
+Pixels of the 3D viewport are read by a POST_PIXEL handler (Capture), after
+the add-on's own POST_VIEW composite.
+"""
+
+import os
+import sys
+import time
+import traceback
+
+import bpy
+
+
+class Run:
+    def __init__(self, name, limit_s):
+        self.name = name
+        self.limit_s = limit_s
+        self.started = time.time()
+        self.results = []
+
+    def check(self, name, cond, detail=""):
+        self.results.append((name, bool(cond)))
+        print("%s %s %s" % ("PASS" if cond else "FAIL", name, detail), flush=True)
+
+    def finish(self):
+        failed = sum(1 for _, ok in self.results if not ok)
+        print("RESULT %s: %d passed, %d failed" % (self.name, len(self.results) - failed, failed),
+              flush=True)
+        sys.stdout.flush()
+        os._exit(1 if failed else 0)
+
+    def start(self, steps):
+        """Runs the generator's steps from a timer; any exception, the end of
+        the steps or the time limit finishes the script."""
+        def tick():
+            if time.time() - self.started > self.limit_s:
+                self.check("finished_in_time", False)
+                self.finish()
+            try:
+                return next(steps)
+            except StopIteration:
+                self.finish()
+            except Exception:
+                traceback.print_exc()
+                self.check("no_exception", False)
+                self.finish()
+        bpy.app.timers.register(tick, first_interval=1.0)
+
+
+class Capture:
+    """Reads the 3D viewport's pixels when asked: set want, redraw, then img
+    holds (h, w, 4) float, row 0 = bottom."""
+
+    def __init__(self):
+        self.want = False
+        self.img = None
+        self._handle = None
+
+    def install(self):
+        self._handle = bpy.types.SpaceView3D.draw_handler_add(self._draw, (), "WINDOW", "POST_PIXEL")
+
+    def request(self):
+        self.want, self.img = True, None
+
+    def _draw(self):
+        if not self.want:
+            return
+        import gpu
+        import numpy as np
+        region = bpy.context.region
+        fb = gpu.state.active_framebuffer_get()
+        buf = fb.read_color(0, 0, region.width, region.height, 4, 0, "FLOAT")
+        self.img = np.array(buf.to_list(), np.float32).reshape(region.height, region.width, 4)
+        self.want = False

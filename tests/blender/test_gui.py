@@ -28,7 +28,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import _gui  # noqa: E402
 import _util as u  # noqa: E402
 
-RUN = _gui.Run("test_gui", limit_s=500)
+RUN = _gui.Run("test_gui", limit_s=560)  # a watchdog, under the runner's 600 s
 check = RUN.check
 finish = RUN.finish
 capture = _gui.Capture()

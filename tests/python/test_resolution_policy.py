@@ -81,6 +81,24 @@ def test_nothing_measured_keeps_the_start_and_bad_samples_are_ignored():
     assert p.next_scale(FULL, 0.2) == pytest.approx(0.2)  # the maximum still applies
 
 
+def test_fixed_cost_per_frame_is_learnt():
+    # 50 ms per call whatever the size, plus the pixels: the pixels get the
+    # other 50 ms (a per-pixel-only model would shrink the preview far more).
+    p = ScalePolicy(0.35)
+    scales = simulate(p, 1e-7, 40, overhead=0.05)
+    assert p.overhead == pytest.approx(0.05, rel=0.05)
+    assert scales[-1] == pytest.approx(math.sqrt(0.05 / (1e-7 * FULL)), rel=0.05)
+
+
+def test_overhead_beyond_the_budget_does_not_collapse_the_preview():
+    # A call costs 0.2 s however small: the pixels get a quarter of the
+    # budget instead of the smallest scale.
+    p = ScalePolicy(0.35)
+    scales = simulate(p, 1e-7, 40, overhead=0.2)
+    assert scales[-1] == pytest.approx(math.sqrt(0.025 / (1e-7 * FULL)), rel=0.1)
+    assert scales[-1] > 2 * p.min_scale
+
+
 def test_refinement_steps():
     assert refine_scales(0.2, 1.0) == (0.5, 1.0)   # preview, half, full
     assert refine_scales(0.45, 1.0) == (1.0,)      # half barely sharper: straight to full

@@ -161,7 +161,12 @@ def test_ct_presets_keep_hounsfield_units_on_ct():
                         rng.normal(1200, 200, 5_000)])
     s = _stats(v)
     lo, hi, stops = tf_fit.place("CT_BONE", "ct", s)
-    assert abs(lo - (-16.4458)) < 1e-6 and hi == 3071.0
+    # the window starts FLOOR_ENTRIES table entries below the preset's last
+    # transparent point (-16.4458 HU), so those entries stay exactly 0
+    f = tf_fit.FLOOR_ENTRIES / (tf_presets.TABLE_SIZE - 1)
+    assert abs(lo - (-16.4458 - f * (3071.0 + 16.4458) / (1 - f))) < 1e-6 and hi == 3071.0
+    table = tf_presets.stops_table(stops)
+    assert (table[:tf_fit.FLOOR_ENTRIES, 3] == 0).all() and table[-1, 3] > 0
     # The built-in CT preset placed on CT is the library's CT table over
     # the library's CT window (-1000..2000 HU), within the ramp tolerance.
     lo, hi, stops = tf_fit.place("CT", "ct", s)
@@ -228,3 +233,17 @@ def test_histogram_picture_draws_the_ramp():
     white = np.all(top[..., :3] > 0.99, axis=2)
     assert white[:, 120].any() and np.nonzero(white[:, 120])[0].max() > 0.8 * top.shape[0]
     assert np.nonzero(white[:, 4])[0].min() < 0.2 * top.shape[0]  # opacity rises left to right
+
+
+@pytest.mark.parametrize("key", sorted(tf_presets.PRESETS))
+def test_placed_presets_keep_background_skippable(key):
+    """A preset that starts transparent keeps its first table entries at
+    exactly zero opacity once placed, so the library can still skip bricks of
+    background (it widens each brick's table range by one entry either way):
+    ramps that rose from entry 0 made ch2better's F12 frame 5x slower."""
+    pr = tf_presets.PRESETS[key]
+    if pr.stops[0][1][3] > 0:
+        return  # visible from its first value: nothing to skip below it
+    for kind in ("mr", "ct"):
+        _lo, _hi, stops = tf_fit.place(key, kind, _stats(_mr_like()))
+        assert (tf_presets.stops_table(stops)[:tf_fit.FLOOR_ENTRIES, 3] == 0).all(), (key, kind)

@@ -1,15 +1,58 @@
-/* error.c - error recording. The thread-local buffer is the only state that
- * outlives a call, and it is per thread, so the library has no global mutable
- * state shared between callers. */
+/* error.c - error recording. The last message is kept per thread, so the
+ * library has no global mutable state shared between callers.
+ *
+ * The per-thread buffer hangs off a pthread key rather than a _Thread_local
+ * array: TLS in a shared object compiles to calls of __tls_get_addr, which
+ * lives in the dynamic loader and would make ld-linux a NEEDED entry of the
+ * core (issue 13: the core links only the C runtime). The key is written once
+ * (pthread_once) and only read after; a thread's buffer is made at its first
+ * failure and freed when the thread ends. */
 #include "error.h"
 
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "voxlight.h"
 
-static _Thread_local char tls_last_error[VXL_MSG_MAX];
+static pthread_once_t last_error_once = PTHREAD_ONCE_INIT;
+static pthread_key_t last_error_key;
+static int last_error_key_ok;
+
+static void make_last_error_key(void) { last_error_key_ok = pthread_key_create(&last_error_key, free) == 0; }
+
+/* The library may be unloaded (Blender disabling the add-on) while threads
+ * that hold buffers live on: without the key their destructor would call
+ * into unmapped code. Those buffers then leak, as pthread_key_delete says. */
+__attribute__((destructor)) static void delete_last_error_key(void)
+{
+    if (last_error_key_ok) pthread_key_delete(last_error_key);
+}
+
+/* This thread's buffer, made when create is set; NULL when there is none
+ * (or no memory: the message is then lost, the error code is not). */
+static char *last_error_buffer(int create)
+{
+    pthread_once(&last_error_once, make_last_error_key);
+    if (!last_error_key_ok) return NULL;
+    char *buf = pthread_getspecific(last_error_key);
+    if (!buf && create) {
+        buf = calloc(1, VXL_MSG_MAX);
+        if (buf && pthread_setspecific(last_error_key, buf)) {
+            free(buf);
+            buf = NULL;
+        }
+    }
+    return buf;
+}
+
+static void set_last_error(const char *msg)
+{
+    char *buf = last_error_buffer(1);
+    if (buf) memcpy(buf, msg, VXL_MSG_MAX);
+}
 
 int vxl_fail(vxl_err *e, int code, const char *fmt, ...)
 {
@@ -22,13 +65,13 @@ int vxl_fail(vxl_err *e, int code, const char *fmt, ...)
         e->code = code;
         memcpy(e->msg, buf, sizeof buf);
     }
-    memcpy(tls_last_error, buf, sizeof buf);
+    set_last_error(buf);
     return code;
 }
 
 void vxl_publish_error(const vxl_err *e)
 {
-    if (e && e->code != VXL_OK) memcpy(tls_last_error, e->msg, sizeof tls_last_error);
+    if (e && e->code != VXL_OK) set_last_error(e->msg);
 }
 
 void vxl_clear_error(vxl_err *e)
@@ -39,7 +82,11 @@ void vxl_clear_error(vxl_err *e)
     }
 }
 
-const char *vxl_last_error(void) { return tls_last_error; }
+const char *vxl_last_error(void)
+{
+    const char *buf = last_error_buffer(0);
+    return buf ? buf : "";
+}
 
 const char *vxl_error_name(int code)
 {

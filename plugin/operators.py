@@ -5,15 +5,20 @@ import bpy
 from . import native, runtime
 
 
-class VOXLIGHT_OT_reload_volume(bpy.types.Operator):
-    """Reload the active volume's file (after it changed on disk or failed)"""
-    bl_idname = "voxlight.reload_volume"
-    bl_label = "Reload Volume"
+class OnActiveVolume:
+    """Mixin of the operators and panels that act on the active object when
+    it is a Voxlight volume (put it before bpy.types.Operator/Panel)."""
 
     @classmethod
     def poll(cls, context):
         obj = context.object
         return obj is not None and obj.voxlight.is_volume
+
+
+class VOXLIGHT_OT_reload_volume(OnActiveVolume, bpy.types.Operator):
+    """Reload the active volume's file (after it changed on disk or failed)"""
+    bl_idname = "voxlight.reload_volume"
+    bl_label = "Reload Volume"
 
     def execute(self, context):
         p = context.object.voxlight

@@ -10,6 +10,7 @@ the editor's default width."""
 import bpy
 
 from . import histogram_image, runtime, tf
+from .operators import OnActiveVolume
 from .properties import FIXED_TAP_FILTERS
 
 
@@ -37,15 +38,10 @@ _KIND_TEXT = {"ct": "CT (Hounsfield units)", "mr": "MR (arbitrary units)",
               "pet": "PET/NM (arbitrary units)", "other": "arbitrary units"}
 
 
-class _VolumePanel:
+class _VolumePanel(OnActiveVolume):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "object"
-
-    @classmethod
-    def poll(cls, context):
-        obj = context.object
-        return obj is not None and obj.voxlight.is_volume
 
 
 class VOXLIGHT_PT_volume(_VolumePanel, bpy.types.Panel):

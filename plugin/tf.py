@@ -27,6 +27,7 @@ import bpy
 import numpy as np
 
 from . import runtime, tf_fit, tf_presets
+from .operators import OnActiveVolume
 
 TABLE_SIZE = tf_presets.TABLE_SIZE
 TF_VERSION = 1  # Object.voxlight.tf_version of volumes that use the single editor
@@ -285,7 +286,7 @@ def on_legacy_use_ramp(props, context):
 
 # ------------------------------------------------------------- operators
 
-class VOXLIGHT_OT_tf_preset(bpy.types.Operator):
+class VOXLIGHT_OT_tf_preset(OnActiveVolume, bpy.types.Operator):
     """Load a transfer-function preset into the volume's ColorRamp, placed on its data"""
     bl_idname = "voxlight.tf_preset"
     bl_label = "Load Transfer-Function Preset"
@@ -293,10 +294,6 @@ class VOXLIGHT_OT_tf_preset(bpy.types.Operator):
 
     preset: bpy.props.EnumProperty(name="Preset", items=PRESET_ITEMS,
                                    description="The preset to load")
-
-    @classmethod
-    def poll(cls, context):
-        return context.object is not None and context.object.voxlight.is_volume
 
     @classmethod
     def description(cls, context, properties):
@@ -309,7 +306,7 @@ class VOXLIGHT_OT_tf_preset(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class VOXLIGHT_OT_tf_fit_window(bpy.types.Operator):
+class VOXLIGHT_OT_tf_fit_window(OnActiveVolume, bpy.types.Operator):
     """Place the window by the data's histogram: an unedited preset is placed again, an edited ramp is stretched over the non-background values"""
     bl_idname = "voxlight.tf_fit_window"
     bl_label = "Fit Window to Data"
@@ -324,10 +321,6 @@ class VOXLIGHT_OT_tf_fit_window(bpy.types.Operator):
         description="Share of the non-background voxels below the window's end "
                     "(edited ramps)")
 
-    @classmethod
-    def poll(cls, context):
-        return context.object is not None and context.object.voxlight.is_volume
-
     def execute(self, context):
         lo, hi = sorted((self.low_quantile, self.high_quantile))
         fit_window(context.object, lo, hi)
@@ -335,15 +328,11 @@ class VOXLIGHT_OT_tf_fit_window(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class VOXLIGHT_OT_tf_ramp(bpy.types.Operator):
+class VOXLIGHT_OT_tf_ramp(OnActiveVolume, bpy.types.Operator):
     """Give the volume a ColorRamp transfer function again (with the preset that suits its data)"""
     bl_idname = "voxlight.tf_ramp"
     bl_label = "Create ColorRamp"
     bl_options = {"REGISTER", "UNDO"}
-
-    @classmethod
-    def poll(cls, context):
-        return context.object is not None and context.object.voxlight.is_volume
 
     def execute(self, context):
         ensure_texture(context.object)

@@ -22,7 +22,7 @@ def look_kwargs(props, fast=False):
     # converted yet (tf_version 0: appended from an old file) keep the old
     # switches: library preset unless Use ColorRamp, preset window unless
     # Custom Window.
-    legacy = props.tf_version < _tf.TF_VERSION
+    legacy = props.tf_version < _tf.TF_SINGLE_EDITOR
     window = None
     if props.use_window or not legacy:
         lo, hi = sorted((props.window_low, props.window_high))

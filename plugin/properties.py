@@ -13,11 +13,12 @@ from . import native, tf
 # appears in the panel without editing this file; each item's number is the
 # library's VXL_FILTER_* value, so saved files and keyframes stay valid.
 _FILTER_UI = {
-    "central": ("Central", "Central: fast, good on clean data (6 samples per step)"),
+    "central": ("Central", "Central: fast, good on clean data; on noisy 8-bit scans it can draw "
+                           "faint diagonal stripes on flat regions (6 samples per step)"),
     "forward3": ("Forward", "Forward: the fastest, normals slightly shifted; for quick previews "
                             "(3 samples)"),
-    "sobel8": ("Sobel 8", "Sobel 8: a little smoother than Central at about the same cost "
-                          "(8 samples)"),
+    "sobel8": ("Sobel 8", "Sobel 8: the default; about Central's cost, smoother, and no "
+                          "lattice stripes on noisy scans (8 samples)"),
     "sobel14": ("Sobel 14", "Sobel 14: smoother, for mildly noisy scans (14 samples)"),
     "sobel26": ("Sobel 26", "Sobel 26: smooth normals on noisy scans (26 samples, slower)"),
     "precomputed": ("Precomputed", "Precomputed: blurred normals worked out once per volume "
@@ -126,7 +127,10 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                              description="Volume frame shown in Fixed mode (0-based)")
 
     # --- gradients
-    filter: EnumProperty(name="Gradient Filter", items=FILTER_ITEMS, default="central",
+    # sobel8 by default: on 8-bit scans central differences draw the voxel
+    # lattice as faint stripes in orthographic views (tests/test_stripes.c,
+    # docs/filters_on_scans.md); sobel8 does not, for ~10% more per frame.
+    filter: EnumProperty(name="Gradient Filter", items=FILTER_ITEMS, default="sobel8",
                          description="How the surface normals that lighting needs are worked "
                                      "out: smoother filters hide scanner noise, cost more",
                          update=tag_redraw)

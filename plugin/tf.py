@@ -30,7 +30,12 @@ from . import runtime, tf_fit, tf_presets
 from .operators import OnActiveVolume
 
 TABLE_SIZE = tf_presets.TABLE_SIZE
-TF_VERSION = 1  # Object.voxlight.tf_version of volumes that use the single editor
+# Object.voxlight.tf_version: the file format of a volume's look.
+# 1: the single editor (ramp + explicit window); 2: the gradient filter's
+# default became sobel8, so a volume saved before with the old default
+# (central, never set, so not stored) is given central when its file opens.
+TF_SINGLE_EDITOR = 1
+TF_VERSION = 2
 
 # Kept for scripts written against the ColorRamp presets of issue 6.
 SLICER_PRESETS = tf_presets.SLICER_PRESETS
@@ -373,12 +378,23 @@ def _on_depsgraph_update(scene, depsgraph=None):
         _redraw()
 
 
+def upgrade(obj):
+    """Bring a volume from an older file up to TF_VERSION, looking the same."""
+    p = obj.voxlight
+    old = p.tf_version
+    if old < TF_SINGLE_EDITOR:
+        migrate_legacy(obj)
+    if old < 2 and p.get("filter") is None:
+        p.filter = "central"  # the default it was saved with
+    p.tf_version = TF_VERSION
+
+
 @bpy.app.handlers.persistent
 def _on_load_post(*_args):
     for obj in bpy.data.objects:
         p = getattr(obj, "voxlight", None)
         if p is not None and p.is_volume and p.tf_version < TF_VERSION and obj.library is None:
-            migrate_legacy(obj)
+            upgrade(obj)
 
 
 _classes = (VOXLIGHT_OT_tf_preset, VOXLIGHT_OT_tf_fit_window, VOXLIGHT_OT_tf_ramp,

@@ -176,7 +176,9 @@ def old_files_open_looking_the_same():
             p.window_low, p.window_high = 12.0, 34.0  # ignored without use_window
         finally:
             vx.tf._quiet = False
+        p.filter = "central"  # the filter's default then
         before = _render(ob)  # the library's preset and window, as before
+        del p["filter"]  # a default is not stored in the file
         name = ob.name
         path = os.path.join(u.TMP, "legacy_%s.blend" % preset)
         bpy.ops.wm.save_as_mainfile(filepath=path)
@@ -189,8 +191,32 @@ def old_files_open_looking_the_same():
         assert p.tf_preset == key, (preset, p.tf_preset)
         want = (-1000.0, 2000.0) if key == "CT" else (p.data_min, p.data_max)
         assert abs(p.window_low - want[0]) < 1e-3 and abs(p.window_high - want[1]) < 1e-3
+        assert p.filter == "central", p.filter
         after = _render(ob)
         assert _diff(after, before) < 0.02, (preset, _diff(after, before))
+
+
+@test
+def files_from_before_the_sobel8_default_keep_their_filter():
+    """tf_version 1 volumes saved with the old default filter (central,
+    never set, so not stored) open with central; a filter the artist chose
+    stays; new volumes get sobel8."""
+    old_default = _volume("v1_default.nii.gz")
+    assert old_default.voxlight.filter == "sobel8"  # a new volume's
+    chosen = u.import_volume(bpy.path.abspath(old_default.voxlight.filepath))
+    chosen.voxlight.filter = "sobel26"
+    for ob in (old_default, chosen):
+        ob.voxlight.tf_version = 1
+    assert old_default.voxlight.get("filter") is None
+    names = old_default.name, chosen.name
+    path = os.path.join(u.TMP, "tf_v1.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    vx.runtime.release_all()
+    bpy.ops.wm.open_mainfile(filepath=path)
+    old_default, chosen = (bpy.data.objects[n] for n in names)
+    assert old_default.voxlight.filter == "central", old_default.voxlight.filter
+    assert chosen.voxlight.filter == "sobel26", chosen.voxlight.filter
+    assert old_default.voxlight.tf_version == chosen.voxlight.tf_version == vx.tf.TF_VERSION
 
 
 @test
@@ -398,6 +424,9 @@ def panel_has_subpanels_ramp_picture_and_preset_name():
     filt = rna.properties["filter"].enum_items
     assert filt["central"].description.startswith("Central: fast, good on clean data")
     assert filt["sobel26"].description.startswith("Sobel 26: smooth normals on noisy scans")
+    # the default avoids central's lattice stripes on scans (tests/test_stripes.c)
+    assert rna.properties["filter"].default == "sobel8"
+    assert filt["sobel8"].description.startswith("Sobel 8: the default")
 
 
 @test

@@ -27,7 +27,9 @@ DICOM_CXX := csrc/dicom.cpp
 HELPER_C := $(wildcard csrc/helper_*.c)
 LIB_C := $(filter-out csrc/cli.c $(HELPER_C),$(wildcard csrc/*.c))
 LIBS := -ldl -lpthread -lz -lm
-SHADERS := $(wildcard shaders/*.glsl shaders/*.vert shaders/*.frag shaders/*.comp)
+# shaders/lib: included code; compute/: compute programs; render/: the ray
+# caster's stages. A shader's name is its path under shaders/ (csrc/shader_source.h).
+SHADERS := $(wildcard shaders/lib/*.glsl shaders/compute/*.comp shaders/render/*.vert shaders/render/*.frag)
 OBJ := $(LIB_C:csrc/%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/shaders_embedded.o
 # What the helpers' readers use of the core (volume building, errors, file
 # helpers), linked into each helper, which needs no libvoxlight.so.
@@ -52,7 +54,7 @@ $(BUILD)/embed_files: tools/embed_files.c | $(BUILD)/obj
 	$(CC) -std=c11 $(WARN) -O1 $< -o $@
 
 $(BUILD)/gen/shaders_embedded.c: $(BUILD)/embed_files $(SHADERS) | $(BUILD)/gen
-	$(BUILD)/embed_files $@ $(SHADERS)
+	$(BUILD)/embed_files $@ shaders $(SHADERS)
 
 $(BUILD)/obj/shaders_embedded.o: $(BUILD)/gen/shaders_embedded.c
 	$(CC) $(CFLAGS) -c $< -o $@

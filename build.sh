@@ -258,13 +258,17 @@ case "$cmd" in
         install_deps; build; build_asan
         # Without them the Blender suite reports the missing versions as failures.
         bpy_venvs || echo "build.sh: the bpy venvs are incomplete" >&2
+        # dependencies go one way (issue 15): no include cycle between csrc/
+        # files or folders, each folder above the ones it uses
+        run_suite "Include cycles and layers (csrc/)" /usr/bin/python3 tools/check_includes.py
         run_suite "C tests" run_c_tests build
         # Mesa and LLVM keep allocations until exit: their leaks are suppressed
         # by library name (tests/lsan.supp); ours are not.
         ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions="$ROOT/tests/lsan.supp" UBSAN_OPTIONS=print_stacktrace=1 \
             run_suite "C tests under ASan+UBSan" run_c_tests build-asan
         # every file loader under libFuzzer + ASan/UBSan, 20 s each, after
-        # replaying tests/crashers/ (./build.sh fuzz runs them longer)
+        # replaying tests/crashers/ (which fails when a loader's corpus is
+        # missing or empty; ./build.sh fuzz runs them longer)
         run_suite "Loader fuzzing (ASan+UBSan)" tests/fuzz/run.sh 20
         run_suite "CLI tests" /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/cli
         run_suite "Benchmark smoke" /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/bench
@@ -276,8 +280,9 @@ case "$cmd" in
         [ "$TOTAL_FAIL" -eq 0 ] ;;
     fuzz)
         # ./build.sh fuzz [SECONDS [TARGET...]]: each loader's libFuzzer target
-        # (nifti nrrd metaimage tiff png dicom) for SECONDS (default 300); crashes
-        # are kept in tests/crashers/<target>/
+        # (nifti nrrd metaimage tiff png dicom vdb) for SECONDS (default 300);
+        # crashes are kept in tests/crashers/<target>/. SECONDS "replay":
+        # replay tests/crashers/ only
         install_deps; build
         shift
         tests/fuzz/run.sh "${1:-300}" "${@:2}" ;;

@@ -10,7 +10,7 @@
 #include <time.h>
 
 #include "bench_util.h"
-#include "voxlight.h"
+#include "voxlight_dev.h"
 
 #define BRAIN "/usr/share/mricron/templates/ch2better.nii.gz"
 #define MAX_CONFIGS 4096

@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "volume.h"
-#include "voxlight.h"
+#include "voxlight_dev.h"
 
 static uint32_t D[3];
 static double *C; /* interpolating coefficients, double */

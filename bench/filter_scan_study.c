@@ -20,7 +20,7 @@
 #include <time.h>
 
 #include "volume.h"
-#include "voxlight.h"
+#include "voxlight_dev.h"
 
 #define W 512
 #define H 512

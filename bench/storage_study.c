@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include "bench_util.h"
-#include "voxlight.h"
+#include "voxlight_dev.h"
 
 #define BRAIN "/usr/share/mricron/templates/ch2better.nii.gz"
 

@@ -7,8 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "voxlight.h"
+
 /* Table index a normalised value maps to (as classify.glsl computes it). */
-static double table_pos(const vxl_frame *f, double v)
+static double table_pos(const vxl_occupancy_rule *f, double v)
 {
     double x = (v - f->window_offset) * f->window_scale;
     x = x < 0 ? 0 : x > 1 ? 1 : x;
@@ -43,26 +45,26 @@ static void chebyshev_axis(uint8_t *d, const uint32_t dims[3], int axis, uint8_t
         }
 }
 
-uint32_t vxl_bricks_gradient_apron(const vxl_frame *f)
+uint32_t vxl_bricks_gradient_apron(uint32_t filter, float sample_distance)
 {
     /* cubic: the prefiltered B-spline's derivative is not bounded by adjacent
      * differences; precomputed: stored relative to the volume's largest
      * gradient. Taps at +-d reach floor(p -+ d) .. +1: ceil(d) + 1 voxels. */
-    if (f->filter == VXL_FILTER_CUBIC || f->filter == VXL_FILTER_PRECOMPUTED) return 0;
+    if (filter == VXL_FILTER_CUBIC || filter == VXL_FILTER_PRECOMPUTED) return 0;
     /* approximating B-spline: its derivative is a convex blend of adjacent
      * differences over texels floor(p) - 1 .. floor(p) + 2 */
-    if (f->filter == VXL_FILTER_CUBIC_SMOOTH) return 2;
-    return (uint32_t)ceil(f->sample_distance) + 1;
+    if (filter == VXL_FILTER_CUBIC_SMOOTH) return 2;
+    return (uint32_t)ceil(sample_distance) + 1;
 }
 
 /* Levoy's iso-surface opacity is non-zero only where |iso - v| <= r*|g|.
  * A sample's v lies in its brick's [min, max] and |g| <= the brick's
  * gradient bound, so a brick is occupied unless iso lies outside that range
  * widened by r times the bound. Without a usable bound, every brick is. */
-static void classify_iso(vxl_bricks *b, const vxl_frame *f)
+static void classify_iso(vxl_bricks *b, const vxl_occupancy_rule *f)
 {
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
-    uint32_t need = vxl_bricks_gradient_apron(f);
+    uint32_t need = vxl_bricks_gradient_apron(f->filter, f->sample_distance);
     int bounded = need && b->gbound && b->gbound_apron >= need;
     uint32_t occupied = 0;
     for (size_t i = 0; i < n; i++) {
@@ -82,7 +84,7 @@ static void classify_iso(vxl_bricks *b, const vxl_frame *f)
 
 /* Occupancy under the transfer function: a brick is occupied when any table
  * entry its [min, max] can reach has non-zero opacity. -1 out of memory. */
-static int classify_table(vxl_bricks *b, const vxl_frame *f)
+static int classify_table(vxl_bricks *b, const vxl_occupancy_rule *f)
 {
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     /* prefix count of table entries with non-zero opacity */
@@ -112,10 +114,10 @@ static int classify_table(vxl_bricks *b, const vxl_frame *f)
     return 0;
 }
 
-int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
+int vxl_bricks_classify(vxl_bricks *b, const vxl_occupancy_rule *f)
 {
-    uint64_t key = vxl_classification_key(f);
-    if (f->gopacity == VXL_GOPACITY_ISO) { /* occupancy follows the iso-surface, its thickness and the filter */
+    uint64_t key = f->table_key;
+    if (f->iso) { /* occupancy follows the iso-surface, its thickness and the filter */
         float iso[5] = {f->iso_pos, f->iso_thickness, f->sample_distance, (float)f->filter, (float)b->gbound_apron};
         for (int i = 0; i < 5; i++) {
             uint32_t bits;
@@ -130,7 +132,7 @@ int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f)
     maxdim = maxdim > b->dims[2] ? maxdim : b->dims[2];
     uint8_t *scratch = malloc(2 * (size_t)maxdim);
     if (!scratch) return -1;
-    if (f->gopacity == VXL_GOPACITY_ISO) classify_iso(b, f);
+    if (f->iso) classify_iso(b, f);
     else if (classify_table(b, f)) {
         free(scratch);
         return -1;

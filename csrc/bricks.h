@@ -8,8 +8,6 @@
 
 #include <stdint.h>
 
-#include "frame.h"
-
 #define VXL_DEFAULT_BRICK 8
 
 typedef struct vxl_bricks {
@@ -26,13 +24,28 @@ typedef struct vxl_bricks {
     uint32_t gbound_apron;
 } vxl_bricks;
 
-/* Occupancy + distance map for the frame's classification; returns 1 if it
- * changed (the caller re-uploads), 0 if the cached one still holds. */
-int vxl_bricks_classify(vxl_bricks *b, const vxl_frame *f);
+/* What occupancy depends on, as plain values (the renderer fills it from
+ * its frame: vxl_frame_occupancy_rule in frame.h), so skipping needs no
+ * render parameters. */
+typedef struct vxl_occupancy_rule {
+    uint64_t table_key;     /* hash of the table, window and opacity scale: equal keys, equal occupancy */
+    const float *tf;        /* tf_size straight RGBA entries, alpha per voxel of path */
+    uint32_t tf_size;
+    float window_offset, window_scale, opacity_scale; /* normalised value -> table position in [0,1] */
+    int iso;                /* iso-surface opacity: occupancy follows the surface, not the table */
+    float iso_pos, iso_thickness; /* iso: the surface's normalised value and its thickness */
+    uint32_t filter;        /* VXL_FILTER_* of the gradients (iso: bounds how far taps reach) */
+    float sample_distance;  /* voxels between gradient taps */
+} vxl_occupancy_rule;
+
+/* Occupancy + distance map under the rule; returns 1 if it changed (the
+ * caller re-uploads), 0 if the cached one still holds, -1 out of memory. */
+int vxl_bricks_classify(vxl_bricks *b, const vxl_occupancy_rule *c);
 void vxl_bricks_free(vxl_bricks *b);
-/* Voxels around a brick that a frame's gradient taps and their trilinear
- * footprint reach, when the filter's |gradient| is bounded by the adjacent
- * differences there (central, forward3, Sobel); 0 = no such bound. */
-uint32_t vxl_bricks_gradient_apron(const vxl_frame *f);
+/* Voxels around a brick that gradient taps sample_distance apart (filter
+ * VXL_FILTER_*) and their trilinear footprint reach, when the filter's
+ * |gradient| is bounded by the adjacent differences there (central,
+ * forward3, Sobel); 0 = no such bound. */
+uint32_t vxl_bricks_gradient_apron(uint32_t filter, float sample_distance);
 
 #endif

@@ -3,43 +3,41 @@
  * (shaders/bspline_prefilter.comp) and kept until the volume changes. */
 #include <stdlib.h>
 
+#include "holdings.h"
 #include "renderer_internal.h"
 
 void vxl_bspline_release(vxl_renderer *r)
 {
-    if (r->bspline_tex) r->gl.DeleteTextures(1, &r->bspline_tex);
-    if (r->cpage_tex) r->gl.DeleteTextures(1, &r->cpage_tex);
-    r->bspline_tex = r->cpage_tex = 0;
-    r->bspline_bytes = 0;
-    free(r->bspline_covered); /* bricked: the coefficient bricks made */
-    r->bspline_covered = NULL;
+    const GLuint tex[2] = {r->bspline.tex, r->bspline.page_tex}; /* the volume or pool, and a pool's page table */
+    r->gl.DeleteTextures(2, tex); /* 0 is ignored */
+    r->bspline.tex = r->bspline.page_tex = 0;
+    r->bspline.bytes = 0;
+    free(r->bspline.covered); /* bricked: the coefficient bricks made */
+    r->bspline.covered = NULL;
 }
 
 static GLuint groups8(uint32_t n) { return (n + 7) / 8; }
 
 int vxl_bspline_ensure(vxl_renderer *r)
 {
-    if (r->bspline_tex) return VXL_OK;
+    if (r->bspline.tex) return VXL_OK;
     vxl_gl *gl = &r->gl;
     uint64_t n = (uint64_t)r->dims[0] * r->dims[1] * r->dims[2];
-    uint64_t need = r->volume_bytes + r->gradient_bytes + n * 4;
-    if (need > r->budget)
-        return vxl_fail(&r->err, VXL_ERR_LIMIT,
-                        "cubic B-spline coefficients need %.1f MiB in all, over the memory budget of %.1f MiB",
-                        need / 1048576.0, r->budget / 1048576.0);
+    int rc = vxl_holdings_ask(r, VXL_HOLD_BSPLINE, n * 4, NULL, "cubic B-spline coefficients");
+    if (rc) return rc;
     GLuint copy_prog, axis_prog;
-    int rc = vxl_program_get(r, VXL_PROG_BSPLINE_COPY, 0, 0, &copy_prog);
+    rc = vxl_program_get(r, VXL_PROG_BSPLINE_COPY, 0, 0, &copy_prog);
     if (!rc) rc = vxl_program_get(r, VXL_PROG_BSPLINE_AXIS, 0, 0, &axis_prog);
     if (rc) return rc;
     gl->GetError();
-    r->bspline_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+    r->bspline.tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
     gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R32F, (GLsizei)r->dims[0], (GLsizei)r->dims[1], (GLsizei)r->dims[2], 0,
                    GL_RED, GL_FLOAT, NULL);
-    gl->BindImageTexture(0, r->bspline_tex, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
+    gl->BindImageTexture(VXL_IMAGE_OUT, r->bspline.tex, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32F);
     gl->UseProgram(copy_prog);
-    gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
-    vxl_uniform_i(r, copy_prog, "u_volume", 0);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_VOLUME_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, r->storage.volume_tex);
+    vxl_uniform_i(r, copy_prog, "u_volume", VXL_VOLUME_UNIT);
     gl->DispatchCompute(groups8(r->dims[1]), groups8(r->dims[2]), 1);
     gl->MemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     gl->UseProgram(axis_prog);
@@ -55,6 +53,6 @@ int vxl_bspline_ensure(vxl_renderer *r)
         vxl_bspline_release(r);
         return rc;
     }
-    r->bspline_bytes = n * 4;
+    r->bspline.bytes = n * 4;
     return VXL_OK;
 }

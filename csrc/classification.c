@@ -7,22 +7,23 @@
 #include <string.h>
 
 #include "preint.h"
+#include "holdings.h"
 #include "renderer_internal.h"
 
 void vxl_classification_release(vxl_renderer *r)
 {
-    if (r->classified_tex) r->gl.DeleteTextures(1, &r->classified_tex);
-    if (r->preint_tex) r->gl.DeleteTextures(1, &r->preint_tex);
-    r->classified_tex = r->preint_tex = 0;
-    r->classified_key = r->preint_key = 0;
-    r->classified_bytes = 0;
+    if (r->classification.classified_tex) r->gl.DeleteTextures(1, &r->classification.classified_tex);
+    if (r->classification.preint_tex) r->gl.DeleteTextures(1, &r->classification.preint_tex);
+    r->classification.classified_tex = r->classification.preint_tex = 0;
+    r->classification.classified_key = r->classification.preint_key = 0;
+    r->classification.classified_bytes = 0;
 }
 
 /* The TF and window uniforms of classify.glsl, for the compute pass. */
 static void set_classify_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame *f)
 {
     vxl_gl *gl = &r->gl;
-    vxl_uniform_i(r, prog, "u_tf", 2);
+    vxl_uniform_i(r, prog, "u_tf", VXL_TF_UNIT);
     vxl_uniform_f(r, prog, "u_tf_size", (float)f->tf_size);
     gl->Uniform2f(gl->GetUniformLocation(prog, "u_window"), f->window_offset, f->window_scale);
     vxl_uniform_f(r, prog, "u_opacity_scale", f->opacity_scale);
@@ -35,43 +36,41 @@ static void set_classify_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame 
 static int prepare_pre(vxl_renderer *r, const vxl_frame *f)
 {
     vxl_gl *gl = &r->gl;
-    const uint32_t *dims = r->volume_tex ? r->dims : r->pool_dims;
-    uint64_t key = (vxl_classification_key(f) ^ r->pool_generation) * 1099511628211ull;
-    if (r->classified_tex && r->classified_key == key) goto bind;
+    const uint32_t *dims;
+    const GLuint texels = r->storage.ops->texels(r, &dims);
+    uint64_t key = (vxl_classification_key(f) ^ r->storage.pool_generation) * 1099511628211ull;
+    if (r->classification.classified_tex && r->classification.classified_key == key) goto bind;
     uint64_t n = (uint64_t)dims[0] * dims[1] * dims[2];
-    if (r->classified_tex && memcmp(r->classified_dims, dims, sizeof r->classified_dims)) {
-        gl->DeleteTextures(1, &r->classified_tex); /* the pool changed size */
-        r->classified_tex = 0;
-        r->classified_bytes = 0;
+    if (r->classification.classified_tex && memcmp(r->classification.classified_dims, dims, sizeof r->classification.classified_dims)) {
+        gl->DeleteTextures(1, &r->classification.classified_tex); /* the pool changed size */
+        r->classification.classified_tex = 0;
+        r->classification.classified_bytes = 0;
     }
-    if (!r->classified_tex) {
-        uint64_t need = (r->volume_tex ? r->volume_bytes : r->pool_bytes) + r->gradient_bytes + r->bspline_bytes + n * 4;
-        if (need > r->budget)
-            return vxl_fail(&r->err, VXL_ERR_LIMIT,
-                            "pre-classification needs %.1f MiB in all, over the memory budget of %.1f MiB",
-                            need / 1048576.0, r->budget / 1048576.0);
-        r->classified_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+    if (!r->classification.classified_tex) {
+        int rc = vxl_holdings_ask(r, VXL_HOLD_CLASSIFIED, n * 4, NULL, "the pre-classified volume");
+        if (rc) return rc;
+        r->classification.classified_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
         gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, (GLsizei)dims[0], (GLsizei)dims[1], (GLsizei)dims[2], 0, GL_RGBA,
                        GL_UNSIGNED_BYTE, NULL);
-        r->classified_bytes = n * 4;
-        memcpy(r->classified_dims, dims, sizeof r->classified_dims);
+        r->classification.classified_bytes = n * 4;
+        memcpy(r->classification.classified_dims, dims, sizeof r->classification.classified_dims);
     }
     GLuint prog;
     int rc = vxl_program_get(r, VXL_PROG_CLASSIFY_VOLUME, 0, 0, &prog);
     if (rc) return rc;
     gl->UseProgram(prog);
-    gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex ? r->volume_tex : r->pool_tex);
-    vxl_uniform_i(r, prog, "u_volume", 0);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_VOLUME_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, texels);
+    vxl_uniform_i(r, prog, "u_volume", VXL_VOLUME_UNIT);
     set_classify_uniforms(r, prog, f); /* the TF is already on unit 2 */
-    gl->BindImageTexture(0, r->classified_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    gl->BindImageTexture(VXL_IMAGE_OUT, r->classification.classified_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA8);
     gl->DispatchCompute((dims[0] + 3) / 4, (dims[1] + 3) / 4, (dims[2] + 3) / 4);
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     gl->UseProgram(0);
-    r->classified_key = key;
+    r->classification.classified_key = key;
 bind:
-    gl->ActiveTexture(GL_TEXTURE5);
-    gl->BindTexture(GL_TEXTURE_3D, r->classified_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_CLASSIFIED_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, r->classification.classified_tex);
     return vxl_gl_check(r, "pre-classifying the volume");
 }
 
@@ -83,7 +82,7 @@ static int prepare_preint(vxl_renderer *r, const vxl_frame *f)
     uint64_t bits;
     memcpy(&bits, &step, sizeof bits);
     key = (key ^ bits) * 1099511628211ull;
-    if (!(r->preint_tex && r->preint_key == key)) {
+    if (!(r->classification.preint_tex && r->classification.preint_key == key)) {
         uint32_t n = f->preint_size;
         float *table = malloc((size_t)n * n * 4 * sizeof *table);
         if (!table) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for a %ux%u pre-integration table", n, n);
@@ -91,17 +90,17 @@ static int prepare_preint(vxl_renderer *r, const vxl_frame *f)
             free(table);
             return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "cannot build the pre-integration table");
         }
-        if (!r->preint_tex) r->preint_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_LINEAR);
+        if (!r->classification.preint_tex) r->classification.preint_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_LINEAR);
         else {
             gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
-            gl->BindTexture(GL_TEXTURE_2D, r->preint_tex);
+            gl->BindTexture(GL_TEXTURE_2D, r->classification.preint_tex);
         }
         gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, (GLsizei)n, (GLsizei)n, 0, GL_RGBA, GL_FLOAT, table);
         free(table);
-        r->preint_key = key;
+        r->classification.preint_key = key;
     }
-    gl->ActiveTexture(GL_TEXTURE6);
-    gl->BindTexture(GL_TEXTURE_2D, r->preint_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_PREINT_UNIT);
+    gl->BindTexture(GL_TEXTURE_2D, r->classification.preint_tex);
     return vxl_gl_check(r, "uploading the pre-integration table");
 }
 

@@ -8,28 +8,60 @@
 #include <strings.h>
 #include <time.h>
 
-#include "voxlight.h"
+#include "voxlight_dev.h" /* phantoms (phantom:NAME inputs) and --no-skip */
 
-static const char usage[] =
+/* The option values come from the library's name functions (vxl_*_name),
+ * filled in by print_usage, so a value added there shows up here. */
+static const char usage_format[] =
     "usage:\n"
     "  voxlight render INPUT -o OUT.png|OUT.exr [--size WxH] [--filter NAME] [--sample-distance D]\n"
     "                  [--reuse-gradients] [--step S] [--azimuth DEG] [--elevation DEG] [--preset NAME]\n"
-    "                  [--window LO:HI] [--no-shading] [--backend auto|osmesa|egl] [--memory-budget SIZE]\n"
-    "                  [--gradient-store 8bit|16f|32f] [--classify post|pre|preint] [--no-jitter] [--no-skip]\n"
-    "                  [--gradient-opacity off|boundary|iso] [--gradient-ref G] [--iso VALUE] [--iso-thickness R]\n"
+    "                  [--window LO:HI] [--no-shading] [--backend %s] [--memory-budget SIZE]\n"
+    "                  [--gradient-store %s] [--classify %s] [--no-jitter] [--no-skip]\n"
+    "                  [--gradient-opacity %s] [--gradient-ref G] [--iso VALUE] [--iso-thickness R]\n"
     "                  [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
-    "                  [--storage auto|dense|bricked|sparse|compressed] [--page-brick 8|16|32|64]\n"
+    "                  [--storage %s] [--page-brick 8|16|32|64]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
     "--voxel-size (mm) is for inputs without geometry (TIFF/PNG stacks); one value sets all three\n"
-    "filters: central forward3 sobel8 sobel14 sobel26 precomputed cubic cubic-smooth; presets: auto gray bone hot mri ct\n"
+    "filters: %s; presets: %s\n"
     "storage: auto = one texture when it fits the texture limit and --memory-budget, else bricked;\n"
     "         sparse keeps only the bricks the transfer function can show; compressed holds every brick\n"
     "         as a palette of <= 256 values + 8-bit codes and decodes the visible ones into a cache\n"
     "         (compressed storage: every filter but precomputed and cubic; bricked and sparse: every filter and mode)\n"
-    "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of marschner-lobb sphere ramp\n"
-    "         noisy-blob sparse-balls dense-balls large-sparse (default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
+    "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of\n"
+    "         %s\n"
+    "         (large-sparse: default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
+
+typedef const char *(*name_fn)(uint32_t value);
+
+/* The names of one of the library's enumerations from value `first` up to
+ * the first NULL, joined by sep, into buf. */
+static const char *name_list(name_fn name, uint32_t first, const char *sep, char *buf, size_t size)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    for (uint32_t i = first; name(i); i++) {
+        int n = snprintf(buf + len, size - len, "%s%s", i > first ? sep : "", name(i));
+        if (n < 0 || (size_t)n >= size - len) break;
+        len += (size_t)n;
+    }
+    return buf;
+}
+
+static void print_usage(FILE *out)
+{
+    char backends[64], stores[64], classify[64], gopacity[64], storage[128], filters[256], presets[128], phantoms[256];
+    fprintf(out, usage_format, name_list(vxl_backend_name, 0, "|", backends, sizeof backends),
+            name_list(vxl_gradient_store_name, 0, "|", stores, sizeof stores),
+            name_list(vxl_classify_name, 0, "|", classify, sizeof classify),
+            name_list(vxl_gradient_opacity_name, 0, "|", gopacity, sizeof gopacity),
+            name_list(vxl_storage_name, 0, "|", storage, sizeof storage),
+            name_list(vxl_filter_name, 0, " ", filters, sizeof filters),
+            name_list(vxl_preset_name, 0, " ", presets, sizeof presets),
+            name_list(vxl_phantom_name, 1, " ", phantoms, sizeof phantoms));
+}
 
 static int die(const char *fmt, ...)
 {
@@ -97,10 +129,15 @@ static int voxel_size_option(const char *val, vxl_load_options *lo)
     return 0;
 }
 
-static const char *dtype_name(uint32_t t)
+/* A value of one of the library's enumerations given by name; an unknown
+ * name is an error listing the names there are. `what` names the option in
+ * the message. */
+static int enum_option(const char *what, const char *val, name_fn name, int (*from_name)(const char *, uint32_t *),
+                       uint32_t *out)
 {
-    static const char *const names[] = {"?", "uint8", "int8", "uint16", "int16", "uint32", "int32", "float32", "float64"};
-    return t < sizeof names / sizeof *names ? names[t] : "?";
+    if (from_name(val, out) == VXL_OK) return 0;
+    char names[256];
+    return die("unknown %s '%s' (%s)", what, val, name_list(name, 0, ", ", names, sizeof names));
 }
 
 /* --frame N / --series S / --voxel-size X[,Y,Z], shared by render and info.
@@ -206,7 +243,8 @@ static int cmd_info(int argc, char **argv)
     printf("dimensions:  %u x %u x %u\n", in.dims[0], in.dims[1], in.dims[2]);
     if (in.frame_count > 1) printf("frames:      %u (this is frame %u; --frame N)\n", in.frame_count, in.frame);
     printf("spacing:     %g x %g x %g mm\n", in.spacing[0], in.spacing[1], in.spacing[2]);
-    printf("data type:   %s (stored as %u-bit %s)\n", dtype_name(in.dtype), in.texture_bits,
+    const char *dtype = vxl_dtype_name(in.dtype);
+    printf("data type:   %s (stored as %u-bit %s)\n", dtype ? dtype : "?", in.texture_bits,
            in.texture_bits == 32 ? "float" : "normalised");
     printf("value range: %g .. %g\n", in.value_min, in.value_max);
     printf("nan voxels:  %llu\n", (unsigned long long)in.nan_count);
@@ -242,7 +280,7 @@ static int parse_render(int argc, char **argv, render_args *a)
             p->width = w; p->height = h;
         } else if (!strcmp(o, "--filter")) {
             NEED_VALUE();
-            if (vxl_filter_from_name(val, &p->filter)) return die("unknown filter '%s' (central, forward3, sobel8, sobel14, sobel26, precomputed, cubic, cubic-smooth)", val);
+            if (enum_option("filter", val, vxl_filter_name, vxl_filter_from_name, &p->filter)) return 1;
         } else if (!strcmp(o, "--sample-distance")) {
             NEED_VALUE();
             if (!parse_float(val, &p->sample_distance) || p->sample_distance <= 0) return die("bad --sample-distance '%s'", val);
@@ -254,7 +292,7 @@ static int parse_render(int argc, char **argv, render_args *a)
         else if (!strcmp(o, "--elevation")) { NEED_VALUE(); if (!parse_float(val, &p->elevation_deg)) return die("bad --elevation '%s'", val); }
         else if (!strcmp(o, "--preset")) {
             NEED_VALUE();
-            if (vxl_preset_from_name(val, &p->preset)) return die("unknown preset '%s' (auto, gray, bone, hot, mri, ct)", val);
+            if (enum_option("preset", val, vxl_preset_name, vxl_preset_from_name, &p->preset)) return 1;
         } else if (!strcmp(o, "--window")) {
             NEED_VALUE();
             char *colon = strchr(val, ':');
@@ -270,10 +308,9 @@ static int parse_render(int argc, char **argv, render_args *a)
         else if (!strcmp(o, "--no-skip")) p->no_skip = 1;
         else if (!strcmp(o, "--gradient-opacity")) {
             NEED_VALUE();
-            if (!strcasecmp(val, "off")) p->gradient_opacity = VXL_GOPACITY_OFF;
-            else if (!strcasecmp(val, "boundary")) p->gradient_opacity = VXL_GOPACITY_BOUNDARY;
-            else if (!strcasecmp(val, "iso")) p->gradient_opacity = VXL_GOPACITY_ISO;
-            else return die("unknown --gradient-opacity '%s' (off, boundary, iso)", val);
+            if (enum_option("--gradient-opacity", val, vxl_gradient_opacity_name, vxl_gradient_opacity_from_name,
+                            &p->gradient_opacity))
+                return 1;
         } else if (!strcmp(o, "--iso")) {
             NEED_VALUE();
             if (!parse_float(val, &p->iso_value)) return die("bad --iso '%s'", val);
@@ -285,30 +322,23 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (!parse_float(val, &p->gradient_ref) || p->gradient_ref <= 0) return die("bad --gradient-ref '%s'", val);
         } else if (!strcmp(o, "--classify")) {
             NEED_VALUE();
-            if (!strcasecmp(val, "post")) p->classify = VXL_CLASSIFY_POST;
-            else if (!strcasecmp(val, "pre")) p->classify = VXL_CLASSIFY_PRE;
-            else if (!strcasecmp(val, "preint")) p->classify = VXL_CLASSIFY_PREINT;
-            else return die("unknown --classify '%s' (post, pre, preint)", val);
+            if (enum_option("--classify", val, vxl_classify_name, vxl_classify_from_name, &p->classify)) return 1;
         }
         else if (!strcmp(o, "--gradient-store")) {
             NEED_VALUE();
-            if (!strcasecmp(val, "8bit")) p->gradient_store = VXL_GRADIENT_STORE_8BIT;
-            else if (!strcasecmp(val, "16f")) p->gradient_store = VXL_GRADIENT_STORE_16F;
-            else if (!strcasecmp(val, "32f")) p->gradient_store = VXL_GRADIENT_STORE_32F;
-            else return die("unknown --gradient-store '%s' (8bit, 16f, 32f)", val);
+            if (enum_option("--gradient-store", val, vxl_gradient_store_name, vxl_gradient_store_from_name,
+                            &p->gradient_store))
+                return 1;
         } else if (!strcmp(o, "--backend")) {
             NEED_VALUE();
-            if (!strcasecmp(val, "auto")) a->ro.backend = VXL_BACKEND_AUTO;
-            else if (!strcasecmp(val, "osmesa")) a->ro.backend = VXL_BACKEND_OSMESA;
-            else if (!strcasecmp(val, "egl")) a->ro.backend = VXL_BACKEND_EGL;
-            else return die("unknown backend '%s' (auto, osmesa, egl)", val);
+            if (enum_option("backend", val, vxl_backend_name, vxl_backend_from_name, &a->ro.backend)) return 1;
         } else if (!strcmp(o, "--memory-budget")) {
             NEED_VALUE();
             if (!parse_size(val, &a->ro.memory_budget_bytes)) return die("bad --memory-budget '%s': e.g. 2G or 512M", val);
             a->lo.memory_budget_bytes = a->ro.memory_budget_bytes;
         } else if (!strcmp(o, "--storage")) {
             NEED_VALUE();
-            if (vxl_storage_from_name(val, &a->ro.storage)) return die("unknown storage '%s' (auto, dense, bricked, sparse, compressed)", val);
+            if (enum_option("storage", val, vxl_storage_name, vxl_storage_from_name, &a->ro.storage)) return 1;
         } else if (!strcmp(o, "--page-brick")) {
             NEED_VALUE();
             char *end;
@@ -388,7 +418,7 @@ done:
 int main(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
-        fputs(usage, argc < 2 ? stderr : stdout);
+        print_usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? 1 : 0;
     }
     if (vxl_abi_version() != VXL_ABI_VERSION) return die("libvoxlight ABI %u, expected %u", vxl_abi_version(), VXL_ABI_VERSION);

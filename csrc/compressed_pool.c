@@ -26,11 +26,11 @@ uint64_t vxl_code_bytes_for(const vxl_renderer *r, const vxl_pages *pg)
 
 void vxl_compressed_release(vxl_renderer *r)
 {
-    if (r->code_tex && r->code_tex != r->pool_tex) r->gl.DeleteTextures(1, &r->code_tex);
-    if (r->palette_tex) r->gl.DeleteTextures(1, &r->palette_tex);
-    r->code_tex = r->palette_tex = 0;
-    r->code_bytes = 0;
-    memset(r->code_slots, 0, sizeof r->code_slots);
+    if (r->storage.code_tex && r->storage.code_tex != r->storage.pool_tex) r->gl.DeleteTextures(1, &r->storage.code_tex);
+    if (r->storage.palette_tex) r->gl.DeleteTextures(1, &r->storage.palette_tex);
+    r->storage.code_tex = r->storage.palette_tex = 0;
+    r->storage.code_bytes = 0;
+    memset(r->storage.code_slots, 0, sizeof r->storage.code_slots);
 }
 
 /* Compresses the full-resolution bricks and uploads codes and palettes; the
@@ -38,23 +38,23 @@ void vxl_compressed_release(vxl_renderer *r)
 int vxl_compressed_upload(vxl_renderer *r)
 {
     vxl_gl *gl = &r->gl;
-    vxl_pages *pg = &r->levels[0];
+    vxl_pages *pg = &r->storage.levels[0];
     const uint32_t e = vxl_page_edge(pg);
     vxl_compressed c;
     int rc = vxl_compress_pages(&c, pg, &r->err);
     if (rc) return rc;
     free(pg->data);
     pg->data = NULL;
-    vxl_pool_layout(r, c.n, e, r->code_slots); /* checked by the plan */
+    vxl_pool_layout(r, c.n, e, r->storage.code_slots); /* checked by the plan */
     gl->GetError();
-    r->code_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST); /* integer textures cannot be filtered */
-    gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, (GLsizei)(r->code_slots[0] * e), (GLsizei)(r->code_slots[1] * e),
-                   (GLsizei)(r->code_slots[2] * e), 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, NULL);
+    r->storage.code_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST); /* integer textures cannot be filtered */
+    gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, (GLsizei)(r->storage.code_slots[0] * e), (GLsizei)(r->storage.code_slots[1] * e),
+                   (GLsizei)(r->storage.code_slots[2] * e), 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, NULL);
     for (uint32_t k = 0; k < c.n; k++) {
-        const uint32_t *s = r->code_slots;
-        gl->TexSubImage3D(GL_TEXTURE_3D, 0, (GLint)(k % s[0] * e), (GLint)(k / s[0] % s[1] * e),
-                          (GLint)(k / (s[0] * s[1]) * e), (GLsizei)e, (GLsizei)e, (GLsizei)e, GL_RED_INTEGER,
-                          GL_UNSIGNED_BYTE, c.codes + (size_t)k * c.voxels);
+        uint32_t o[3];
+        vxl_slot_origin(k, r->storage.code_slots, e, o);
+        gl->TexSubImage3D(GL_TEXTURE_3D, 0, (GLint)o[0], (GLint)o[1], (GLint)o[2], (GLsizei)e, (GLsizei)e, (GLsizei)e,
+                          GL_RED_INTEGER, GL_UNSIGNED_BYTE, c.codes + (size_t)k * c.voxels);
     }
     /* palettes are consecutive rows of 256: 16 of them fill one texel row as they lie */
     const uint32_t rows = palette_rows(c.n);
@@ -65,11 +65,11 @@ int vxl_compressed_upload(vxl_renderer *r)
     }
     memcpy(pal, c.palette, (size_t)c.n * VXL_PALETTE_SIZE * sizeof *pal);
     vxl_compressed_free(&c);
-    r->palette_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_NEAREST);
+    r->storage.palette_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_NEAREST);
     gl->TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, VXL_PALETTES_PER_ROW * VXL_PALETTE_SIZE, (GLsizei)(rows ? rows : 1), 0,
                    GL_RED, GL_FLOAT, pal);
     free(pal);
-    r->code_bytes = vxl_code_bytes_for(r, pg);
+    r->storage.code_bytes = vxl_code_bytes_for(r, pg);
     return vxl_gl_check(r, "uploading the compressed bricks");
 }
 
@@ -85,7 +85,7 @@ static double now_ms(void)
 int vxl_compressed_decode(vxl_renderer *r, const int32_t *source, uint32_t count, const uint32_t slots[3])
 {
     vxl_gl *gl = &r->gl;
-    const vxl_pages *pg = &r->levels[0];
+    const vxl_pages *pg = &r->storage.levels[0];
     const uint32_t e = vxl_page_edge(pg);
     static const GLenum image_formats[] = {GL_R8, GL_R16, 0, GL_R32F};
     GLuint prog;
@@ -95,25 +95,25 @@ int vxl_compressed_decode(vxl_renderer *r, const int32_t *source, uint32_t count
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[1]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(count ? count : 1) * (GLsizeiptr)sizeof(int32_t), source,
                    GL_STATIC_DRAW);
-    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, r->ssbo[1]);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, VXL_SSBO_BRICK_LIST, r->ssbo[1]);
     gl->UseProgram(prog);
     gl->ActiveTexture(GL_TEXTURE0 + VXL_CODE_UNIT);
-    gl->BindTexture(GL_TEXTURE_3D, r->code_tex);
+    gl->BindTexture(GL_TEXTURE_3D, r->storage.code_tex);
     gl->ActiveTexture(GL_TEXTURE0 + VXL_PALETTE_UNIT);
-    gl->BindTexture(GL_TEXTURE_2D, r->palette_tex);
-    gl->ActiveTexture(GL_TEXTURE0);
+    gl->BindTexture(GL_TEXTURE_2D, r->storage.palette_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_VOLUME_UNIT);
     vxl_uniform_i(r, prog, "u_codes", VXL_CODE_UNIT);
     vxl_uniform_i(r, prog, "u_palette", VXL_PALETTE_UNIT);
     vxl_uniform_i(r, prog, "u_edge", (int)e);
     vxl_uniform_i(r, prog, "u_count", (int)count);
     gl->Uniform3i(gl->GetUniformLocation(prog, "u_cache_slots"), (GLint)slots[0], (GLint)slots[1], (GLint)slots[2]);
-    gl->Uniform3i(gl->GetUniformLocation(prog, "u_code_slots"), (GLint)r->code_slots[0], (GLint)r->code_slots[1],
-                  (GLint)r->code_slots[2]);
-    gl->BindImageTexture(0, r->pool_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, image_formats[pg->bytes_per_voxel - 1]);
+    gl->Uniform3i(gl->GetUniformLocation(prog, "u_code_slots"), (GLint)r->storage.code_slots[0], (GLint)r->storage.code_slots[1],
+                  (GLint)r->storage.code_slots[2]);
+    gl->BindImageTexture(VXL_IMAGE_OUT, r->storage.pool_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, image_formats[pg->bytes_per_voxel - 1]);
     vxl_dispatch_bricks(r, prog, 0, count, e);
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     gl->Finish(); /* the decode time is a reported number */
-    r->decode_ms = now_ms() - t0;
+    r->storage.decode_ms = now_ms() - t0;
     gl->UseProgram(0);
     return vxl_gl_check(r, "decoding compressed bricks");
 }

@@ -8,7 +8,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
-#include "volume.h"
+#include "loaders.h"
 
 /* "DICM" at byte 128: a Part 10 file. */
 static int has_dicm_magic(const char *path)

@@ -2,6 +2,7 @@
 #include "frame.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -207,14 +208,39 @@ static int resolve_matrices(vxl_frame *f, const vxl_render_params *p, const vxl_
     return VXL_OK;
 }
 
+/* Every release of ABI 1 before the reserved room grew had this size (fields
+ * were taken from reserved[] until one word was left): the oldest layout a
+ * caller can have compiled against. */
+#define RENDER_PARAMS_OLDEST_SIZE (offsetof(vxl_render_params, reserved) + sizeof(uint32_t))
+
+int vxl_render_params_read(vxl_render_params *q, const vxl_render_params *p, vxl_err *e)
+{
+    memset(q, 0, sizeof *q);
+    if (!p) return VXL_OK;
+    if (p->struct_size != 0 && p->struct_size < RENDER_PARAMS_OLDEST_SIZE)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT,
+                        "render params struct_size %u is smaller than the oldest layout (%zu bytes)", p->struct_size,
+                        RENDER_PARAMS_OLDEST_SIZE);
+    /* An older caller's struct ends early: only its bytes are read, the rest
+     * stays zero (every field's default). A newer caller's extra bytes are
+     * not looked at. */
+    size_t n = p->struct_size == 0 || p->struct_size > sizeof *q ? sizeof *q : p->struct_size;
+    memcpy(q, p, n);
+    for (uint32_t i = 0; i < VXL_RENDER_PARAMS_RESERVED; i++)
+        if (q->reserved[i])
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT,
+                            "render params reserved[%u] is %u: it must be 0 (kept for future fields)", i,
+                            q->reserved[i]);
+    return VXL_OK;
+}
+
 int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volume_geom *g, vxl_err *e)
 {
-    static const vxl_render_params zero;
-    const vxl_render_params *p = pin ? pin : &zero;
     memset(f, 0, sizeof *f);
-    if (p->struct_size != 0 && p->struct_size < sizeof *p)
-        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "render params struct_size %u is smaller than this ABI's %zu",
-                        p->struct_size, sizeof *p);
+    vxl_render_params params;
+    int rc = vxl_render_params_read(&params, pin, e);
+    if (rc) return rc;
+    const vxl_render_params *p = &params;
     f->width = p->width ? p->width : 512;
     f->height = p->height ? p->height : 512;
     if (f->width > 16384 || f->height > 16384)
@@ -249,7 +275,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     f->jitter = !p->jitter_off;
     f->seed = p->jitter_seed;
     f->sample_distance = p->sample_distance == 0 ? DEFAULT_SAMPLE_DISTANCE : p->sample_distance;
-    int rc = check_float(e, "sample_distance", f->sample_distance, 1e-3f, 64);
+    rc = check_float(e, "sample_distance", f->sample_distance, 1e-3f, 64);
     if (rc) return rc;
     float step = p->step == 0 ? DEFAULT_STEP : p->step;
     if (!(step > 0) || !isfinite(step))

@@ -6,6 +6,7 @@
 
 #include <stdint.h>
 
+#include "bricks.h"
 #include "error.h"
 #include "transfer.h"
 #include "voxlight.h"
@@ -54,6 +55,30 @@ static inline uint32_t vxl_frame_filter(const vxl_frame *f)
 /* A hash of everything the classification depends on (table, window,
  * opacity scale): caches derived from it compare keys. */
 uint64_t vxl_classification_key(const vxl_frame *f);
+
+/* What brick occupancy depends on in this frame, as bricks.h takes it;
+ * fills *out and returns it. */
+static inline const vxl_occupancy_rule *vxl_frame_occupancy_rule(const vxl_frame *f, vxl_occupancy_rule *out)
+{
+    *out = (vxl_occupancy_rule){.table_key = vxl_classification_key(f),
+                                .tf = f->tf,
+                                .tf_size = f->tf_size,
+                                .window_offset = f->window_offset,
+                                .window_scale = f->window_scale,
+                                .opacity_scale = f->opacity_scale,
+                                .iso = f->gopacity == VXL_GOPACITY_ISO,
+                                .iso_pos = f->iso_pos,
+                                .iso_thickness = f->iso_thickness,
+                                .filter = f->filter,
+                                .sample_distance = f->sample_distance};
+    return out;
+}
+
+/* The caller's params as this library's struct: zero-filled past the
+ * caller's struct_size (older layouts get the defaults), reserved words
+ * checked. p may be NULL (all defaults). Every reader of vxl_render_params
+ * goes through it, so none reads past an older caller's struct. */
+int vxl_render_params_read(vxl_render_params *q, const vxl_render_params *p, vxl_err *e);
 
 /* p may be NULL (all defaults). On success free with vxl_frame_free. */
 int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e);

@@ -22,8 +22,11 @@ static const char *const cache_formats[] = {"r8", "r16", "r32f", "r32f"};
 static int compile(vxl_renderer *r, GLenum type, const char *file, const char *defines, GLuint *out)
 {
     vxl_gl *gl = &r->gl;
+    /* the binding numbers first, so layout(binding = VXL_...) reads gl_bindings.h */
+    char all[1024];
+    snprintf(all, sizeof all, "%s%s", vxl_glsl_binding_defines(), defines ? defines : "");
     char *src = NULL;
-    int rc = vxl_shader_source(r->shader_dir, file, defines, &src, &r->err);
+    int rc = vxl_shader_source(r->shader_dir, file, all, &src, &r->err);
     if (rc) return rc;
     GLuint s = gl->CreateShader(type);
     const GLchar *srcs[1] = {src};
@@ -82,9 +85,9 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
                  ((flags >> 2) & 3) == VXL_CLASSIFY_PRE      ? "#define CLASSIFY_PRE 1\n"
                  : ((flags >> 2) & 3) == VXL_CLASSIFY_PREINT ? "#define CLASSIFY_PREINT 1\n"
                                                              : "");
-        rc = compile(r, GL_VERTEX_SHADER, "raycast.vert", NULL, &a);
+        rc = compile(r, GL_VERTEX_SHADER, "render/raycast.vert", NULL, &a);
         if (rc) return rc;
-        rc = compile(r, GL_FRAGMENT_SHADER, "raycast.frag", defines, &b);
+        rc = compile(r, GL_FRAGMENT_SHADER, "render/raycast.frag", defines, &b);
         if (rc) {
             r->gl.DeleteShader(a);
             return rc;
@@ -92,38 +95,38 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
         return link(r, a, b, out);
     case VXL_PROG_PROBE:
         snprintf(defines, sizeof defines, "%s%s", paged, fdef);
-        rc = compile(r, GL_COMPUTE_SHADER, "probe.comp", defines, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/probe.comp", defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_GRAD_BLUR:
-        rc = compile(r, GL_COMPUTE_SHADER, "gradient_blur.comp", NULL, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/gradient_blur.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_GRAD_MAX: /* the dense texture's largest gradient (bricked: found on the CPU) */
-        rc = compile(r, GL_COMPUTE_SHADER, "gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_GRAD_STORE:
     case VXL_PROG_PAGED_GRAD_STORE:
         snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
-        rc = compile(r, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_STORE ? "gradient_sobel.comp" : "paged_gradient.comp",
+        rc = compile(r, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_STORE ? "compute/gradient_sobel.comp" : "compute/paged_gradient.comp",
                      defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BSPLINE_COPY:
-        rc = compile(r, GL_COMPUTE_SHADER, "bspline_prefilter.comp", "#define COPY_PASS 1\n", &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/bspline_prefilter.comp", "#define COPY_PASS 1\n", &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BSPLINE_AXIS:
-        rc = compile(r, GL_COMPUTE_SHADER, "bspline_prefilter.comp", NULL, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/bspline_prefilter.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_CLASSIFY_VOLUME:
-        rc = compile(r, GL_COMPUTE_SHADER, "classify_volume.comp", NULL, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/classify_volume.comp", NULL, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_PAGED_BLUR:
-        rc = compile(r, GL_COMPUTE_SHADER, "paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_DECODE_BRICKS:
         snprintf(defines, sizeof defines, "#define CACHE_FORMAT %s\n", cache_formats[flags & 3]);
-        rc = compile(r, GL_COMPUTE_SHADER, "decode_bricks.comp", defines, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/decode_bricks.comp", defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
-        rc = compile(r, GL_COMPUTE_SHADER, "brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);
         return rc ? rc : link(r, a, 0, out);
     default:
         return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown program kind %u", kind);
@@ -169,8 +172,8 @@ void vxl_uniform_f(vxl_renderer *r, GLuint prog, const char *name, float v)
     if (loc >= 0) r->gl.Uniform1f(loc, v);
 }
 
-/* Created on a scratch unit, so making a texture never disturbs what a
- * program has bound on its sampler units (0-4). Leaves unit 7 active. */
+/* Created on the scratch unit, so making a texture never disturbs what a
+ * program has bound on its sampler units. Leaves VXL_SCRATCH_UNIT active. */
 GLuint vxl_texture_new(vxl_renderer *r, GLenum target, GLint filter)
 {
     GLuint t = 0;

@@ -17,6 +17,7 @@
 #include <strings.h>
 
 #include "loader_util.h"
+#include "loaders.h"
 
 #define MHA_MAX_DIM 4
 

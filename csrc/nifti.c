@@ -11,7 +11,7 @@
  * file's byte order is foreign -> hand over to vxl_volume_build, which owns
  * scaling, NaN handling and normalisation. */
 #include "loader_util.h"
-#include "volume.h"
+#include "loaders.h"
 
 #include <errno.h>
 #include <math.h>

@@ -22,6 +22,7 @@
 #include <strings.h>
 
 #include "loader_util.h"
+#include "loaders.h"
 
 #define NRRD_MAX_DIM 16
 #define ENC_RAW 0

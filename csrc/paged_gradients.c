@@ -28,7 +28,7 @@ static uint32_t blur_chunk(const vxl_renderer *r, uint32_t eb, uint32_t count)
 
 uint64_t vxl_paged_gradient_bytes(const vxl_renderer *r, uint32_t level, int store, uint8_t *want, uint32_t *count_out)
 {
-    const vxl_pages *pg = &r->levels[level];
+    const vxl_pages *pg = &r->storage.levels[level];
     const uint32_t count = vxl_paged_derived_want(r, level, VXL_GRADIENT_SUPPORT, VXL_GRADIENT_READ_REACH, want);
     const uint64_t eb = pg->brick + 4, eg = pg->brick + 2;
     uint32_t bslots[3], gslots[3];
@@ -61,61 +61,49 @@ static GLint *brick_list(const vxl_pages *pg, const uint8_t *want, uint32_t coun
 /* The whole level's largest |gradient|, from the CPU bricks; kept per level. */
 static int cpu_gradient_max(vxl_renderer *r, float *out)
 {
-    if (r->gradient_max_level[r->level] >= 0) {
-        *out = r->gradient_max_level[r->level];
+    if (r->gradients.max_level[r->storage.level] >= 0) {
+        *out = r->gradients.max_level[r->storage.level];
         return VXL_OK;
     }
     vxl_brick_store s;
     uint8_t *owned;
     int rc = vxl_paged_brick_store(r, &s, &owned);
     if (rc) return rc;
-    float m = vxl_pages_gradient_max(&r->levels[r->level], &s, r->level_dims[r->level]);
+    float m = vxl_pages_gradient_max(&r->storage.levels[r->storage.level], &s, r->storage.level_dims[r->storage.level]);
     free(owned);
     if (m < 0) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory finding the largest gradient");
-    *out = r->gradient_max_level[r->level] = m;
+    *out = r->gradients.max_level[r->storage.level] = m;
     return VXL_OK;
-}
-
-static GLuint groups(uint32_t n) { return (n + 3) / 4; }
-
-void vxl_dispatch_bricks(vxl_renderer *r, GLuint prog, uint32_t first, uint32_t count, uint32_t e)
-{
-    const uint32_t per = 65535u * 4u / e; /* bricks per dispatch: z groups <= 65535 */
-    for (uint32_t k = first; k < first + count; k += per) {
-        uint32_t n = first + count - k < per ? first + count - k : per;
-        vxl_uniform_i(r, prog, "u_first", (int)k);
-        r->gl.DispatchCompute(groups(e), groups(e), groups(n * e));
-    }
 }
 
 static void set_common(vxl_renderer *r, GLuint prog, uint32_t count, const uint32_t slots[3])
 {
     vxl_gl *gl = &r->gl;
     gl->UseProgram(prog);
-    const uint32_t *ld = r->level_dims[r->level];
-    vxl_uniform_i(r, prog, "u_brick", (int)r->levels[r->level].brick);
-    vxl_uniform_f(r, prog, "u_page_brick", (float)r->levels[r->level].brick);
+    const uint32_t *ld = r->storage.level_dims[r->storage.level];
+    vxl_uniform_i(r, prog, "u_brick", (int)r->storage.levels[r->storage.level].brick);
+    vxl_uniform_f(r, prog, "u_page_brick", (float)r->storage.levels[r->storage.level].brick);
     vxl_uniform_i(r, prog, "u_count", (int)count);
     float dims[3] = {(float)ld[0], (float)ld[1], (float)ld[2]};
     gl->Uniform3fv(gl->GetUniformLocation(prog, "u_dims"), 1, dims);
     gl->Uniform3i(gl->GetUniformLocation(prog, "u_slots"), (GLint)slots[0], (GLint)slots[1], (GLint)slots[2]);
 }
 
-int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
+int vxl_paged_gradients_ensure(vxl_renderer *r, int store, void (*make_room)(vxl_renderer *r))
 {
-    const vxl_pages *pg = &r->levels[r->level];
+    const vxl_pages *pg = &r->storage.levels[r->storage.level];
     const uint64_t n = vxl_page_count(pg);
     uint8_t *want = malloc(n);
     if (!want) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the gradient bricks");
     uint32_t count;
-    const uint64_t all_bytes = vxl_paged_gradient_bytes(r, r->level, store, want, &count);
-    if (r->gradient_tex && r->gradient_store == store &&
-        vxl_paged_derived_current(r, r->gradient_covered, r->gradient_level, want)) {
+    const uint64_t all_bytes = vxl_paged_gradient_bytes(r, r->storage.level, store, want, &count);
+    if (r->gradients.tex && r->gradients.store == store &&
+        vxl_paged_derived_current(r, r->gradients.covered, r->gradients.level, want)) {
         free(want);
         return VXL_OK;
     }
     vxl_gradients_release(r);
-    vxl_bspline_release(r); /* one derived pool at a time: storage that pages is short of memory */
+    if (make_room) make_room(r);
     vxl_gl *gl = &r->gl;
     const uint32_t pb = pg->brick, eb = pb + 4, eg = pb + 2;
     uint32_t bslots[3], gslots[3];
@@ -143,7 +131,7 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
                         count, r->info.max_3d_texture_size);
     }
     const uint64_t gbytes = (uint64_t)gslots[0] * gslots[1] * gslots[2] * eg * eg * eg * store_bytes[store],
-                   need = r->pool_bytes + r->classified_bytes + all_bytes;
+                   need = all_bytes;
     GLuint progs[3];
     rc = vxl_gradient_programs(r, 1, store, need, progs);
     if (rc) {
@@ -156,29 +144,29 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[1]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(count ? count : 1) * 4 * (GLsizeiptr)sizeof(GLint), list,
                    GL_STATIC_DRAW);
-    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, r->ssbo[1]);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, VXL_SSBO_BRICK_LIST, r->ssbo[1]);
     /* The bricks go through in chunks whose blurred copies fit one small
      * texture: the blurred copy of every brick at once would double the
      * memory. Pass 1 blurs a chunk, pass 2 stores its scaled gradients. */
     GLuint blur = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
     gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R32F, (GLsizei)(bslots[0] * eb), (GLsizei)(bslots[1] * eb),
                    (GLsizei)(bslots[2] * eb), 0, GL_RED, GL_FLOAT, NULL);
-    r->gradient_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
-    for (int a = 0; a < 3; a++) r->gpool_dims[a] = gslots[a] * eg;
-    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)store_internal[store], (GLsizei)r->gpool_dims[0], (GLsizei)r->gpool_dims[1],
-                   (GLsizei)r->gpool_dims[2], 0, GL_RGBA, GL_FLOAT, NULL);
+    r->gradients.tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
+    for (int a = 0; a < 3; a++) r->gradients.pool_dims[a] = gslots[a] * eg;
+    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)store_internal[store], (GLsizei)r->gradients.pool_dims[0], (GLsizei)r->gradients.pool_dims[1],
+                   (GLsizei)r->gradients.pool_dims[2], 0, GL_RGBA, GL_FLOAT, NULL);
     for (uint32_t first = 0; first < count; first += chunk) {
         const uint32_t n_chunk = count - first < chunk ? count - first : chunk;
         /* pass 1: blur the chunk's bricks plus a 2-voxel border, through the data pool */
         set_common(r, blur_prog, first + n_chunk, bslots); /* u_count: this chunk ends the list */
         vxl_uniform_i(r, blur_prog, "u_blur_first", (int)first);
         gl->ActiveTexture(GL_TEXTURE0 + VXL_PAGE_UNIT);
-        gl->BindTexture(GL_TEXTURE_3D, r->page_tex);
-        gl->ActiveTexture(GL_TEXTURE0);
-        gl->BindTexture(GL_TEXTURE_3D, r->pool_tex);
-        vxl_uniform_i(r, blur_prog, "u_volume", 0);
+        gl->BindTexture(GL_TEXTURE_3D, r->storage.page_tex);
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_VOLUME_UNIT);
+        gl->BindTexture(GL_TEXTURE_3D, r->storage.pool_tex);
+        vxl_uniform_i(r, blur_prog, "u_volume", VXL_VOLUME_UNIT);
         vxl_uniform_i(r, blur_prog, "u_page", VXL_PAGE_UNIT);
-        gl->BindImageTexture(0, blur, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+        gl->BindImageTexture(VXL_IMAGE_OUT, blur, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
         vxl_dispatch_bricks(r, blur_prog, first, n_chunk, eb);
         gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         /* pass 2: the Sobel of the blurred chunk, divided by the maximum, into the gradient pool */
@@ -186,15 +174,15 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
         vxl_uniform_i(r, store_prog, "u_blur_first", (int)first);
         gl->Uniform3i(gl->GetUniformLocation(store_prog, "u_blur_slots"), (GLint)bslots[0], (GLint)bslots[1],
                       (GLint)bslots[2]);
-        gl->ActiveTexture(GL_TEXTURE0);
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_VOLUME_UNIT);
         gl->BindTexture(GL_TEXTURE_3D, blur);
-        vxl_uniform_i(r, store_prog, "u_blur", 0);
+        vxl_uniform_i(r, store_prog, "u_blur", VXL_VOLUME_UNIT);
         vxl_uniform_f(r, store_prog, "u_inv_max", max_mag > 0 ? 1.0f / max_mag : 0.0f);
-        gl->BindImageTexture(0, r->gradient_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, store_internal[store]);
+        gl->BindImageTexture(VXL_IMAGE_OUT, r->gradients.tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, store_internal[store]);
         vxl_dispatch_bricks(r, store_prog, first, n_chunk, eg);
         gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     }
-    r->gradient_max = max_mag; /* the shader scales back to value per voxel */
+    r->gradients.max = max_mag; /* the shader scales back to value per voxel */
     gl->DeleteTextures(1, &blur);
     /* the gradient page table: slot origins + ghost, or zero gradient */
     float *entries = calloc(n * 4, sizeof *entries);
@@ -203,17 +191,12 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
     for (uint32_t k = 0; k < count && entries; k++) {
         const GLint *c = list + 4 * (size_t)k;
         float *e = entries + 4 * ((size_t)c[0] + pg->grid[0] * ((size_t)c[1] + (size_t)pg->grid[1] * c[2]));
-        e[0] = (float)(k % gslots[0] * eg + 1);
-        e[1] = (float)(k / gslots[0] % gslots[1] * eg + 1);
-        e[2] = (float)(k / (gslots[0] * gslots[1]) * eg + 1);
+        uint32_t o[3];
+        vxl_slot_origin(k, gslots, eg, o);
+        for (int a = 0; a < 3; a++) e[a] = (float)(o[a] + 1);
         e[3] = -1;
     }
-    if (entries) {
-        if (!r->gpage_tex) r->gpage_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
-        gl->BindTexture(GL_TEXTURE_3D, r->gpage_tex);
-        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA32F, (GLsizei)pg->grid[0], (GLsizei)pg->grid[1], (GLsizei)pg->grid[2], 0,
-                       GL_RGBA, GL_FLOAT, entries);
-    }
+    if (entries) vxl_page_table_upload(r, &r->gradients.page_tex, pg, entries);
     free(entries);
     free(list);
     gl->UseProgram(0);
@@ -223,9 +206,9 @@ int vxl_paged_gradients_ensure(vxl_renderer *r, int store)
         vxl_gradients_release(r);
         return rc;
     }
-    r->gradient_covered = want;
-    r->gradient_level = r->level;
-    r->gradient_store = store;
-    r->gradient_bytes = gbytes + n * 16;
+    r->gradients.covered = want;
+    r->gradients.level = r->storage.level;
+    r->gradients.store = store;
+    r->gradients.bytes = gbytes + n * 16;
     return VXL_OK;
 }

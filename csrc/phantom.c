@@ -7,6 +7,7 @@
 
 #include "phantom_large.h"
 #include "volume.h"
+#include "voxlight_dev.h"
 
 #define ML_FM 6.0
 #define ML_ALPHA 0.25

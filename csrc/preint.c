@@ -9,7 +9,7 @@
 #include "preint.h"
 
 #include "error.h"
-#include "voxlight.h"
+#include "voxlight_dev.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "renderer_internal.h"
+#include "voxlight_dev.h"
 
 #define MAX_PROBE_POINTS (1u << 24)
 
@@ -21,8 +22,10 @@ static int job_probe(void *arg)
     vxl_renderer *r = j->r;
     vxl_gl *gl = &r->gl;
     if (!r->has_volume) return vxl_fail(&r->err, VXL_ERR_STATE, "no volume: call vxl_renderer_set_volume first");
-    static const vxl_render_params zero;
-    const vxl_render_params *p = j->p ? j->p : &zero;
+    vxl_render_params params; /* read up to the caller's struct_size, never past */
+    int rc = vxl_render_params_read(&params, j->p, &r->err);
+    if (rc) return rc;
+    const vxl_render_params *p = &params;
     if (p->filter >= VXL_FILTER_COUNT) return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown filter %u", p->filter);
     float d = p->sample_distance == 0 ? 1.0f : p->sample_distance;
     if (!(d >= 1e-3f && d <= 64))
@@ -31,9 +34,9 @@ static int job_probe(void *arg)
         if (!isfinite(j->points[i]))
             return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "probe point %u is not finite", i / 3);
     GLuint prog;
-    int rc = vxl_paged_check_filter(r, p->filter, VXL_CLASSIFY_POST);
-    if (!rc) rc = vxl_paged_prepare(r, NULL);
-    if (!rc) rc = vxl_program_get(r, VXL_PROG_PROBE, p->filter, vxl_volume_flags(r), &prog);
+    rc = r->storage.ops->check_filter(r, p->filter, VXL_CLASSIFY_POST);
+    if (!rc) rc = r->storage.ops->prepare(r, NULL);
+    if (!rc) rc = vxl_program_get(r, VXL_PROG_PROBE, p->filter, r->storage.ops->sample_flags(r), &prog);
     if (rc) return rc;
     gl->GetError();
     rc = vxl_bind_volume_textures(r, prog, p->filter, (int)p->gradient_store);
@@ -41,10 +44,10 @@ static int job_probe(void *arg)
     GLsizeiptr bytes = (GLsizeiptr)j->n * 3 * (GLsizeiptr)sizeof(float);
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[0]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, bytes, j->points, GL_STATIC_DRAW);
-    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r->ssbo[0]);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, VXL_SSBO_PROBE_POINTS, r->ssbo[0]);
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[1]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, bytes, NULL, GL_DYNAMIC_READ);
-    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, r->ssbo[1]);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, VXL_SSBO_PROBE_RESULTS, r->ssbo[1]);
     gl->Uniform1ui(gl->GetUniformLocation(prog, "u_count"), j->n);
     vxl_uniform_i(r, prog, "u_sequential", p->reuse_gradients != 0);
     vxl_uniform_f(r, prog, "u_sample_distance", d);

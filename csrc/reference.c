@@ -8,6 +8,7 @@
 #include "frame.h"
 #include "mat4.h"
 #include "volume.h"
+#include "voxlight_dev.h"
 
 #define REF_MAX_STEP (1.0 / 16.0)
 

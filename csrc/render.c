@@ -49,62 +49,26 @@ static int ensure_framebuffer(vxl_renderer *r, uint32_t w, uint32_t h)
 int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store)
 {
     vxl_gl *gl = &r->gl;
+    const vxl_storage_ops *ops = r->storage.ops;
     if (filter == VXL_FILTER_PRECOMPUTED) {
         if (store < 0 || store > VXL_GRADIENT_STORE_32F)
             return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown gradient_store %d", store);
-        int rc = r->volume_tex ? vxl_gradients_ensure(r, store) : vxl_paged_gradients_ensure(r, store);
+        int rc = ops->gradients(r, store);
         if (rc) return rc;
-        if (r->gpage_tex) {
-            gl->ActiveTexture(GL_TEXTURE0 + VXL_GPAGE_UNIT);
-            gl->BindTexture(GL_TEXTURE_3D, r->gpage_tex);
-        }
-        gl->ActiveTexture(GL_TEXTURE1);
-        gl->BindTexture(GL_TEXTURE_3D, r->gradient_tex);
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_DERIVED_UNIT);
+        gl->BindTexture(GL_TEXTURE_3D, r->gradients.tex);
     } else if (filter == VXL_FILTER_CUBIC) {
-        int rc = r->volume_tex ? vxl_bspline_ensure(r) : vxl_paged_bspline_ensure(r);
+        int rc = ops->bspline(r);
         if (rc) return rc;
-        if (r->cpage_tex) {
-            gl->ActiveTexture(GL_TEXTURE0 + VXL_CPAGE_UNIT);
-            gl->BindTexture(GL_TEXTURE_3D, r->cpage_tex);
-        }
-        gl->ActiveTexture(GL_TEXTURE1);
-        gl->BindTexture(GL_TEXTURE_3D, r->bspline_tex);
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_DERIVED_UNIT);
+        gl->BindTexture(GL_TEXTURE_3D, r->bspline.tex);
     }
     gl->UseProgram(prog);
-    if (r->pool_tex) { /* bricked: the pool stands in for the volume, the page table translates */
-        gl->ActiveTexture(GL_TEXTURE0 + VXL_PAGE_UNIT);
-        gl->BindTexture(GL_TEXTURE_3D, r->page_tex);
-        vxl_uniform_i(r, prog, "u_page", VXL_PAGE_UNIT);
-        vxl_uniform_f(r, prog, "u_page_brick", (float)r->levels[r->level].brick);
-        vxl_uniform_f(r, prog, "u_lod_scale", (float)(1u << r->level));
-        const uint32_t *ld = r->level_dims[r->level];
-        float pd[3] = {(float)r->pool_dims[0], (float)r->pool_dims[1], (float)r->pool_dims[2]};
-        float lv[3] = {(float)ld[0], (float)ld[1], (float)ld[2]};
-        GLint ploc = gl->GetUniformLocation(prog, "u_pool_dims"), lloc = gl->GetUniformLocation(prog, "u_page_dims");
-        if (ploc >= 0) gl->Uniform3fv(ploc, 1, pd);
-        if (lloc >= 0) gl->Uniform3fv(lloc, 1, lv);
-        vxl_uniform_i(r, prog, "u_gpage", VXL_GPAGE_UNIT);
-        float gd[3] = {(float)r->gpool_dims[0], (float)r->gpool_dims[1], (float)r->gpool_dims[2]};
-        GLint gloc = gl->GetUniformLocation(prog, "u_gpool_dims");
-        if (gloc >= 0) gl->Uniform3fv(gloc, 1, gd);
-        vxl_uniform_i(r, prog, "u_cpage", VXL_CPAGE_UNIT);
-        float cd[3] = {(float)r->cpool_dims[0], (float)r->cpool_dims[1], (float)r->cpool_dims[2]};
-        GLint cloc = gl->GetUniformLocation(prog, "u_cpool_dims");
-        if (cloc >= 0) gl->Uniform3fv(cloc, 1, cd);
-        if (r->pool_tex == r->code_tex) { /* compressed storage filtered in the compressed domain */
-            gl->ActiveTexture(GL_TEXTURE0 + VXL_PALETTE_UNIT);
-            gl->BindTexture(GL_TEXTURE_2D, r->palette_tex);
-            vxl_uniform_i(r, prog, "u_palette", VXL_PALETTE_UNIT);
-            gl->Uniform3i(gl->GetUniformLocation(prog, "u_code_slots"), (GLint)r->code_slots[0],
-                          (GLint)r->code_slots[1], (GLint)r->code_slots[2]);
-        }
-    }
-    gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, r->pool_tex ? r->pool_tex : r->volume_tex);
-    vxl_uniform_i(r, prog, "u_volume", 0);
-    vxl_uniform_i(r, prog, "u_gradient", 1);
-    vxl_uniform_i(r, prog, "u_bspline", 1);
-    if (filter == VXL_FILTER_PRECOMPUTED) vxl_uniform_f(r, prog, "u_gradient_scale", r->gradient_max);
+    ops->bind(r, prog); /* the values on the volume unit, and what translates a sample */
+    vxl_uniform_i(r, prog, "u_volume", VXL_VOLUME_UNIT);
+    vxl_uniform_i(r, prog, "u_gradient", VXL_DERIVED_UNIT);
+    vxl_uniform_i(r, prog, "u_bspline", VXL_DERIVED_UNIT);
+    if (filter == VXL_FILTER_PRECOMPUTED) vxl_uniform_f(r, prog, "u_gradient_scale", r->gradients.max);
     GLint loc = gl->GetUniformLocation(prog, "u_dims");
     float dims[3] = {(float)r->dims[0], (float)r->dims[1], (float)r->dims[2]};
     if (loc >= 0) gl->Uniform3fv(loc, 1, dims);
@@ -115,7 +79,7 @@ static void upload_tf(vxl_renderer *r, const vxl_frame *f)
 {
     vxl_gl *gl = &r->gl;
     if (!r->tf_tex) r->tf_tex = vxl_texture_new(r, GL_TEXTURE_1D, GL_LINEAR);
-    gl->ActiveTexture(GL_TEXTURE2);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_TF_UNIT);
     gl->BindTexture(GL_TEXTURE_1D, r->tf_tex);
     gl->TexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, (GLsizei)f->tf_size, 0, GL_RGBA, GL_FLOAT, f->tf);
 }
@@ -124,7 +88,7 @@ static void upload_scene_depth(vxl_renderer *r, const vxl_frame *f)
 {
     vxl_gl *gl = &r->gl;
     if (!r->scene_depth_tex) r->scene_depth_tex = vxl_texture_new(r, GL_TEXTURE_2D, GL_NEAREST);
-    gl->ActiveTexture(GL_TEXTURE3);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_SCENE_DEPTH_UNIT);
     gl->BindTexture(GL_TEXTURE_2D, r->scene_depth_tex);
     gl->TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, (GLsizei)f->width, (GLsizei)f->height, 0, GL_RED, GL_FLOAT,
                    f->scene_depth);
@@ -146,8 +110,8 @@ static void set_frame_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame *f)
     gl->Uniform1f(LOC("u_early_termination"), f->early_termination);
     gl->Uniform1f(LOC("u_depth_threshold"), f->depth_threshold);
     gl->Uniform1i(LOC("u_has_scene_depth"), f->scene_depth != NULL);
-    gl->Uniform1i(LOC("u_scene_depth"), 3);
-    gl->Uniform1i(LOC("u_tf"), 2);
+    gl->Uniform1i(LOC("u_scene_depth"), VXL_SCENE_DEPTH_UNIT);
+    gl->Uniform1i(LOC("u_tf"), VXL_TF_UNIT);
     gl->Uniform1f(LOC("u_tf_size"), (float)f->tf_size);
     gl->Uniform2f(LOC("u_window"), f->window_offset, f->window_scale);
     gl->Uniform1f(LOC("u_opacity_scale"), f->opacity_scale);
@@ -202,9 +166,9 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     vxl_gl *gl = &r->gl;
     GLuint prog;
     uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2) |
-                     (f->gopacity << 4) | vxl_volume_flags(r);
+                     (f->gopacity << 4) | r->storage.ops->sample_flags(r);
     uint32_t filter = vxl_frame_filter(f);
-    int rc = vxl_paged_check_filter(r, filter, f->classify);
+    int rc = r->storage.ops->check_filter(r, filter, f->classify);
     if (!rc) rc = vxl_program_get(r, VXL_PROG_RAYCAST, filter, flags, &prog);
     if (!rc) rc = ensure_framebuffer(r, f->width, f->height);
     if (rc) return rc;
@@ -212,17 +176,17 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     upload_tf(r, f);
     if (f->scene_depth) upload_scene_depth(r, f);
     /* bricked storage derives its resident set from the skipping grid */
-    if ((f->skip || !r->volume_tex) && (rc = vxl_skipping_prepare(r, f))) return rc;
-    if ((rc = vxl_paged_prepare(r, f))) return rc;
+    if ((f->skip || r->storage.ops->needs_occupancy) && (rc = vxl_skipping_prepare(r, f))) return rc;
+    if ((rc = r->storage.ops->prepare(r, f))) return rc;
     if ((rc = vxl_classification_prepare(r, f))) return rc;
     rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
     if (rc) return rc;
     set_frame_uniforms(r, prog, f);
     vxl_uniform_i(r, prog, "u_skip", f->skip);
-    vxl_uniform_i(r, prog, "u_brick_size", (int)(r->bricks.size ? r->bricks.size : VXL_DEFAULT_BRICK));
-    vxl_uniform_i(r, prog, "u_brick_distance", 4);
-    vxl_uniform_i(r, prog, "u_classified", 5);
-    vxl_uniform_i(r, prog, "u_preint", 6);
+    vxl_uniform_i(r, prog, "u_brick_size", (int)(r->skipping.bricks.size ? r->skipping.bricks.size : VXL_DEFAULT_BRICK));
+    vxl_uniform_i(r, prog, "u_brick_distance", VXL_DISTANCE_UNIT);
+    vxl_uniform_i(r, prog, "u_classified", VXL_CLASSIFIED_UNIT);
+    vxl_uniform_i(r, prog, "u_preint", VXL_PREINT_UNIT);
     vxl_uniform_f(r, prog, "u_preint_size", (float)f->preint_size);
     if (f->gopacity == VXL_GOPACITY_BOUNDARY)
         gl->Uniform2f(gl->GetUniformLocation(prog, "u_gopacity_param"), f->gradient_ref, f->gradient_exp);
@@ -231,7 +195,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     const GLuint zeros[4] = {0, 0, 0, 0};
     gl->BindBuffer(GL_SHADER_STORAGE_BUFFER, r->ssbo[2]);
     gl->BufferData(GL_SHADER_STORAGE_BUFFER, sizeof zeros, zeros, GL_DYNAMIC_READ);
-    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, r->ssbo[2]);
+    gl->BindBufferBase(GL_SHADER_STORAGE_BUFFER, VXL_SSBO_STATS, r->ssbo[2]);
     gl->BindFramebuffer(GL_FRAMEBUFFER, r->fbo);
     const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     gl->DrawBuffers(2, bufs);
@@ -270,21 +234,13 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     r->stats.rays = counts[3];
     r->stats.effective_step = f->step;
     if (f->skip) {
-        r->stats.bricks_total = r->bricks.dims[0] * r->bricks.dims[1] * r->bricks.dims[2];
-        r->stats.bricks_occupied = r->bricks.occupied;
-        r->stats.brick_size = r->bricks.size;
+        r->stats.bricks_total = r->skipping.bricks.dims[0] * r->skipping.bricks.dims[1] * r->skipping.bricks.dims[2];
+        r->stats.bricks_occupied = r->skipping.bricks.occupied;
+        r->stats.brick_size = r->skipping.bricks.size;
     }
-    r->stats.storage = r->storage;
-    r->stats.resident_bytes = r->volume_tex ? r->volume_bytes : r->pool_bytes;
-    if (!r->volume_tex) {
-        r->stats.page_brick = r->levels[r->level].brick;
-        r->stats.pages_total = (uint32_t)vxl_page_count(&r->levels[r->level]);
-        r->stats.lod_level = r->level;
-        r->stats.lod_wanted_bytes = r->lod_wanted_bytes;
-        r->stats.decode_ms = r->decode_ms;
-        r->stats.pages_resident = r->pages_resident;
-        r->stats.pages_constant = r->pages_constant;
-    }
+    r->stats.storage = r->storage.mode;
+    r->stats.resident_bytes = r->storage.ops->resident_bytes(r);
+    r->storage.ops->report(r, &r->stats);
     return VXL_OK;
 }
 
@@ -326,12 +282,13 @@ static int job_camera(void *p)
     if (!r->has_volume) return vxl_fail(&r->err, VXL_ERR_STATE, "no volume: call vxl_renderer_set_volume first");
     vxl_volume_geom g;
     geom_of(r, &g);
-    vxl_render_params q;
-    memset(&q, 0, sizeof q);
-    if (j->p) q = *j->p;
+    vxl_render_params q; /* read up to the caller's struct_size, never past */
+    int rc = vxl_render_params_read(&q, j->p, &r->err);
+    if (rc) return rc;
+    q.struct_size = sizeof q;
     q.has_camera = 0;
     vxl_frame f;
-    int rc = vxl_frame_resolve(&f, &q, &g, &r->err);
+    rc = vxl_frame_resolve(&f, &q, &g, &r->err);
     if (rc) return rc;
     for (int i = 0; i < 16; i++) {
         j->view[i] = (float)f.view[i];

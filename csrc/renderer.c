@@ -57,16 +57,23 @@ static void delete_texture(vxl_renderer *r, GLuint *t)
     *t = 0;
 }
 
+/* Everything derived from the volume, and the volume itself, goes. */
+static void release_volume(vxl_renderer *r)
+{
+    vxl_gradients_forget_volume(r);
+    vxl_bspline_release(r);
+    vxl_skipping_release(r);
+    vxl_classification_release(r);
+    if (r->storage.ops) r->storage.ops->release(r);
+    r->storage.ops = NULL;
+    r->storage.mode = 0;
+}
+
 static int job_close(void *p)
 {
     vxl_renderer *r = p;
     if (r->ctx.close) {
-        vxl_gradients_release(r);
-        vxl_bspline_release(r);
-        vxl_skipping_release(r);
-        vxl_classification_release(r);
-        vxl_paged_release(r);
-        delete_texture(r, &r->volume_tex);
+        release_volume(r);
         delete_texture(r, &r->color_tex);
         delete_texture(r, &r->depth_tex);
         delete_texture(r, &r->scene_depth_tex);
@@ -93,11 +100,11 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
             free(r);
             return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "unknown storage %u", opt->storage);
         }
-        r->storage_request = opt->storage;
-        r->page_brick_request = opt->page_brick;
+        r->storage.request = opt->storage;
+        r->storage.page_brick_request = opt->page_brick;
     }
     if (opt && opt->struct_size >= offsetof(vxl_renderer_options, compressed_domain) + sizeof opt->compressed_domain)
-        r->compressed_domain = opt->compressed_domain != 0;
+        r->storage.compressed_domain = opt->compressed_domain != 0;
     const char *dir = (opt && opt->shader_dir) ? opt->shader_dir : getenv("VOXLIGHT_SHADER_DIR");
     if (dir && *dir && !(r->shader_dir = strdup(dir))) {
         free(r);
@@ -134,15 +141,21 @@ typedef struct stats_job {
     vxl_render_stats *out;
 } stats_job;
 
+/* Copies an output struct (src, size bytes, struct_size first) to the
+ * caller's: one built against an older header is shorter, so only what its
+ * struct_size covers is written (0: the whole of this header's). */
+static void copy_to_caller(void *out, const void *src, size_t size)
+{
+    uint32_t asked;
+    memcpy(&asked, out, sizeof asked);
+    memcpy(out, src, asked && asked < size ? asked : size);
+    if (asked) memcpy(out, &asked, sizeof asked);
+}
+
 static int job_stats(void *p)
 {
     stats_job *j = p;
-    /* a caller built against an older header has a shorter struct: copy
-     * only what its struct_size covers (0: the whole of this header's) */
-    size_t n = j->out->struct_size && j->out->struct_size < sizeof *j->out ? j->out->struct_size : sizeof *j->out;
-    uint32_t asked = j->out->struct_size;
-    memcpy(j->out, &j->r->stats, n);
-    if (asked) j->out->struct_size = asked;
+    copy_to_caller(j->out, &j->r->stats, sizeof j->r->stats);
     return VXL_OK;
 }
 
@@ -158,7 +171,7 @@ const char *vxl_renderer_error(const vxl_renderer *r) { return r ? r->err.msg : 
 int vxl_renderer_get_info(vxl_renderer *r, vxl_renderer_info *out)
 {
     if (!r || !out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "renderer or info is NULL");
-    *out = r->info; /* written once by job_open, read-only afterwards */
+    copy_to_caller(out, &r->info, sizeof r->info); /* written once by job_open, read-only afterwards */
     return VXL_OK;
 }
 
@@ -167,80 +180,35 @@ typedef struct volume_job {
     const vxl_volume *v;
 } volume_job;
 
-static const GLenum internal_formats[] = {GL_R8, GL_R16, GL_R32F};
-static const GLenum texel_types[] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_SHORT, GL_FLOAT};
-
-/* DENSE when asked, or (AUTO) when one texture fits the limit and budget. */
-static uint32_t choose_storage(const vxl_renderer *r, const vxl_volume *v)
-{
-    if (r->storage_request != VXL_STORAGE_AUTO) return r->storage_request;
-    for (int a = 0; a < 3; a++)
-        if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size) return VXL_STORAGE_AUTO;
-    return v->storage_bytes > r->budget ? VXL_STORAGE_AUTO : VXL_STORAGE_DENSE;
-}
-
-static int upload_dense(vxl_renderer *r, const vxl_volume *v)
-{
-    for (int a = 0; a < 3; a++)
-        if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size)
-            return vxl_fail(&r->err, VXL_ERR_LIMIT,
-                            "volume %ux%ux%u exceeds this backend's 3D texture limit of %d per axis (bricked "
-                            "storage has no such limit)",
-                            v->dims[0], v->dims[1], v->dims[2], r->info.max_3d_texture_size);
-    if (v->storage_bytes > r->budget)
-        return vxl_fail(&r->err, VXL_ERR_LIMIT, "volume needs %.1f MiB, over the renderer's memory budget of %.1f MiB",
-                        v->storage_bytes / 1048576.0, r->budget / 1048576.0);
-    int fi = v->texture_bits == 8 ? 0 : v->texture_bits == 16 ? 1 : 2;
-    r->gl.GetError();
-    r->volume_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_LINEAR);
-    r->gl.TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)v->dims[0], (GLsizei)v->dims[1],
-                     (GLsizei)v->dims[2], 0, GL_RED, texel_types[fi], v->texels);
-    int rc = vxl_gl_check(r, "uploading the volume");
-    if (rc) delete_texture(r, &r->volume_tex);
-    r->storage = VXL_STORAGE_DENSE;
-    return rc;
-}
-
 static int job_set_volume(void *p)
 {
     volume_job *j = p;
     vxl_renderer *r = j->r;
     const vxl_volume *v = j->v;
-    uint32_t storage = choose_storage(r, v);
-    vxl_paged_volume pv;
+    const uint32_t asked = vxl_storage_choose(r, v);
+    vxl_storage_plan plan;
     /* refuse before anything is released: a failed set_volume loses nothing */
-    if (storage == VXL_STORAGE_DENSE) {
-        for (int a = 0; a < 3; a++)
-            if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size || v->storage_bytes > r->budget)
-                return upload_dense(r, v);
-    } else {
-        int rc = vxl_paged_plan(r, v, storage, &pv);
-        if (rc) return rc;
-    }
-    /* Everything derived from the old volume goes: the data changed. */
-    vxl_gradients_release(r);
-    vxl_bspline_release(r);
-    vxl_skipping_release(r);
-    vxl_classification_release(r);
-    vxl_paged_release(r);
-    delete_texture(r, &r->volume_tex);
+    int rc = vxl_storage_ops_for(asked)->plan(r, v, asked, &plan);
+    if (rc) return rc;
+    const vxl_storage_ops *ops = vxl_storage_ops_for(plan.mode);
+    release_volume(r); /* the data changed */
     r->has_volume = 0;
-    r->storage = 0;
-    int rc = storage == VXL_STORAGE_DENSE ? upload_dense(r, v) : vxl_paged_install(r, &pv);
+    r->storage.ops = ops;
+    rc = ops->install(r, v, &plan);
     if (rc) {
-        vxl_skipping_release(r);
-        vxl_paged_release(r);
-        delete_texture(r, &r->volume_tex);
-        r->storage = 0;
+        vxl_bricks_free(&plan.bricks);
+        ops->release(r);
+        r->storage.ops = NULL;
+        r->storage.mode = 0;
         return rc;
     }
+    vxl_skipping_adopt(r, &plan.bricks); /* the min-max grid the plan computed, if any */
     memcpy(r->dims, v->dims, sizeof r->dims);
     r->tex_lo = v->tex_lo;
     r->tex_hi = v->tex_hi;
     r->value_min = v->value_min;
     r->value_max = v->value_max;
     memcpy(r->affine, v->affine, sizeof r->affine);
-    r->volume_bytes = storage == VXL_STORAGE_DENSE ? v->storage_bytes : r->pool_bytes;
     r->has_volume = 1;
     return VXL_OK;
 }

@@ -1,6 +1,10 @@
 /* shader_source.h - GLSL sources: embedded at build time (tools/embed_files.c)
- * or, for shader development, read from a directory. `#include "x"` lines
- * are expanded, each file at most once per program. */
+ * or, for shader development, read from a directory (VOXLIGHT_SHADER_DIR,
+ * vxl_renderer_options.shader_dir: the shaders/ folder). Every name, of a
+ * program and in `#include "x"` lines alike, is a path under shaders/:
+ * "lib/common.glsl" (shared code), "compute/probe.comp", "render/raycast.frag".
+ * Includes are expanded, each file at most once per program: where it is
+ * first named, so a file two users need is not included inside an #if. */
 #ifndef VXL_SHADER_SOURCE_H
 #define VXL_SHADER_SOURCE_H
 

@@ -16,9 +16,16 @@ uint32_t vxl_skip_brick_size(void)
 
 void vxl_skipping_release(vxl_renderer *r)
 {
-    if (r->brick_tex) r->gl.DeleteTextures(1, &r->brick_tex);
-    r->brick_tex = 0;
-    vxl_bricks_free(&r->bricks);
+    if (r->skipping.brick_tex) r->gl.DeleteTextures(1, &r->skipping.brick_tex);
+    r->skipping.brick_tex = 0;
+    vxl_bricks_free(&r->skipping.bricks);
+}
+
+void vxl_skipping_adopt(vxl_renderer *r, vxl_bricks *grid)
+{
+    vxl_bricks_free(&r->skipping.bricks);
+    r->skipping.bricks = *grid;
+    memset(grid, 0, sizeof *grid);
 }
 
 /* One per-brick pass of brick_minmax.comp into out (2 floats per brick):
@@ -26,7 +33,7 @@ void vxl_skipping_release(vxl_renderer *r)
 static int brick_pass(vxl_renderer *r, uint32_t apron, float *out)
 {
     vxl_gl *gl = &r->gl;
-    vxl_bricks *b = &r->bricks;
+    vxl_bricks *b = &r->skipping.bricks;
     GLuint prog;
     int rc = vxl_program_get(r, VXL_PROG_BRICK_MINMAX, 0, apron ? 1 : 0, &prog);
     if (rc) return rc;
@@ -35,12 +42,13 @@ static int brick_pass(vxl_renderer *r, uint32_t apron, float *out)
     gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RG32F, (GLsizei)b->dims[0], (GLsizei)b->dims[1], (GLsizei)b->dims[2], 0, GL_RG,
                    GL_FLOAT, NULL);
     gl->UseProgram(prog);
-    gl->ActiveTexture(GL_TEXTURE0);
-    gl->BindTexture(GL_TEXTURE_3D, r->volume_tex);
-    vxl_uniform_i(r, prog, "u_volume", 0);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_VOLUME_UNIT);
+    const uint32_t *dims;
+    gl->BindTexture(GL_TEXTURE_3D, r->storage.ops->texels(r, &dims));
+    vxl_uniform_i(r, prog, "u_volume", VXL_VOLUME_UNIT);
     vxl_uniform_i(r, prog, "u_brick", (int)b->size);
     if (apron) vxl_uniform_i(r, prog, "u_apron", (int)apron);
-    gl->BindImageTexture(0, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RG32F);
+    gl->BindImageTexture(VXL_IMAGE_OUT, tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RG32F);
     gl->DispatchCompute((b->dims[0] + 3) / 4, (b->dims[1] + 3) / 4, (b->dims[2] + 3) / 4);
     gl->MemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
     gl->BindTexture(GL_TEXTURE_3D, tex);
@@ -52,7 +60,7 @@ static int brick_pass(vxl_renderer *r, uint32_t apron, float *out)
 
 static int build_minmax(vxl_renderer *r)
 {
-    vxl_bricks *b = &r->bricks;
+    vxl_bricks *b = &r->skipping.bricks;
     b->size = vxl_skip_brick_size();
     for (int a = 0; a < 3; a++) b->dims[a] = (r->dims[a] + b->size - 1) / b->size;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
@@ -68,9 +76,9 @@ static int build_minmax(vxl_renderer *r)
  * every brick counts as occupied in iso mode. */
 static int ensure_gradient_bound(vxl_renderer *r, const vxl_frame *f)
 {
-    vxl_bricks *b = &r->bricks;
-    uint32_t need = vxl_bricks_gradient_apron(f);
-    if (f->gopacity != VXL_GOPACITY_ISO || !need || need > b->size || !r->volume_tex ||
+    vxl_bricks *b = &r->skipping.bricks;
+    uint32_t need = vxl_bricks_gradient_apron(f->filter, f->sample_distance);
+    if (f->gopacity != VXL_GOPACITY_ISO || !need || need > b->size || !r->storage.ops->one_texture ||
         (b->gbound && b->gbound_apron >= need))
         return VXL_OK;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
@@ -91,7 +99,7 @@ static int ensure_gradient_bound(vxl_renderer *r, const vxl_frame *f)
 int vxl_skipping_prepare(vxl_renderer *r, const vxl_frame *f)
 {
     vxl_gl *gl = &r->gl;
-    if (!r->bricks.minmax) {
+    if (!r->skipping.bricks.minmax) {
         int rc = build_minmax(r);
         if (rc) {
             vxl_skipping_release(r);
@@ -100,16 +108,16 @@ int vxl_skipping_prepare(vxl_renderer *r, const vxl_frame *f)
     }
     int rc = ensure_gradient_bound(r, f);
     if (rc) return rc;
-    int changed = vxl_bricks_classify(&r->bricks, f);
+    int changed = vxl_bricks_classify(&r->skipping.bricks, vxl_frame_occupancy_rule(f, &(vxl_occupancy_rule){0}));
     if (changed < 0) return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "out of memory for the brick occupancy");
-    if (!r->brick_tex) {
-        r->brick_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
+    if (!r->skipping.brick_tex) {
+        r->skipping.brick_tex = vxl_texture_new(r, GL_TEXTURE_3D, GL_NEAREST);
         changed = 1;
     }
-    gl->ActiveTexture(GL_TEXTURE4);
-    gl->BindTexture(GL_TEXTURE_3D, r->brick_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_DISTANCE_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, r->skipping.brick_tex);
     if (changed)
-        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, (GLsizei)r->bricks.dims[0], (GLsizei)r->bricks.dims[1],
-                       (GLsizei)r->bricks.dims[2], 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, r->bricks.distance);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, (GLsizei)r->skipping.bricks.dims[0], (GLsizei)r->skipping.bricks.dims[1],
+                       (GLsizei)r->skipping.bricks.dims[2], 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE, r->skipping.bricks.distance);
     return VXL_OK;
 }

@@ -1,18 +1,12 @@
-/* transfer.c - built-in transfer functions and the names of presets and
- * filters (the CLI and the Blender add-on use the same names). */
+/* transfer.c - built-in transfer functions (the presets; their names are in
+ * names.c). */
 #include "transfer.h"
 
 #include <math.h>
 #include <string.h>
-#include <strings.h>
 
 #include "error.h"
 #include "voxlight.h"
-
-static const char *const filter_names[VXL_FILTER_COUNT] = {"central", "forward3", "sobel8",
-                                                           "sobel14", "sobel26", "precomputed", "cubic",
-                                                           "cubic-smooth"};
-static const char *const preset_names[VXL_PRESET_COUNT] = {"auto", "gray", "bone", "hot", "mri", "ct"};
 
 static double smoothstep(double a, double b, double x)
 {
@@ -73,36 +67,4 @@ void vxl_preset_window(uint32_t preset, double mn, double mx, double *lo, double
     }
     *lo = mn;
     *hi = mx;
-}
-
-const char *vxl_filter_name(uint32_t f) { return f < VXL_FILTER_COUNT ? filter_names[f] : NULL; }
-const char *vxl_preset_name(uint32_t p) { return p < VXL_PRESET_COUNT ? preset_names[p] : NULL; }
-
-static const char *const storage_names[VXL_STORAGE_COUNT] = {"auto", "dense", "bricked", "sparse", "compressed"};
-const char *vxl_storage_name(uint32_t s) { return s < VXL_STORAGE_COUNT ? storage_names[s] : NULL; }
-
-static int lookup(const char *const *names, uint32_t n, const char *name, uint32_t *out, const char *what)
-{
-    if (!name || !out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "%s name is NULL", what);
-    for (uint32_t i = 0; i < n; i++)
-        if (!strcasecmp(names[i], name)) {
-            *out = i;
-            return VXL_OK;
-        }
-    return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "unknown %s '%.64s'", what, name);
-}
-
-int vxl_filter_from_name(const char *name, uint32_t *out)
-{
-    return lookup(filter_names, VXL_FILTER_COUNT, name, out, "filter");
-}
-
-int vxl_preset_from_name(const char *name, uint32_t *out)
-{
-    return lookup(preset_names, VXL_PRESET_COUNT, name, out, "preset");
-}
-
-int vxl_storage_from_name(const char *name, uint32_t *out)
-{
-    return lookup(storage_names, VXL_STORAGE_COUNT, name, out, "storage");
 }

@@ -6,7 +6,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 
-#include "volume.h"
+#include "loaders.h"
 
 static int has_suffix(const char *s, const char *suffix)
 {

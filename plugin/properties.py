@@ -52,17 +52,53 @@ def _items(names, ui, what):
             for i, n in enumerate(names)]
 
 
-def _library_names(method, fallback):
+def _library_names(kind):
+    """The library's names of enumeration `kind` (vxl_<kind>_name), or the
+    binding's fallback copy when no library loads."""
+    fallback = native.ENUM_FALLBACKS[kind]
     try:
-        return getattr(native.load_library(), method)() or fallback
+        return native.load_library().names(kind) or fallback
     except native.LibraryUnavailable:
         return fallback  # the panels say why; the properties still register
 
 
-FILTER_ITEMS = _items(_library_names("filter_names", native.FILTERS), _FILTER_UI,
-                      "Gradient filter")
-PRESET_ITEMS = _items(_library_names("preset_names", native.PRESETS), _PRESET_UI,
-                      "Transfer-function preset")
+# UI names of the other enumerations the panels offer; like the filters, the
+# identifiers and numbers are the library's (VXL_CLASSIFY_*, VXL_GOPACITY_*,
+# VXL_BACKEND_*, VXL_STORAGE_*).
+_CLASSIFY_UI = {
+    "post": ("Post", "Post: look up each sample's value; sharp, the usual choice"),
+    "pre": ("Pre", "Pre: colour the voxels, then blend between them; softer, blockier edges"),
+    "preint": ("Pre-integrated", "Pre-integrated: exact between samples; for narrow spikes in "
+                                 "the ramp (no slab artefacts)"),
+}
+_GRADIENT_OPACITY_UI = {
+    "off": ("Off", "Opacity from the transfer function only"),
+    "boundary": ("Boundary", "Boundary: only where values change (edges between tissues) stays "
+                             "opaque; uniform regions fade"),
+    "iso": ("Iso-surface", "Iso-surface: a thin shell at one value, like a surface mesh"),
+}
+_BACKEND_UI = {
+    "auto": ("Auto", "EGL on a GPU, then OSMesa, then EGL on Mesa"),
+    "osmesa": ("OSMesa", "Software rendering (llvmpipe)"),
+    "egl": ("EGL", "EGL without a window (GPU or Mesa surfaceless)"),
+}
+_STORAGE_UI = {
+    "auto": ("Auto", "One texture when it fits the texture limit and the budget, else bricked"),
+    "dense": ("Dense", "One 3D texture"),
+    "bricked": ("Bricked", "Bricks in a pool texture; constant bricks cost nothing"),
+    "sparse": ("Sparse", "Only the bricks the transfer function can show; a coarser level when "
+                         "even they exceed the budget"),
+    "compressed": ("Compressed", "Every brick as a palette of up to 256 values and 8-bit codes; "
+                                 "the visible ones decoded into a cache"),
+}
+
+FILTER_ITEMS = _items(_library_names("filter"), _FILTER_UI, "Gradient filter")
+PRESET_ITEMS = _items(_library_names("preset"), _PRESET_UI, "Transfer-function preset")
+CLASSIFY_ITEMS = _items(_library_names("classify"), _CLASSIFY_UI, "Classification")
+GRADIENT_OPACITY_ITEMS = _items(_library_names("gradient_opacity"), _GRADIENT_OPACITY_UI,
+                                "Gradient opacity mode")
+BACKEND_ITEMS = _items(_library_names("backend"), _BACKEND_UI, "Backend")
+STORAGE_ITEMS = _items(_library_names("storage"), _STORAGE_UI, "Storage")
 
 
 def tag_redraw(self=None, context=None):
@@ -182,20 +218,11 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
         name="Classification", default="post", update=tag_redraw,
         description="When the transfer function is applied: to each sample (sharp) or to "
                     "the voxels before sampling (soft)",
-        items=[("post", "Post", "Post: look up each sample's value; sharp, the usual choice", 0),
-               ("pre", "Pre", "Pre: colour the voxels, then blend between them; softer, "
-                              "blockier edges", 1),
-               ("preint", "Pre-integrated", "Pre-integrated: exact between samples; for "
-                                            "narrow spikes in the ramp (no slab artefacts)",
-                2)])
+        items=CLASSIFY_ITEMS)
     gradient_opacity: EnumProperty(
         name="Gradient Opacity", default="off", update=tag_redraw,
         description="Make opacity depend on how fast values change, not only on the value",
-        items=[("off", "Off", "Opacity from the transfer function only", 0),
-               ("boundary", "Boundary", "Boundary: only where values change (edges between "
-                                        "tissues) stays opaque; uniform regions fade", 1),
-               ("iso", "Iso-surface", "Iso-surface: a thin shell at one value, like a "
-                                      "surface mesh", 2)])
+        items=GRADIENT_OPACITY_ITEMS)
     gradient_ref: FloatProperty(name="Gradient Reference", default=0.05, min=0.0001,
                                 soft_max=1.0, update=tag_redraw,
                                 description="How sharp an edge must be for full opacity "
@@ -241,11 +268,6 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                                          "sharper, like a glossier surface")
 
 
-BACKEND_ITEMS = [("auto", "Auto", "EGL on a GPU, then OSMesa, then EGL on Mesa"),
-                 ("osmesa", "OSMesa", "Software rendering (llvmpipe)"),
-                 ("egl", "EGL", "EGL without a window (GPU or Mesa surfaceless)")]
-
-
 class VoxlightSceneProperties(bpy.types.PropertyGroup):
     viewport_enabled: BoolProperty(name="Show in Viewport", default=True, update=tag_redraw,
                                    description="Draw Voxlight volumes in the 3D viewports")
@@ -278,16 +300,7 @@ class VoxlightSceneProperties(bpy.types.PropertyGroup):
     backend: EnumProperty(name="Backend", items=BACKEND_ITEMS, default="auto",
                           description="How the library reaches OpenGL; Auto picks the GPU when "
                                       "there is one (volumes loaded later use it)")
-    storage: EnumProperty(name="Storage", default="auto",
-                          items=[("auto", "Auto", "One texture when it fits the texture limit and "
-                                  "the budget, else bricked"),
-                                 ("dense", "Dense", "One 3D texture"),
-                                 ("bricked", "Bricked", "Bricks in a pool texture; constant bricks "
-                                  "cost nothing"),
-                                 ("sparse", "Sparse", "Only the bricks the transfer function can "
-                                  "show; a coarser level when even they exceed the budget"),
-                                 ("compressed", "Compressed", "Every brick as a palette of up to 256 "
-                                  "values and 8-bit codes; the visible ones decoded into a cache")],
+    storage: EnumProperty(name="Storage", default="auto", items=STORAGE_ITEMS,
                           description="How volumes are held on the GPU (volumes reload when "
                                       "this changes)")
     memory_budget_mib: IntProperty(name="Memory Budget (MiB)", default=2048, min=1,

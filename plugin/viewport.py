@@ -7,6 +7,9 @@ Per region and volume, on every redraw:
   2. Read the depth of the bound framebuffer (the scene's depth at
      POST_VIEW), convert it to planar view distance and reduce it to what
      can change the image (depth.for_library): rays stop at geometry.
+     The per-pixel maths runs only inside the volume's screen footprint
+     and is cached by the depth's contents (crc32), so the redraws of a
+     still view (refine steps arriving, hover) do not redo it.
   3. Build the render parameters and hash them (native.params_digest: every
      struct field, the scene depth's contents and the volume's identity).
      Equal hash = the image on screen is still right: nothing is rendered.
@@ -29,9 +32,13 @@ Per region and volume, on every redraw:
      Where the volume has no hit the fragment gets the scene's own depth,
      so its colour (in front of that geometry, since the rays stopped
      there) always blends.
+
+VOXLIGHT_PROFILE=1 in the environment prints where each draw's time goes
+(_Profile).
 """
 
 import collections
+import os
 import time
 import zlib
 
@@ -57,20 +64,90 @@ draw_count = 0        # draw handler calls
 culled_count = 0      # volumes skipped because they were outside the frustum
 # (seconds in the handler, view moving, a refined frame in flight at its start)
 draw_log = collections.deque(maxlen=256)
+# Each newly shown image: (object name, "preview" | "half" | "full", scale,
+# width, height); the refinement steps the artist saw, in order.
+shown_log = collections.deque(maxlen=256)
+
+
+class _Profile:
+    """VOXLIGHT_PROFILE=1 in the environment: where one viewport draw's
+    time goes. Each step is timed from the previous mark to its own
+    (time.perf_counter) and summed per name; every draw prints one line
+
+        voxlight profile: t=<perf_counter> handler 0.31 s [moving] setup 0.001
+            ... gl_sync 0.20 glreadpixels 0.01 ... render 0.09 ... | blender scene 0.5
+            overlays 0.001 | rendered 119x98 (rect ...) in 0.09 s ...; preview 119x98 scale 0.112
+
+    "gl_sync" is the wait for the GL work Blender queued for this redraw
+    (its own scene), which the depth read has to wait for; "blender scene"
+    is Blender's own drawing between the region's PRE_VIEW and this
+    POST_VIEW handler, "overlays" what follows it up to POST_PIXEL. Off
+    (the default) a mark costs one attribute test."""
+
+    def __init__(self, enabled):
+        self.enabled = enabled
+        self.steps = {}
+        self.notes = []
+        self._t = 0.0
+        self._pre_view = None   # perf_counter at this region's PRE_VIEW
+        self._handler_end = None
+        self._line = None       # the handler's part, printed at POST_PIXEL
+
+    def begin(self):
+        self.steps, self.notes = {}, []
+        self._t = time.perf_counter()
+
+    def mark(self, step):
+        if self.enabled:
+            t = time.perf_counter()
+            self.steps[step] = self.steps.get(step, 0.0) + (t - self._t)
+            self._t = t
+
+    def note(self, text):
+        if self.enabled:
+            self.notes.append(text)
+
+    def end(self, seconds, moving):
+        if not self.enabled:
+            return
+        self._handler_end = time.perf_counter()
+        scene_s = "" if self._pre_view is None else " | blender scene %.4f" % (
+            self._handler_end - seconds - self._pre_view)
+        self._line = "voxlight profile: t=%.3f handler %.4f s%s %s%s" % (
+            self._handler_end, seconds, " [moving]" if moving else "",
+            " ".join("%s %.4f" % kv for kv in self.steps.items()), scene_s)
+
+    def pre_view(self):
+        self._pre_view = time.perf_counter()
+
+    def post_pixel(self):
+        if self._line is None:
+            return
+        tail = " overlays %.4f" % (time.perf_counter() - self._handler_end)
+        notes = (" | " + "; ".join(self.notes)) if self.notes else ""
+        print(self._line + tail + notes, flush=True)
+        self._line = self._pre_view = None
+
+
+_profile = _Profile(os.environ.get("VOXLIGHT_PROFILE", "") not in ("", "0"))
+_profile_handles = []
 
 
 class _Image:
     """One rendered frame, uploaded: GPUTextures must outlive the draw call
     that samples them, so they live here until replaced."""
 
-    def __init__(self, key, rgba, vdepth, win_small, proj, full, scale=1.0):
+    def __init__(self, key, rgba, vdepth, win_small, proj, full, scale=1.0, rect=None):
         self.key = key
         self.full = full
         self.scale = scale
         self.height, self.width = rgba.shape[:2]
         self.vdepth = vdepth
         self.proj = proj
+        self.rect = rect   # the rendered pixels; outside them vdepth is +inf
+        _profile.mark("result")
         self.color = _texture(rgba, "RGBA32F")
+        _profile.mark("color_texture")
         self.depth = None
         self.depth_crc = None
         self.update_depth(win_small)
@@ -80,14 +157,15 @@ class _Image:
         now on screen. Cheap (no library call); redone only when the scene
         depth at this resolution changed, e.g. by less than the quantum of
         the frame key."""
-        crc = zlib.crc32(win_small.tobytes()) if win_small is not None else None
+        crc = _crc(win_small) if win_small is not None else None
         if crc == self.depth_crc and self.depth is not None:
+            _profile.mark("depth_check")
             return
-        frag = _depth.planar_to_window(self.vdepth, self.proj)
-        if win_small is not None:
-            frag = np.where(np.isfinite(self.vdepth), np.minimum(frag, win_small), win_small)
+        frag = _fragment_depth(self.vdepth, self.proj, win_small, self.rect)
+        _profile.mark("fragment_depth")
         self.depth = _texture(frag, "R32F")
         self.depth_crc = crc
+        _profile.mark("depth_texture")
 
 
 class _State:
@@ -141,9 +219,18 @@ def _get_shader():
     return _shader, _batch
 
 
+WindowDepth = collections.namedtuple("WindowDepth", "pixels crc")  # what _read_window_depth read
+
+
 def _read_window_depth(width, height):
-    """The bound framebuffer's depth (window depth 0..1) as a (height,
-    width) array, row 0 = bottom.
+    """The bound framebuffer's depth (window depth 0..1) as a WindowDepth:
+    a (height, width) array, row 0 = bottom, and the crc32 of its bytes
+    (what the frames' depth conversions are cached by); None without a
+    depth attachment.
+
+    The read waits for the GL work Blender queued for this redraw (its own
+    scene): with VOXLIGHT_PROFILE=1 a one-pixel read first times that wait
+    apart ("gl_sync") from the read itself ("glreadpixels").
 
     Read into a one-dimensional Buffer on purpose: Blender 3.4's
     gpu.types.Buffer exports multi-dimensional shapes to the buffer
@@ -153,12 +240,82 @@ def _read_window_depth(width, height):
     came out as vertical stripes. A flat Buffer has one stride and no
     ambiguity."""
     buf = gpu.types.Buffer("FLOAT", width * height)
+    _profile.mark("depth_alloc")
     try:
         fb = gpu.state.active_framebuffer_get()
+        if _profile.enabled:  # wait for Blender's queued GL work, timed on its own
+            fb.read_depth(0, 0, 1, 1)
+            _profile.mark("gl_sync")
         fb.read_depth(0, 0, width, height, data=buf)
     except Exception:  # no depth attachment: draw without occlusion input
         return None
-    return np.asarray(buf, dtype=np.float32).reshape(height, width)
+    _profile.mark("glreadpixels")
+    pixels = np.asarray(buf, dtype=np.float32).reshape(height, width)
+    window = WindowDepth(pixels, _crc(pixels))
+    _profile.mark("depth_numpy_crc")
+    return window
+
+
+def _crc(arr):
+    """crc32 of an array's bytes, without copying a contiguous one."""
+    return zlib.crc32(np.ascontiguousarray(arr))
+
+
+def _library_depth(win_small, proj, near, far, quantum, rect):
+    """The scene depth the library is given (depth.for_library of the
+    planar depth), computed in the footprint `rect` only: for_library sets
+    every pixel outside it to +inf, and both steps work pixel by pixel, so
+    the result equals the whole image's at a fraction of the work."""
+    if rect is None:
+        return _depth.for_library(_depth.window_to_planar(win_small, proj), near, far, quantum)
+    x0, y0, x1, y1 = rect
+    out = np.full(win_small.shape, np.inf, np.float32)
+    out[y0:y1, x0:x1] = _depth.for_library(
+        _depth.window_to_planar(win_small[y0:y1, x0:x1], proj), near, far, quantum)
+    return out
+
+
+def _fragment_depth(vdepth, proj, win_small, rect):
+    """Window depth written by the volume's quad: the volume's hit depth
+    where its rays hit (never behind the scene), the scene's own depth
+    elsewhere (1 without one). Outside `rect` a frame has no hit
+    (render_tiled leaves +inf there), so only the footprint is computed;
+    the result equals the whole image's."""
+    def compute(vd, win):
+        frag = _depth.planar_to_window(vd, proj)
+        if win is not None:
+            frag = np.where(np.isfinite(vd), np.minimum(frag, win), win)
+        return frag
+    if rect is None:
+        return compute(vdepth, win_small)
+    x0, y0, x1, y1 = rect
+    out = (np.array(win_small, np.float32) if win_small is not None
+           else np.ones(vdepth.shape, np.float32))
+    out[y0:y1, x0:x1] = compute(vdepth[y0:y1, x0:x1],
+                                None if win_small is None else win_small[y0:y1, x0:x1])
+    return out
+
+
+# Scene depth converted for the library, per frame size and footprint,
+# keyed by the window depth's contents: a still view redraws (hover,
+# refine steps arriving) reuse it instead of redoing the per-pixel maths.
+_DEPTH_CACHE_SIZE = 6
+_depth_cache = collections.OrderedDict()
+
+
+def _scene_depth(window, w, h, proj, near, far, quantum, rect):
+    """(window depth at w x h, the library's scene depth) of a frame."""
+    key = (window.crc, window.pixels.shape, w, h, proj.tobytes(), near, far, quantum, rect)
+    hit = _depth_cache.get(key)
+    if hit is not None:
+        _depth_cache.move_to_end(key)
+        return hit
+    win_small = _depth.downsample(window.pixels, w, h)
+    hit = (win_small, _library_depth(win_small, proj, near, far, quantum, rect))
+    _depth_cache[key] = hit
+    while len(_depth_cache) > _DEPTH_CACHE_SIZE:
+        _depth_cache.popitem(last=False)
+    return hit
 
 
 def _texture(arr, fmt):
@@ -245,31 +402,34 @@ def busy():
 class _Frame:
     """Everything one render of one volume at one size needs, and its key."""
 
-    def __init__(self, ob, entry, w, h, view, proj, model, raw_depth, lights, fast, scale=1.0):
+    def __init__(self, ob, entry, w, h, view, proj, model, window_depth, lights, fast, scale=1.0):
         self.w, self.h = w, h
         self.scale = scale
         dims = tuple(ob.voxlight.dims)
+        _profile.mark("frame_setup")
         self.rect = volume_space.screen_rect(model, dims, view, proj, w, h)
         self.win_small = None
         scene_depth = None
-        if raw_depth is not None:
-            self.win_small = _depth.downsample(raw_depth, w, h)
+        if window_depth is not None:
             near, far = volume_space.planar_range(model, dims, view)
             quantum = 0.125 * volume_space.voxel_size(model)
-            scene_depth = _depth.for_library(_depth.window_to_planar(self.win_small, proj),
-                                             near, far, quantum, self.rect)
+            self.win_small, scene_depth = _scene_depth(window_depth, w, h, proj, near, far,
+                                                       quantum, self.rect)
+        _profile.mark("scene_depth")
         self.params = params.build(ob, w, h, view, proj, scene_depth=scene_depth,
                                    lights=lights, fast=fast)
+        _profile.mark("params")
         self.key = native.params_digest(self.params, entry.identity)
+        _profile.mark("digest")
 
 
 def _size(W, H, frac):
     return max(1, round(W * frac)), max(1, round(H * frac))
 
 
-def _frame_at(scale, ob, entry, W, H, view, proj, model, raw_depth, lights, fast):
+def _frame_at(scale, ob, entry, W, H, view, proj, model, window_depth, lights, fast):
     w, h = _size(W, H, scale)
-    return _Frame(ob, entry, w, h, view, proj, model, raw_depth, lights, fast, scale)
+    return _Frame(ob, entry, w, h, view, proj, model, window_depth, lights, fast, scale)
 
 
 def _rect_pixels(rect):
@@ -293,6 +453,11 @@ def _draw_image(img, shader, batch):
     gpu.state.depth_test_set("NONE")
 
 
+def _kind(st, img):
+    """Which refinement step an image of `st` is (shown_log, profile)."""
+    return "full" if img.full else "half" if img is st.half else "preview"
+
+
 def _report(e):
     global last_error
     if last_error != str(e):
@@ -303,6 +468,8 @@ def _report(e):
 def _draw():
     global draw_count, culled_count, last_error
     t_draw = time.perf_counter()
+    if _profile.enabled:
+        _profile.begin()
     draw_count += 1
     in_flight = busy()
     ctx = bpy.context
@@ -329,7 +496,7 @@ def _draw():
         depsgraph = ctx.evaluated_depsgraph_get()
         now = time.monotonic()
         view_key = (view.tobytes(), proj.tobytes(), W, H)
-        raw_depth = None
+        window_depth = None
         depth_read = False
         lights = None
         shader, batch = _get_shader()
@@ -352,18 +519,22 @@ def _draw():
                 st.view_key = view_key
             moving = (now - st.moved_at) < s.settle_time
             moving_any |= moving
+            _profile.mark("setup")
             try:
                 entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
                                           scene.frame_current, **runtime.options_of(s))
             except native.VoxlightError as e:
                 _report(e)
                 continue
+            _profile.mark("entry")
             if not depth_read:
-                raw_depth = _read_window_depth(W, H)
+                window_depth = _read_window_depth(W, H)
                 depth_read = True
+                _profile.mark("depth_read")
                 lights = params.scene_lights(scene, depsgraph)
+                _profile.mark("lights")
             try:
-                shown = _update(st, ob, entry, W, H, view, proj, model, raw_depth, lights,
+                shown = _update(st, ob, entry, W, H, view, proj, model, window_depth, lights,
                                 moving, key)
             except native.VoxlightError as e:
                 _report(e)
@@ -371,8 +542,16 @@ def _draw():
             last_error = ""
             if moving:
                 _schedule_refine(s.settle_time - (now - st.moved_at) + 0.01)
+            if shown is not None and shown is not st.shown:
+                shown_log.append((obj.name, _kind(st, shown), shown.scale, shown.width,
+                                  shown.height))
             st.shown = shown
+            _profile.mark("update")
             _draw_image(shown, shader, batch)
+            _profile.mark("gpu_draw")
+            if shown is not None:
+                _profile.note("%s %dx%d scale %.3f" % (_kind(st, shown), shown.width, shown.height,
+                                                       shown.scale))
 
     # Volumes of this region that were not drawn (hidden, culled, deleted)
     # must not keep a worker busy.
@@ -383,15 +562,19 @@ def _draw():
         now = time.monotonic()
         for k in [k for k, v in _states.items() if now - v.used_at > 60.0]:
             _states.pop(k).cancel_job()
-    draw_log.append((time.perf_counter() - t_draw, moving_any, in_flight))
+    seconds = time.perf_counter() - t_draw
+    draw_log.append((seconds, moving_any, in_flight))
+    if _profile.enabled:
+        _profile.mark("bookkeeping")
+        _profile.end(seconds, moving_any)
 
 
-def _update(st, ob, entry, W, H, view, proj, model, raw_depth, lights, moving, owner):
+def _update(st, ob, entry, W, H, view, proj, model, window_depth, lights, moving, owner):
     """Decide what to show for one volume; render only what is missing."""
     s = bpy.context.scene.voxlight
     if st.policy is None:
         st.policy = resolution_policy.ScalePolicy(s.interactive_resolution)
-    args = (ob, entry, W, H, view, proj, model, raw_depth, lights)
+    args = (ob, entry, W, H, view, proj, model, window_depth, lights)
     if not moving:
         decided, shown = _refine_still(st, s, args, owner)
         if decided:
@@ -408,33 +591,43 @@ def _refine_still(st, s, args, owner):
     (False, None) to show the preview."""
     preview_scale = st.fast.scale if st.fast is not None else st.policy.scale
     steps = resolution_policy.refine_scales(preview_scale, s.viewport_resolution)
-    frames = [_frame_at(sc, *args, fast=False) for sc in steps]
-    full = frames[-1]
+    full = _frame_at(steps[-1], *args, fast=False)
+    built = {}
+
+    def half_frame():
+        """The half-resolution step (None when there is none), built only
+        when needed: not on the redraws of a view whose full frame shows."""
+        if len(steps) < 2:
+            return None
+        if "half" not in built:
+            built["half"] = _frame_at(steps[0], *args, fast=False)
+        return built["half"]
+
     job = st.job
+    fr = None
     if job is not None and job.done:
-        for fr in frames:
-            if job.key != fr.key:
-                continue
-            if job.result is not None:
-                rgba, vdepth, _stats = job.result
-                img = _Image(fr.key, rgba, vdepth, fr.win_small, args[5], fr is full, fr.scale)
-                st.job = None
-                if fr is full:
-                    st.full = img
-                    _tag_properties()  # the Statistics panel shows this final frame, not the preview
-                else:
-                    st.half = img
-            elif job.error is not None:
-                st.job = None
-                st.error_key = fr.key
-                raise native.VoxlightError(str(job.error))
+        fr = full if job.key == full.key else half_frame()
+    if fr is not None and job.key == fr.key:
+        if job.result is not None:
+            rgba, vdepth, _stats = job.result
+            img = _Image(fr.key, rgba, vdepth, fr.win_small, args[5], fr is full, fr.scale, fr.rect)
+            st.job = None
+            if fr is full:
+                st.full = img
+                _tag_properties()  # the Statistics panel shows this final frame, not the preview
+            else:
+                st.half = img
+        elif job.error is not None:
+            st.job = None
+            st.error_key = fr.key
+            raise native.VoxlightError(str(job.error))
     if st.full is not None and st.full.key == full.key:
         st.full.update_depth(full.win_small)
         st.cancel_job()
         return True, st.full
-    if st.error_key in [fr.key for fr in frames] or full.rect is None:
+    half = half_frame()
+    if st.error_key in [fr.key for fr in (full, half) if fr is not None] or full.rect is None:
         return True, None  # failed with exactly these inputs, or nothing on screen
-    half = frames[0] if len(frames) > 1 else None
     have_half = half is not None and st.half is not None and st.half.key == half.key
     step = full if half is None or have_half else half
     if st.job is None or st.job.key != step.key or (st.job.done and st.job.result is None):
@@ -462,16 +655,20 @@ def _preview(st, s, args):
         fast = _frame_at(scale, *args, fast=True)
     if fast.rect is None or st.error_key == fast.key:
         return None  # off screen, or failed with exactly these inputs: no retry per redraw
+    _profile.mark("policy")
     t = time.perf_counter()
     try:
-        rgba, vdepth, _stats = runtime.render_rect(args[1], fast.params, fast.rect)
+        rgba, vdepth, stats = runtime.render_rect(args[1], fast.params, fast.rect)
     except native.VoxlightError:
         st.error_key = fast.key
         raise
+    _profile.mark("render")
+    _profile.note("rendered %dx%d (rect %s) in %.4f s, library calls %.4f s" % (
+        fast.w, fast.h, fast.rect, time.perf_counter() - t, stats.get("seconds", 0.0)))
     pixels = _rect_pixels(fast.rect)
     st.policy.observe(time.perf_counter() - t, pixels)
     st.pixels_at_scale_1 = pixels / (fast.scale * fast.scale)
-    st.fast = _Image(fast.key, rgba, vdepth, fast.win_small, args[5], False, fast.scale)
+    st.fast = _Image(fast.key, rgba, vdepth, fast.win_small, args[5], False, fast.scale, fast.rect)
     return st.fast
 
 
@@ -479,6 +676,7 @@ def _forget_all():
     for st in _states.values():
         st.cancel_job()
     _states.clear()
+    _depth_cache.clear()
 
 
 @persistent
@@ -492,6 +690,10 @@ def register():
     global _handle
     if _handle is None:
         _handle = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
+        if _profile.enabled:
+            _profile_handles.extend([
+                ("WINDOW", bpy.types.SpaceView3D.draw_handler_add(_profile.pre_view, (), "WINDOW", "PRE_VIEW")),
+                ("WINDOW", bpy.types.SpaceView3D.draw_handler_add(_profile.post_pixel, (), "WINDOW", "POST_PIXEL"))])
     if _on_load_pre not in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.append(_on_load_pre)
 
@@ -501,6 +703,9 @@ def unregister():
     if _handle is not None:
         bpy.types.SpaceView3D.draw_handler_remove(_handle, "WINDOW")
         _handle = None
+    while _profile_handles:
+        region_type, h = _profile_handles.pop()
+        bpy.types.SpaceView3D.draw_handler_remove(h, region_type)
     for fn in (_refine, _poll):
         if bpy.app.timers.is_registered(fn):
             bpy.app.timers.unregister(fn)

@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "voxlight.h"
+#include "voxlight_dev.h"
 
 /* ------------------------------------------------------------ environment */
 

@@ -1,9 +1,14 @@
 /* test_api.c - the public API's contract: error codes and messages, limits,
- * defaults, NULL handling, backend selection. */
+ * defaults, NULL handling, backend selection, the names of the enumerations
+ * and the struct_size promise for callers built against older headers. */
+#include <stddef.h>
 #include <stdio.h>
+#include <unistd.h>
 
 #include "harness.h"
+#include "nifti_writer.h"
 #include "test_util.h"
+#include "voxlight_dev.h" /* the gradient probe, to check it honours struct_size too */
 
 TEST(abi_and_names)
 {
@@ -178,7 +183,7 @@ TEST(renderer_budget_and_defaults)
     /* a zero-initialised options struct and NULL both mean defaults */
     r = NULL;
     CHECK(vxl_renderer_create(NULL, &r) == VXL_OK && r);
-    vxl_renderer_info info;
+    vxl_renderer_info info = {.struct_size = sizeof info};
     CHECK(vxl_renderer_get_info(r, &info) == VXL_OK && info.max_3d_texture_size >= 256);
     vxl_renderer_destroy(r);
 }
@@ -240,9 +245,220 @@ TEST(shader_dir_override_loads_from_disk)
     vxl_renderer_destroy(r);
 }
 
+typedef struct enum_names {
+    const char *what;
+    const char *(*name)(uint32_t);
+    int (*from_name)(const char *, uint32_t *);
+    uint32_t count;
+} enum_names;
+
+/* Every enumeration the CLI and the add-on list has its names in the
+ * library: distinct, round-tripping (case-insensitively), NULL at *_COUNT,
+ * and an unknown name is an error naming it. */
+TEST(every_enumeration_has_names)
+{
+    static const enum_names all[] = {
+        {"filter", vxl_filter_name, vxl_filter_from_name, VXL_FILTER_COUNT},
+        {"preset", vxl_preset_name, vxl_preset_from_name, VXL_PRESET_COUNT},
+        {"storage", vxl_storage_name, vxl_storage_from_name, VXL_STORAGE_COUNT},
+        {"classify", vxl_classify_name, vxl_classify_from_name, VXL_CLASSIFY_COUNT},
+        {"gradient opacity", vxl_gradient_opacity_name, vxl_gradient_opacity_from_name, VXL_GOPACITY_COUNT},
+        {"gradient store", vxl_gradient_store_name, vxl_gradient_store_from_name, VXL_GRADIENT_STORE_COUNT},
+        {"backend", vxl_backend_name, vxl_backend_from_name, VXL_BACKEND_COUNT},
+    };
+    for (size_t e = 0; e < sizeof all / sizeof *all; e++) {
+        const enum_names *E = &all[e];
+        for (uint32_t i = 0; i < E->count; i++) {
+            const char *n = E->name(i);
+            CHECKF(n && *n, "%s %u has no name", E->what, i);
+            if (!n) continue;
+            char upper[64];
+            size_t len = strlen(n);
+            REQUIRE(len < sizeof upper);
+            for (size_t c = 0; c <= len; c++) upper[c] = (char)(n[c] >= 'a' && n[c] <= 'z' ? n[c] - 32 : n[c]);
+            uint32_t back = 999, back_upper = 999;
+            CHECKF(E->from_name(n, &back) == VXL_OK && back == i, "%s '%s' -> %u", E->what, n, back);
+            CHECKF(E->from_name(upper, &back_upper) == VXL_OK && back_upper == i, "%s '%s'", E->what, upper);
+            for (uint32_t j = 0; j < i; j++) CHECKF(strcmp(E->name(j), n) != 0, "%s %u and %u share '%s'", E->what, j, i, n);
+        }
+        CHECKF(E->name(E->count) == NULL, "%s past the last value has a name", E->what);
+        uint32_t v = 7;
+        CHECK(E->from_name("no-such-name", &v) == VXL_ERR_INVALID_ARGUMENT && v == 7);
+        CHECKF(strstr(vxl_last_error(), "no-such-name") != NULL, "%s: %s", E->what, vxl_last_error());
+        CHECK(E->from_name(NULL, &v) == VXL_ERR_INVALID_ARGUMENT);
+        CHECK(E->from_name(E->name(0), NULL) == VXL_ERR_INVALID_ARGUMENT);
+    }
+    /* the tables follow the header's numbers */
+    uint32_t v;
+    CHECK(vxl_classify_from_name("preint", &v) == VXL_OK && v == VXL_CLASSIFY_PREINT);
+    CHECK(vxl_gradient_opacity_from_name("iso", &v) == VXL_OK && v == VXL_GOPACITY_ISO);
+    CHECK(vxl_gradient_store_from_name("16f", &v) == VXL_OK && v == VXL_GRADIENT_STORE_16F);
+    CHECK(vxl_backend_from_name("osmesa", &v) == VXL_OK && v == VXL_BACKEND_OSMESA);
+    CHECK(vxl_storage_from_name("compressed", &v) == VXL_OK && v == VXL_STORAGE_COMPRESSED);
+    CHECK(vxl_dtype_name(0) == NULL && vxl_dtype_name(VXL_DTYPE_COUNT) == NULL);
+    CHECK(!strcmp(vxl_dtype_name(VXL_DTYPE_U8), "uint8") && !strcmp(vxl_dtype_name(VXL_DTYPE_I16), "int16") &&
+          !strcmp(vxl_dtype_name(VXL_DTYPE_F64), "float64"));
+}
+
+/* ---- the struct_size promise: older, shorter structs ----
+ * Each test gives a struct the size an older release had, inside a buffer
+ * whose bytes past it hold values the library would refuse (or notice): a
+ * library that read them fails. The same struct also goes in a heap block
+ * of exactly the old size, where the ASan build reports any read past it. */
+
+/* vxl_render_params before its reserved room grew: up to reserved[0]. */
+#define OLD_RENDER_PARAMS_SIZE (offsetof(vxl_render_params, reserved) + sizeof(uint32_t))
+
+static vxl_render_params *heap_copy(const void *src, size_t size)
+{
+    void *p = malloc(size);
+    if (p) memcpy(p, src, size);
+    return p;
+}
+
+TEST(old_render_params_are_read_up_to_their_size)
+{
+    vxl_renderer *r = make_renderer(software_backend());
+    REQUIRE(r);
+    double prm[4] = {0.5, 0.5, 0.5, 0.35};
+    vxl_volume *v = make_volume_f32(16, 16, 16, field_ball, prm);
+    REQUIRE(v && vxl_renderer_set_volume(r, v) == VXL_OK);
+    vxl_volume_destroy(v);
+    enum { W = 24, H = 20 };
+    static float want[W * H * 4], got[W * H * 4];
+    vxl_render_params p = default_params(W, H);
+    p.azimuth_deg = 30;
+    REQUIRE(vxl_render(r, &p, want, NULL) == VXL_OK);
+    float view[16], proj[16], view_old[16], proj_old[16];
+    REQUIRE(vxl_default_camera(r, &p, view, proj) == VXL_OK);
+    const float point[3] = {7.5f, 7.0f, 8.0f};
+    float grad[3], grad_old[3];
+    REQUIRE(vxl_probe_gradients(r, &p, point, 1, grad) == VXL_OK);
+
+    vxl_render_params old = p;
+    old.struct_size = (uint32_t)OLD_RENDER_PARAMS_SIZE;
+    for (uint32_t i = 1; i < VXL_RENDER_PARAMS_RESERVED; i++) old.reserved[i] = 0xA5A5A5A5u;
+    CHECKF(vxl_render(r, &old, got, NULL) == VXL_OK, "%s", vxl_renderer_error(r));
+    CHECK(memcmp(want, got, sizeof want) == 0);
+    CHECK(vxl_default_camera(r, &old, view_old, proj_old) == VXL_OK);
+    CHECK(!memcmp(view, view_old, sizeof view) && !memcmp(proj, proj_old, sizeof proj));
+    CHECK(vxl_probe_gradients(r, &old, point, 1, grad_old) == VXL_OK && !memcmp(grad, grad_old, sizeof grad));
+    /* the same bytes as today's struct: the reserved words are refused */
+    old.struct_size = sizeof old;
+    CHECK(vxl_render(r, &old, got, NULL) == VXL_ERR_INVALID_ARGUMENT);
+    CHECKF(strstr(vxl_renderer_error(r), "reserved[1]") != NULL, "message: %s", vxl_renderer_error(r));
+    CHECK(vxl_default_camera(r, &old, view_old, proj_old) == VXL_ERR_INVALID_ARGUMENT);
+    CHECK(vxl_probe_gradients(r, &old, point, 1, grad_old) == VXL_ERR_INVALID_ARGUMENT);
+
+    vxl_render_params *heap = heap_copy(&p, OLD_RENDER_PARAMS_SIZE);
+    REQUIRE(heap);
+    heap->struct_size = (uint32_t)OLD_RENDER_PARAMS_SIZE;
+    memset(got, 0, sizeof got);
+    CHECK(vxl_render(r, heap, got, NULL) == VXL_OK && memcmp(want, got, sizeof want) == 0);
+    CHECK(vxl_default_camera(r, heap, view_old, proj_old) == VXL_OK && !memcmp(view, view_old, sizeof view));
+    CHECK(vxl_probe_gradients(r, heap, point, 1, grad_old) == VXL_OK && !memcmp(grad, grad_old, sizeof grad));
+    free(heap);
+    vxl_renderer_destroy(r);
+}
+
+/* vxl_renderer_options of ABI 1's first release ended at shader_dir. */
+TEST(old_renderer_options_get_the_defaults)
+{
+    const size_t old_size = offsetof(vxl_renderer_options, storage);
+    vxl_renderer_options o = {.struct_size = (uint32_t)old_size, .backend = software_backend(), .storage = 99};
+    vxl_renderer *r = NULL;
+    CHECKF(vxl_renderer_create(&o, &r) == VXL_OK, "%s", vxl_last_error());
+    double prm[4] = {0.1, 0, 0, 0};
+    vxl_volume *v = make_volume_f32(8, 8, 8, field_ramp, prm);
+    REQUIRE(v);
+    if (r) {
+        CHECK(vxl_renderer_set_volume(r, v) == VXL_OK);
+        static float img[8 * 8 * 4];
+        vxl_render_params p = default_params(8, 8);
+        CHECK(vxl_render(r, &p, img, NULL) == VXL_OK);
+        vxl_render_stats st = {.struct_size = sizeof st};
+        CHECK(vxl_renderer_get_stats(r, &st) == VXL_OK && st.storage == VXL_STORAGE_DENSE);
+    }
+    vxl_renderer_destroy(r);
+    o.struct_size = sizeof o; /* today's size: the same storage value is refused */
+    r = NULL;
+    CHECK(vxl_renderer_create(&o, &r) == VXL_ERR_INVALID_ARGUMENT && r == NULL);
+    vxl_renderer_options *heap = (vxl_renderer_options *)heap_copy(&o, old_size);
+    REQUIRE(heap);
+    heap->struct_size = (uint32_t)old_size;
+    CHECK(vxl_renderer_create(heap, &r) == VXL_OK && r);
+    free(heap);
+    vxl_renderer_destroy(r);
+    vxl_volume_destroy(v);
+}
+
+/* vxl_load_options of ABI 1's first release ended at memory_budget_bytes;
+ * voxel_size, frame and series came later. */
+TEST(old_load_options_get_the_defaults)
+{
+    char path[256];
+    const char *dir = getenv("TMPDIR");
+    snprintf(path, sizeof path, "%s/vxl_test_api_%d.nii", dir && *dir ? dir : "/tmp", (int)getpid());
+    tnw_header h;
+    tnw_init(&h, 1, 16, 4, 3, 2); /* float32 */
+    float data[4 * 3 * 2];
+    for (int i = 0; i < 24; i++) data[i] = (float)i;
+    REQUIRE(tnw_write(path, &h, data, sizeof data) == 0);
+    const size_t old_size = offsetof(vxl_load_options, voxel_size);
+    vxl_load_options o = {.struct_size = (uint32_t)old_size, .frame = 5};
+    vxl_volume *v = NULL;
+    CHECKF(vxl_volume_load(path, &o, &v) == VXL_OK, "%s", vxl_last_error());
+    vxl_volume_info info = {.struct_size = sizeof info};
+    CHECK(v && vxl_volume_get_info(v, &info) == VXL_OK && info.frame == 0 && info.frame_count == 1);
+    vxl_volume_destroy(v);
+    v = NULL;
+    o.struct_size = sizeof o; /* today's size: frame 5 of a 3D file is an error */
+    CHECK(vxl_volume_load(path, &o, &v) != VXL_OK && v == NULL);
+    vxl_load_options *heap = (vxl_load_options *)heap_copy(&o, old_size);
+    REQUIRE(heap);
+    heap->struct_size = (uint32_t)old_size;
+    CHECK(vxl_volume_load(path, heap, &v) == VXL_OK && v);
+    free(heap);
+    vxl_volume_destroy(v);
+    remove(path);
+}
+
+/* Output structs: an older caller's shorter struct is written only up to
+ * its struct_size; the bytes after it keep the caller's sentinel. */
+TEST(old_output_structs_are_written_up_to_their_size)
+{
+    double prm[4] = {0.1, 0, 0, 0};
+    vxl_volume *v = make_volume_f32(8, 8, 8, field_ramp, prm);
+    REQUIRE(v);
+    vxl_volume_info vi;
+    memset(&vi, 0xEE, sizeof vi);
+    vi.struct_size = (uint32_t)offsetof(vxl_volume_info, frame_count); /* before 4D inputs */
+    CHECK(vxl_volume_get_info(v, &vi) == VXL_OK && vi.dims[0] == 8 && vi.frame_count == 0xEEEEEEEEu);
+
+    vxl_renderer *r = make_renderer(software_backend());
+    REQUIRE(r);
+    CHECK(vxl_renderer_set_volume(r, v) == VXL_OK);
+    vxl_volume_destroy(v);
+    vxl_renderer_info ri;
+    memset(&ri, 0xEE, sizeof ri);
+    ri.struct_size = (uint32_t)offsetof(vxl_renderer_info, gl_renderer);
+    CHECK(vxl_renderer_get_info(r, &ri) == VXL_OK && ri.backend_name[0] != (char)0xEE);
+    CHECK(ri.struct_size == offsetof(vxl_renderer_info, gl_renderer) && (unsigned char)ri.gl_renderer[0] == 0xEE &&
+          (unsigned char)ri.gl_version[127] == 0xEE);
+    static float img[8 * 8 * 4];
+    vxl_render_params p = default_params(8, 8);
+    CHECK(vxl_render(r, &p, img, NULL) == VXL_OK);
+    vxl_render_stats st;
+    memset(&st, 0xEE, sizeof st);
+    st.struct_size = (uint32_t)offsetof(vxl_render_stats, storage); /* before issue 8 */
+    CHECK(vxl_renderer_get_stats(r, &st) == VXL_OK && st.rays > 0 && st.storage == 0xEEEEEEEEu);
+    vxl_renderer_destroy(r);
+}
+
 int main(void)
 {
     RUN(abi_and_names);
+    RUN(every_enumeration_has_names);
     RUN(destroy_null_is_a_noop);
     RUN(volume_create_validates);
     RUN(nan_voxels_are_counted_and_neutralised);
@@ -253,5 +469,9 @@ int main(void)
     RUN(backend_environment_override);
     RUN(auto_uses_what_is_installed);
     RUN(shader_dir_override_loads_from_disk);
+    RUN(old_render_params_are_read_up_to_their_size);
+    RUN(old_renderer_options_get_the_defaults);
+    RUN(old_load_options_get_the_defaults);
+    RUN(old_output_structs_are_written_up_to_their_size);
     return TEST_SUMMARY();
 }

@@ -6,6 +6,7 @@
 
 #include "harness.h"
 #include "test_util.h"
+#include "voxlight_dev.h" /* the test hooks */
 
 static vxl_renderer *R;
 

@@ -2,6 +2,7 @@
  * vxl_probe_gradients, i.e. through the real GLSL the ray caster runs. */
 #include "harness.h"
 #include "test_util.h"
+#include "voxlight_dev.h" /* the test hooks */
 
 static vxl_renderer *R;
 

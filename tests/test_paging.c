@@ -12,6 +12,7 @@
 
 #include "harness.h"
 #include "test_util.h"
+#include "voxlight_dev.h" /* the test hooks */
 
 #define W 64
 #define H 64

@@ -6,11 +6,22 @@
  *  - Parameter structs are plain data with fixed-width fields only (no enums,
  *    no bitfields). Their all-zero value means "default" for every field.
  *    Each starts with `struct_size`, which the caller sets to sizeof(struct);
- *    0 is accepted and means "the size of this ABI version".
+ *    0 is accepted and means "the size of this ABI version". A smaller
+ *    size, that of an older release of the struct, is accepted too: the
+ *    library reads (or, for output structs, writes) only the bytes it covers
+ *    and gives the fields beyond it their defaults.
  *  - Every call returns an int: VXL_OK (0) or a VXL_ERR_* code. The message of
  *    the last failure is available per handle (vxl_renderer_error) and, for
  *    every failing call including those before a handle exists, from the
  *    calling thread's vxl_last_error().
+ *  - Every enumeration the CLI and the add-on offer has its names declared
+ *    below it, so no caller keeps its own list: vxl_*_name(value) returns
+ *    NULL past the last value (list them by counting up to the first NULL);
+ *    vxl_*_from_name(name, &value) is case-insensitive and fails with
+ *    VXL_ERR_INVALID_ARGUMENT for an unknown name.
+ *  - Test and benchmark hooks (the gradient probe, phantoms, the reference
+ *    renderer, the pre-integration table and the developer fields marked
+ *    "developer hook" below) are declared in voxlight_dev.h, not here.
  *  - Output buffers are allocated by the caller.
  *  - Matrices are 4x4, column-major, OpenGL convention.
  *  - Images are row 0 = bottom (OpenGL and Blender Image.pixels order).
@@ -56,11 +67,17 @@ extern "C" {
 #define VXL_DTYPE_I32 6
 #define VXL_DTYPE_F32 7
 #define VXL_DTYPE_F64 8
+#define VXL_DTYPE_COUNT 9 /* one past the last; 0 is no type */
+/* "uint8" ... "float64"; NULL for 0 (no type) as well as past the last. */
+VXL_API const char *vxl_dtype_name(uint32_t dtype);
 
 /* ---- backends ---- */
 #define VXL_BACKEND_AUTO 0   /* EGL on a GPU, then OSMesa, then EGL on Mesa */
 #define VXL_BACKEND_OSMESA 1
 #define VXL_BACKEND_EGL 2
+#define VXL_BACKEND_COUNT 3
+VXL_API const char *vxl_backend_name(uint32_t backend); /* "auto", "osmesa", "egl" */
+VXL_API int vxl_backend_from_name(const char *name, uint32_t *out);
 
 /* ---- gradient filters ---- */
 #define VXL_FILTER_CENTRAL 0     /* 6 taps, the default */
@@ -73,18 +90,24 @@ extern "C" {
 #define VXL_FILTER_CUBIC_SMOOTH 7 /* derivative of the approximating cubic B-spline (no prefilter):
                                      smooth normals on noisy and 8-bit scans, 64 texel reads */
 #define VXL_FILTER_COUNT 8
+VXL_API const char *vxl_filter_name(uint32_t filter); /* "central", ..., "cubic-smooth" */
+VXL_API int vxl_filter_from_name(const char *name, uint32_t *out);
 
 /* ---- classification modes ---- */
 #define VXL_CLASSIFY_POST 0    /* interpolate the value, then look it up (default) */
 #define VXL_CLASSIFY_PRE 1     /* classify voxels first, then interpolate RGBA; shading uses the data gradient */
 #define VXL_CLASSIFY_PREINT 2  /* pre-integrated segments from a 2D (front, back) table */
 #define VXL_CLASSIFY_COUNT 3
+VXL_API const char *vxl_classify_name(uint32_t mode); /* "post", "pre", "preint" */
+VXL_API int vxl_classify_from_name(const char *name, uint32_t *out);
 
 /* ---- gradient-magnitude opacity ---- */
 #define VXL_GOPACITY_OFF 0
 #define VXL_GOPACITY_BOUNDARY 1
 #define VXL_GOPACITY_ISO 2
 #define VXL_GOPACITY_COUNT 3
+VXL_API const char *vxl_gradient_opacity_name(uint32_t mode); /* "off", "boundary", "iso" */
+VXL_API int vxl_gradient_opacity_from_name(const char *name, uint32_t *out);
 
 /* ---- transfer-function presets ---- */
 #define VXL_PRESET_AUTO 0 /* MRI or CT default, chosen from the data range */
@@ -94,11 +117,16 @@ extern "C" {
 #define VXL_PRESET_MRI 4
 #define VXL_PRESET_CT 5
 #define VXL_PRESET_COUNT 6
+VXL_API const char *vxl_preset_name(uint32_t preset); /* "auto", "gray", ... */
+VXL_API int vxl_preset_from_name(const char *name, uint32_t *out);
 
 /* ---- precomputed gradient storage ---- */
 #define VXL_GRADIENT_STORE_8BIT 0  /* RGBA8 signed-normalised, raw gradient / global max */
 #define VXL_GRADIENT_STORE_16F 1   /* RGBA16F, same scaling */
 #define VXL_GRADIENT_STORE_32F 2   /* RGBA32F, same scaling: exact, for tests and references */
+#define VXL_GRADIENT_STORE_COUNT 3
+VXL_API const char *vxl_gradient_store_name(uint32_t store); /* "8bit", "16f", "32f" */
+VXL_API int vxl_gradient_store_from_name(const char *name, uint32_t *out);
 
 /* ---- volume storage on the GL side (vxl_renderer_options.storage) ---- */
 #define VXL_STORAGE_AUTO 0    /* one texture when it fits the texture limit and budget, else bricked,
@@ -112,6 +140,8 @@ extern "C" {
                                     decoded on the GL side into a linear cache the ray caster filters
                                     natively (deferred filtering) */
 #define VXL_STORAGE_COUNT 5
+VXL_API const char *vxl_storage_name(uint32_t storage); /* "auto", "dense", ... */
+VXL_API int vxl_storage_from_name(const char *name, uint32_t *out);
 
 #define VXL_MAX_LIGHTS 8
 
@@ -218,9 +248,7 @@ typedef struct vxl_renderer_options {
     /* Appended (issue 8); read only when struct_size covers them. */
     uint32_t storage;             /* VXL_STORAGE_*; 0 = AUTO */
     uint32_t page_brick;          /* voxels per brick edge when bricked: 8, 16, 32 or 64; 0 = 32 */
-    /* Appended (issue 8, compressed storage): 1 = filter in the compressed
-     * domain (every tap decodes its 8 neighbours; no decode cache), for
-     * measuring deferred filtering against it; 0 = deferred filtering. */
+    /* Appended (issue 8). Developer hook (voxlight_dev.h): leave 0. */
     uint32_t compressed_domain;
 } vxl_renderer_options;
 
@@ -240,6 +268,9 @@ typedef struct vxl_light {
     float color[3];     /* 0,0,0 = white */
     float intensity;    /* 0 = 1 */
 } vxl_light;
+
+/* 17 words of room: the struct then ends on its 8-byte alignment, with no padding. */
+#define VXL_RENDER_PARAMS_RESERVED 17
 
 typedef struct vxl_render_params {
     uint32_t struct_size;
@@ -284,8 +315,8 @@ typedef struct vxl_render_params {
     /* termination and output */
     float early_termination;         /* opacity that stops a ray; 0 = 0.99 */
     float depth_threshold;           /* opacity that defines output depth; 0 = 0.5 */
-    uint32_t no_skip;                /* 1: disable every in-frame skip (testing) */
-    uint32_t preint_size;            /* pre-integration table entries per axis; 0 = 256 */
+    uint32_t no_skip;                /* developer hook (voxlight_dev.h): leave 0 */
+    uint32_t preint_size;            /* developer hook (voxlight_dev.h): leave 0 */
 
     /* Levoy's opacity functions (gradient-magnitude opacity), VXL_GOPACITY_*:
      * BOUNDARY multiplies opacity by min(1, |grad| / gradient_ref)^gradient_exp
@@ -297,7 +328,10 @@ typedef struct vxl_render_params {
     float gradient_exp;              /* 0 = 1 */
     float iso_value;                 /* data units (ISO) */
     float iso_thickness;             /* voxels; 0 = 1 (ISO) */
-    uint32_t reserved[1];
+    /* Room for the next features (fields taken from here keep the struct's
+     * size and offsets). Must be zero: vxl_render fails with
+     * VXL_ERR_INVALID_ARGUMENT naming the word otherwise. */
+    uint32_t reserved[VXL_RENDER_PARAMS_RESERVED];
 } vxl_render_params;
 
 VXL_API int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out);
@@ -349,76 +383,11 @@ VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);
 VXL_API int vxl_default_camera(vxl_renderer *r, const vxl_render_params *p, float view[16],
                                float proj[16]);
 
-/* Evaluates the gradient filter selected in p (filter, sample_distance,
- * gradient_store, reuse_gradients) at n points given in voxel space
- * (points: n*3 floats), with the same GLSL the ray caster runs. out: n*3
- * floats, the gradient in voxel space (units of normalised value per voxel;
- * the precomputed filter's magnitude is relative). With reuse_gradients the
- * points are treated as consecutive samples of one ray. */
-VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, const float *points,
-                                uint32_t n, float *out);
-
-/* ------------------------------------------------- ground truth (issue 4) */
-
-/* Analytic phantoms, generated at any resolution, each with an analytic
- * gradient. The volume covers [-1,1]^3 in world units (affine maps voxel
- * centres 0..n-1 onto -1..1), stored as float32. */
-#define VXL_PHANTOM_MARSCHNER_LOBB 1 /* fM = 6, alpha = 0.25; iso-surface at 0.5 */
-#define VXL_PHANTOM_SPHERE 2         /* ellipsoid distance field: 0.5 - signed distance */
-#define VXL_PHANTOM_RAMP 3           /* linear ramp along (1, 2, 3)/|.| */
-#define VXL_PHANTOM_NOISY_BLOB 4     /* smooth Gaussian blob plus Gaussian noise */
-#define VXL_PHANTOM_SPARSE_BALLS 5   /* Gaussian balls on 5% of an 8^3 lattice (empty-space skipping) */
-#define VXL_PHANTOM_DENSE_BALLS 6    /* its dense twin: a ball on every lattice site */
-#define VXL_PHANTOM_LARGE_SPARSE 7  /* 8-bit Gaussian ellipsoids on 30% of a 12x8x2 lattice; default
-                                        2500x1500x400 (over every 2048 texture limit, for bricking) */
-#define VXL_PHANTOM_COUNT 8
-
-typedef struct vxl_phantom_desc {
-    uint32_t struct_size;
-    uint32_t kind;         /* VXL_PHANTOM_* */
-    uint32_t dims[3];      /* 0 = 64 */
-    uint32_t seed;         /* noise seed (NOISY_BLOB) */
-    double noise_sigma;    /* NOISY_BLOB: standard deviation; 0 = 0.05 */
-} vxl_phantom_desc;
-
-VXL_API int vxl_phantom_create(const vxl_phantom_desc *d, vxl_volume **out);
-/* The noise-free analytic field and its gradient at a voxel-space point
- * (gradient per voxel of the given grid). For NOISY_BLOB this is the blob
- * without noise: the signal a filter should recover. */
-VXL_API int vxl_phantom_eval(const vxl_phantom_desc *d, const double p[3], double *value, double grad[3]);
-VXL_API const char *vxl_phantom_name(uint32_t kind);
-/* Up to max voxel-space points (max*3 floats) where the noise-free field is
- * within tol of iso, drawn uniformly from the central 90% of the box with a
- * fixed seed; *n receives the count found. */
-VXL_API int vxl_phantom_iso_points(const vxl_phantom_desc *d, double iso, double tol, uint32_t seed, float *pts,
-                                   uint32_t max, uint32_t *n);
-
-/* The ground-truth image of a phantom: a CPU renderer in double precision
- * with the shaders' camera, transfer function, shading and compositing
- * equations, sampling the analytic field and gradient at a step of at most
- * 1/16 voxel, with no jitter. vol must be vxl_phantom_create(d)'s volume (it
- * fixes the value normalisation). Slow: meant for small images. */
-VXL_API int vxl_reference_render(const vxl_phantom_desc *d, const vxl_volume *vol, const vxl_render_params *p,
-                                 float *rgba, float *depth);
-
-/* The pre-integration table the PREINT mode uses, for inspection and tests:
- * tf (tf_size straight RGBA entries, alpha per voxel), opacity_scale (0 = 1),
- * segment length step (voxels), n entries per axis. out: n*n*4 floats,
- * premultiplied RGBA, out[(back*n + front)*4 + c]. */
-VXL_API int vxl_preint_table(const float *tf, uint32_t tf_size, float opacity_scale, float step, uint32_t n,
-                             float *out);
-
 /* ------------------------------------------------------------------ misc */
 
 VXL_API uint32_t vxl_abi_version(void);
 VXL_API const char *vxl_last_error(void);       /* thread-local; "" if none */
 VXL_API const char *vxl_error_name(int code);
-VXL_API const char *vxl_filter_name(uint32_t filter);   /* NULL if out of range */
-VXL_API int vxl_filter_from_name(const char *name, uint32_t *out);
-VXL_API const char *vxl_preset_name(uint32_t preset);
-VXL_API const char *vxl_storage_name(uint32_t storage); /* NULL if out of range */
-VXL_API int vxl_storage_from_name(const char *name, uint32_t *out);
-VXL_API int vxl_preset_from_name(const char *name, uint32_t *out);
 
 /* Writes premultiplied RGBA (row 0 = bottom) to .png (straight alpha, 8 bit)
  * or .exr (premultiplied half float, plus a Z channel when depth != NULL). */

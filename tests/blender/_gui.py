@@ -79,7 +79,12 @@ class Capture:
         import gpu
         import numpy as np
         region = bpy.context.region
+        w, h = region.width, region.height
         fb = gpu.state.active_framebuffer_get()
-        buf = fb.read_color(0, 0, region.width, region.height, 4, 0, "FLOAT")
-        self.img = np.array(buf.to_list(), np.float32).reshape(region.height, region.width, 4)
+        # A flat Buffer, read without a per-pixel Python list: Blender 3.4
+        # exports multi-dimensional Buffers with Fortran strides (see
+        # viewport._read_window_depth), a flat one is unambiguous.
+        buf = gpu.types.Buffer("FLOAT", w * h * 4)
+        fb.read_color(0, 0, w, h, 4, 0, "FLOAT", data=buf)
+        self.img = np.array(buf, np.float32).reshape(h, w, 4)
         self.want = False

@@ -248,10 +248,16 @@ def steps():
     check("outside_frustum_was_culled", vp.culled_count > culled,
           "culled %d -> %d" % (culled, vp.culled_count))
 
-    # 5. Orbiting changes the image, first coarse then refined.
+    # 5. Orbiting changes the image, first coarse then refined in steps the
+    # artist sees: the interactive preview, half the still resolution, then
+    # the full one. With previews of at most 0.1 the half step (0.25 of the
+    # still 0.5) is always sharper than the preview, so it is due.
+    interactive_was = scene.voxlight.interactive_resolution
+    scene.voxlight.interactive_resolution = 0.1
     yield from settled()
     before = capture.img
     n = rt.render_count
+    vp.shown_log.clear()
     r3d.view_rotation = Quaternion((0, 0, 1), math.radians(35)) @ r3d.view_rotation
     grab()
     yield 0.05
@@ -263,6 +269,16 @@ def steps():
     check("refined_after_moving", rt.render_count >= n + 2 and moving_w < st.shown.width
           and st.shown.full,
           "renders %d -> %d, widths %d -> %d" % (n, rt.render_count, moving_w, st.shown.width))
+    shown = [e[1:] for e in vp.shown_log if e[0] == ob.name]  # (kind, scale, width, height)
+    steps_seen = [k for i, (k, *_rest) in enumerate(shown) if i == 0 or shown[i - 1][0] != k]
+    interactive = scene.voxlight.interactive_resolution
+    check("refine_steps_preview_half_full",
+          steps_seen == ["preview", "half", "full"]
+          and all(sc <= interactive + 1e-6 for k, sc, _w, _h in shown if k == "preview")
+          and all(sc == 0.25 and w == round(region.width * 0.25) for k, sc, w, _h in shown if k == "half")
+          and all(sc == 0.5 and w == round(region.width * 0.5) for k, sc, w, _h in shown if k == "full"),
+          "shown after the view change: %s" % ["%s %.3f %dx%d" % e for e in shown])
+    scene.voxlight.interactive_resolution = interactive_was
 
     # 6. A full-resolution frame in flight never blocks navigation. Make the
     # full frame slow (the whole region), orbit, wait until its refine

@@ -2,25 +2,56 @@
 # tests/fuzz/run.sh SECONDS [TARGET...] - builds the libFuzzer targets
 # (make fuzz: clang, ASan+UBSan), writes the seed corpus, replays
 # tests/crashers/<target>/ and then fuzzes each target for SECONDS.
+# tests/fuzz/run.sh replay [TARGET...] - the replay alone (no seeds, no
+# fuzzing): what to run after fixing a crash.
 # New crashes land in tests/crashers/<target>/ (a corpus that only grows;
-# test_loaders replays it too). Prints the executions reached per target and
-# a final "N passed, N failed" line (one check per replay and per run).
+# test_loaders replays it too). A target whose corpus folder is missing or
+# holds no input fails before anything is built: a replay of nothing would
+# pass whatever the loaders do. VOXLIGHT_CRASHERS names another corpus root
+# (one folder per target; relative to the caller's working directory), as
+# tests/cli/test_crash_replay.py does; the script runs from any directory.
+# Prints the executions reached per target and a final "N passed, N failed"
+# line (one check per replay and per run).
 # Called by ./build.sh test (short) and ./build.sh fuzz (longer).
 set -uo pipefail
-cd "$(dirname "$0")/../.."
+caller_pwd=$(pwd)
+cd "$(dirname "$0")/../.." || exit 1
+crashers=${VOXLIGHT_CRASHERS:-tests/crashers}
+[ -n "${VOXLIGHT_CRASHERS:-}" ] && [[ $crashers != /* ]] && crashers=$caller_pwd/$crashers
 secs=${1:-20}
 shift || true
+replay_only=0
+[ "$secs" = replay ] && replay_only=1
 targets=("$@")
 # vdb fuzzes in fork mode: see fuzz_contained_vdb below.
 [ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom vdb)
+
+# The corpus first: every target needs at least one input to replay (dot
+# files such as .keep do not count).
+corpus_gaps=0
+for t in "${targets[@]}"; do
+    if [ ! -d "$crashers/$t" ]; then
+        echo "fuzz_$t: FAIL: the crash corpus $crashers/$t/ is missing"
+        corpus_gaps=$((corpus_gaps + 1))
+    elif [ -z "$(find "$crashers/$t" -maxdepth 1 -type f ! -name '.*' -print -quit)" ]; then
+        echo "fuzz_$t: FAIL: the crash corpus $crashers/$t/ is empty (it holds at least one hostile input; see tests/README.md)"
+        corpus_gaps=$((corpus_gaps + 1))
+    fi
+done
+if [ $corpus_gaps -gt 0 ]; then
+    echo "0 passed, $corpus_gaps failed"
+    exit 1
+fi
 
 if ! make -s -j"$(nproc)" fuzz; then
     echo "fuzz: build failed"
     echo "0 passed, 1 failed"
     exit 1
 fi
-build/fuzz/make_seeds build/fuzz/seeds || { echo "fuzz: seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
-/usr/bin/python3 tests/fuzz/vdb_seeds.py build/fuzz/seeds/vdb || { echo "fuzz: vdb seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
+if [ $replay_only -eq 0 ]; then
+    build/fuzz/make_seeds build/fuzz/seeds || { echo "fuzz: seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
+    /usr/bin/python3 tests/fuzz/vdb_seeds.py build/fuzz/seeds/vdb || { echo "fuzz: vdb seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
+fi
 
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
@@ -83,9 +114,9 @@ fail=0
 total_execs=0
 for t in "${targets[@]}"; do
     bin=build/fuzz/fuzz_$t
-    crash_dir=tests/crashers/$t
+    crash_dir=$crashers/$t
     corpus=build/fuzz/corpus/$t
-    mkdir -p "$crash_dir" "$corpus"
+    mkdir -p "$corpus"
     # OpenImageIO's PNG reader longjmps over a std::string on truncated files
     # (31 bytes lost inside libOpenImageIO, not in Voxlight): leak checks
     # stay on for our own C loaders only. OpenVDB (under OpenImageIO's VDB
@@ -93,19 +124,20 @@ for t in "${targets[@]}"; do
     leaks=1
     case $t in tiff|png|vdb) leaks=0 ;; esac
 
-    mapfile -t crashers < <(find "$crash_dir" -maxdepth 1 -type f ! -name '.*' | sort)
-    if [ ${#crashers[@]} -gt 0 ]; then
-        log=$(mktemp)
-        if ASAN_OPTIONS=detect_leaks=$leaks "$bin" -detect_leaks=$leaks -timeout=10 -rss_limit_mb=2048 "${crashers[@]}" >"$log" 2>&1; then
-            echo "fuzz_$t: replayed ${#crashers[@]} crashers: ok"
-            pass=$((pass + 1))
-        else
-            echo "fuzz_$t: FAIL replaying crashers:"
-            grep -E "ERROR|SUMMARY|runtime error|Running:" "$log" | tail -n 20
-            fail=$((fail + 1))
-        fi
-        rm -f "$log"
+    # (never empty: checked above)
+    mapfile -t inputs < <(find "$crash_dir" -maxdepth 1 -type f ! -name '.*' | sort)
+    log=$(mktemp)
+    if ASAN_OPTIONS=detect_leaks=$leaks "$bin" -detect_leaks=$leaks -timeout=10 -rss_limit_mb=2048 "${inputs[@]}" >"$log" 2>&1 \
+        && [ "$(grep -c '^Executed ' "$log")" -eq ${#inputs[@]} ]; then
+        echo "fuzz_$t: replayed ${#inputs[@]} crashers from $crash_dir/: ok"
+        pass=$((pass + 1))
+    else
+        echo "fuzz_$t: FAIL replaying the crashers in $crash_dir/:"
+        grep -E "ERROR|SUMMARY|runtime error|Running:|No such file" "$log" | tail -n 20
+        fail=$((fail + 1))
     fi
+    rm -f "$log"
+    [ $replay_only -eq 1 ] && continue
 
     log=$(mktemp)
     if [ "$t" = vdb ]; then
@@ -132,6 +164,6 @@ for t in "${targets[@]}"; do
     fi
     rm -f "$log"
 done
-echo "fuzz: $total_execs executions in total"
+[ $replay_only -eq 1 ] || echo "fuzz: $total_execs executions in total"
 echo "$pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -1,11 +1,11 @@
 // classify_volume.comp - pre-classification: every voxel through the transfer
 // function and window, stored premultiplied (so interpolation does not bleed
 // colour from transparent neighbours). Re-run when the classification changes.
-#include "common.glsl"
-#include "classify.glsl"
+#include "lib/common.glsl"
+#include "lib/classify.glsl"
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
-layout(rgba8, binding = 0) writeonly uniform image3D u_dst;
+layout(rgba8, binding = VXL_IMAGE_OUT) writeonly uniform image3D u_dst;
 
 void main()
 {

@@ -3,7 +3,7 @@
 // FILTER_SOBEL26, FILTER_PRECOMPUTED, FILTER_CUBIC, FILTER_CUBIC_SMOOTH. Every
 // filter returns the gradient in voxel space (normalised value per voxel) and
 // is exact on a linear ramp.
-#include "common.glsl"
+#include "lib/common.glsl"
 
 uniform float u_sample_distance; // tap offset d, in voxels
 
@@ -13,7 +13,7 @@ uniform float u_gradient_scale; // that global max: magnitudes in value per voxe
 #ifdef PAGED
 // Bricked storage: u_gradient is a pool of its own, u_gpage its page table
 // (w < 0 in the pool, else a brick whose whole neighbourhood is one value:
-// zero gradient), see paged_gradient.comp. On a coarser level the gradient
+// zero gradient), see compute/paged_gradient.comp. On a coarser level the gradient
 // is the level's, per level voxel.
 uniform sampler3D u_gpage;
 uniform vec3 u_gpool_dims;
@@ -106,6 +106,14 @@ vec3 bspline_gradient(vec3 q)
 
 #define TAP(o) sample_value(p + (o))
 
+#ifdef FILTER_SOBEL26
+// The Sobel's taps are trilinear samples u_sample_distance apart around p.
+#define STENCIL_POINT vec3
+#include "lib/stencils.glsl"
+
+float stencil_tap(vec3 p, ivec3 o) { return TAP(u_sample_distance * vec3(o)); }
+#endif
+
 // centre: the value at p, which the ray caster has already fetched.
 vec3 gradient_at(vec3 p, float centre)
 {
@@ -138,18 +146,9 @@ vec3 gradient_at(vec3 p, float centre)
     }
     return g / (10.0 * d);
 #elif defined(FILTER_SOBEL26)
-    // Classic weighted 26-neighbour Sobel: weight o.x*h(o.y)*h(o.z) for the x
-    // component with h(0) = 2, h(+-1) = 1; the weights sum to 32d on a ramp.
-    vec3 g = vec3(0.0);
-    for (int z = -1; z <= 1; z++)
-        for (int y = -1; y <= 1; y++)
-            for (int x = -1; x <= 1; x++) {
-                if (x == 0 && y == 0 && z == 0) continue;
-                vec3 o = vec3(x, y, z);
-                vec3 h = 2.0 - abs(o);
-                g += o * vec3(h.y * h.z, h.x * h.z, h.x * h.y) * TAP(d * o);
-            }
-    return g / (32.0 * d);
+    // Classic weighted 26-neighbour Sobel (lib/stencils.glsl): its weights
+    // sum to 32d on a ramp.
+    return sobel26_sum(p) / (32.0 * d);
 #elif defined(FILTER_PRECOMPUTED) && defined(PAGED)
     return paged_gradient(p) * u_gradient_scale;
 #elif defined(FILTER_PRECOMPUTED)

@@ -1,11 +1,11 @@
 // probe.comp - evaluates the selected gradient filter at given points with
-// the very code the ray caster runs (gradients.glsl), so tests and the
+// the very code the ray caster runs (lib/gradients.glsl), so tests and the
 // benchmark measure the real shader, not a C copy.
-#include "gradients.glsl"
+#include "lib/gradients.glsl"
 
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Points { float pts[]; };
-layout(std430, binding = 1) writeonly buffer Result { float res[]; };
+layout(std430, binding = VXL_SSBO_PROBE_POINTS) readonly buffer Points { float pts[]; };
+layout(std430, binding = VXL_SSBO_PROBE_RESULTS) writeonly buffer Result { float res[]; };
 uniform uint u_count;
 uniform int u_sequential; // 1: points are consecutive samples of one ray (reuseGradients)
 

@@ -1,7 +1,7 @@
 // classify.glsl - classification through a 1D RGBA transfer function. The
 // window maps data onto the table: x = (value - offset) * scale.
 // Post-classification (default) looks up the interpolated value; CLASSIFY_PRE
-// interpolates voxels classified beforehand (classify_volume.comp);
+// interpolates voxels classified beforehand (compute/classify_volume.comp);
 // CLASSIFY_PREINT looks up whole segments in the pre-integration table.
 uniform sampler1D u_tf;     // straight RGBA; alpha is opacity per voxel of path
 uniform float u_tf_size;

@@ -1,10 +1,10 @@
 // raycast.frag - front-to-back ray casting with premultiplied compositing.
-// Variants by define: FILTER_* (gradients.glsl), SHADING, REUSE_GRADIENTS,
-// CLASSIFY_PRE / CLASSIFY_PREINT (classify.glsl; post-classification otherwise),
+// Variants by define: FILTER_* (lib/gradients.glsl), SHADING, REUSE_GRADIENTS,
+// CLASSIFY_PRE / CLASSIFY_PREINT (lib/classify.glsl; post-classification otherwise),
 // GOPACITY 1 (boundary) / 2 (iso-surface): Levoy's gradient-magnitude opacity.
-#include "gradients.glsl"
-#include "classify.glsl"
-#include "shading.glsl"
+#include "lib/gradients.glsl"
+#include "lib/classify.glsl"
+#include "lib/shading.glsl"
 
 #ifndef GOPACITY
 #define GOPACITY 0
@@ -27,7 +27,7 @@ uniform int u_brick_size;         // voxels per brick edge
 uniform usampler3D u_brick_distance; // 0 occupied; k: bricks within k-1 are empty
 
 // Work counters for vxl_renderer_get_stats: one atomic per ray, not per sample.
-layout(std430, binding = 2) buffer Stats { uint st_samples_lo; uint st_samples_hi; uint st_max_ray; uint st_rays; };
+layout(std430, binding = VXL_SSBO_STATS) buffer Stats { uint st_samples_lo; uint st_samples_hi; uint st_max_ray; uint st_rays; };
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;

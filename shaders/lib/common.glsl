@@ -1,6 +1,8 @@
 // common.glsl - volume sampling shared by the ray caster, the probe and the
 // gradient filters. Positions are in voxel space: voxel centres at integers,
 // the box is [-0.5, dims-0.5].
+// (Included outside every #if: files go in once per program, where first named.)
+#include "lib/slots.glsl"
 #ifndef COMPRESSED_DOMAIN
 uniform sampler3D u_volume; // normalised value in [0,1], trilinear, clamp to edge
 #endif
@@ -34,14 +36,13 @@ uniform float u_lod_scale;
 // a brick's slot = its palette row), and a value is palette[code], which is
 // not linear in the codes, so every tap decodes its 8 neighbours and
 // weights them by hand.
-#include "palette.glsl"
+#include "lib/palette.glsl"
 uniform usampler3D u_volume;
 uniform ivec3 u_code_slots;
 
 int palette_row(vec3 origin)
 {
-    ivec3 s = ivec3(origin) / (int(u_page_brick) + 2); // origin = slot corner + ghost
-    return s.x + u_code_slots.x * (s.y + u_code_slots.y * s.z);
+    return slot_index(ivec3(origin) / (int(u_page_brick) + 2), u_code_slots); // origin = slot corner + ghost
 }
 
 float decode_texel(ivec3 t, int row) { return palette_value(row, texelFetch(u_volume, t, 0).r); }

@@ -10,7 +10,7 @@
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 uniform sampler3D u_volume;
 uniform int u_brick;
-layout(rg32f, binding = 0) writeonly uniform image3D u_minmax;
+layout(rg32f, binding = VXL_IMAGE_OUT) writeonly uniform image3D u_minmax;
 
 #ifdef GRADIENT_BOUND
 uniform int u_apron;

@@ -1,0 +1,97 @@
+/*
+ * voxlight_dev.h - libvoxlight's test and benchmark hooks.
+ *
+ * The product API is voxlight.h; this header adds what the tests, the
+ * benchmarks and the accuracy studies use to look inside the renderer or to
+ * produce ground truth. The library exports every function here (the ctypes
+ * binding calls the probe and the phantoms too), with the same conventions
+ * as voxlight.h, but a product has no reason to call them and they may
+ * change between releases without an ABI version bump.
+ *
+ * Developer fields of voxlight.h's structs. They stay where they are, with
+ * their names, so the structs keep one layout for every caller (products
+ * leave them 0, the all-zero default):
+ *  - vxl_renderer_options.compressed_domain: 1 = compressed storage filters
+ *    in the compressed domain (every tap decodes its 8 neighbours; no decode
+ *    cache), to measure deferred filtering against it; 0 = deferred
+ *    filtering.
+ *  - vxl_render_params.no_skip: 1 = disable every in-frame skip (empty-space
+ *    skipping and early ray termination), so tests can compare a frame
+ *    with and without them.
+ *  - vxl_render_params.preint_size: entries per axis of the pre-integration
+ *    table the PREINT classification builds; 0 = 256 (see vxl_preint_table).
+ */
+#ifndef VOXLIGHT_DEV_H
+#define VOXLIGHT_DEV_H
+
+#include "voxlight.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------- gradient probe */
+
+/* Evaluates the gradient filter selected in p (filter, sample_distance,
+ * gradient_store, reuse_gradients) at n points given in voxel space
+ * (points: n*3 floats), with the same GLSL the ray caster runs. out: n*3
+ * floats, the gradient in voxel space (units of normalised value per voxel;
+ * the precomputed filter's magnitude is relative). With reuse_gradients the
+ * points are treated as consecutive samples of one ray. */
+VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, const float *points,
+                                uint32_t n, float *out);
+
+/* ------------------------------------------------- ground truth (issue 4) */
+
+/* Analytic phantoms, generated at any resolution, each with an analytic
+ * gradient. The volume covers [-1,1]^3 in world units (affine maps voxel
+ * centres 0..n-1 onto -1..1), stored as float32. */
+#define VXL_PHANTOM_MARSCHNER_LOBB 1 /* fM = 6, alpha = 0.25; iso-surface at 0.5 */
+#define VXL_PHANTOM_SPHERE 2         /* ellipsoid distance field: 0.5 - signed distance */
+#define VXL_PHANTOM_RAMP 3           /* linear ramp along (1, 2, 3)/|.| */
+#define VXL_PHANTOM_NOISY_BLOB 4     /* smooth Gaussian blob plus Gaussian noise */
+#define VXL_PHANTOM_SPARSE_BALLS 5   /* Gaussian balls on 5% of an 8^3 lattice (empty-space skipping) */
+#define VXL_PHANTOM_DENSE_BALLS 6    /* its dense twin: a ball on every lattice site */
+#define VXL_PHANTOM_LARGE_SPARSE 7  /* 8-bit Gaussian ellipsoids on 30% of a 12x8x2 lattice; default
+                                        2500x1500x400 (over every 2048 texture limit, for bricking) */
+#define VXL_PHANTOM_COUNT 8
+
+typedef struct vxl_phantom_desc {
+    uint32_t struct_size;
+    uint32_t kind;         /* VXL_PHANTOM_* */
+    uint32_t dims[3];      /* 0 = 64 */
+    uint32_t seed;         /* noise seed (NOISY_BLOB) */
+    double noise_sigma;    /* NOISY_BLOB: standard deviation; 0 = 0.05 */
+} vxl_phantom_desc;
+
+VXL_API int vxl_phantom_create(const vxl_phantom_desc *d, vxl_volume **out);
+/* The noise-free analytic field and its gradient at a voxel-space point
+ * (gradient per voxel of the given grid). For NOISY_BLOB this is the blob
+ * without noise: the signal a filter should recover. */
+VXL_API int vxl_phantom_eval(const vxl_phantom_desc *d, const double p[3], double *value, double grad[3]);
+VXL_API const char *vxl_phantom_name(uint32_t kind);
+/* Up to max voxel-space points (max*3 floats) where the noise-free field is
+ * within tol of iso, drawn uniformly from the central 90% of the box with a
+ * fixed seed; *n receives the count found. */
+VXL_API int vxl_phantom_iso_points(const vxl_phantom_desc *d, double iso, double tol, uint32_t seed, float *pts,
+                                   uint32_t max, uint32_t *n);
+
+/* The ground-truth image of a phantom: a CPU renderer in double precision
+ * with the shaders' camera, transfer function, shading and compositing
+ * equations, sampling the analytic field and gradient at a step of at most
+ * 1/16 voxel, with no jitter. vol must be vxl_phantom_create(d)'s volume (it
+ * fixes the value normalisation). Slow: meant for small images. */
+VXL_API int vxl_reference_render(const vxl_phantom_desc *d, const vxl_volume *vol, const vxl_render_params *p,
+                                 float *rgba, float *depth);
+
+/* The pre-integration table the PREINT mode uses, for inspection and tests:
+ * tf (tf_size straight RGBA entries, alpha per voxel), opacity_scale (0 = 1),
+ * segment length step (voxels), n entries per axis. out: n*n*4 floats,
+ * premultiplied RGBA, out[(back*n + front)*4 + c]. */
+VXL_API int vxl_preint_table(const float *tf, uint32_t tf_size, float opacity_scale, float step, uint32_t n,
+                             float *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

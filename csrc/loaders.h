@@ -1,0 +1,38 @@
+/* loaders.h - the file loaders, and the dispatch (volume_load.c) that picks
+ * one for a path. Arrows go one way: the dispatch calls the loaders, the
+ * loaders call volume.h (limits, building a volume), and volume.c knows no
+ * loader. */
+#ifndef VXL_LOADERS_H
+#define VXL_LOADERS_H
+
+#include "error.h"
+#include "volume.h"
+#include "voxlight.h"
+
+/* NIfTI-1/2 reader (.nii, .nii.gz, .hdr/.img[.gz]); in nifti.c. */
+int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+
+/* The other file loaders, same contract as vxl_nifti_load: *out is NULL on
+ * failure, every failure is a vxl_fail naming the file, sizes from headers
+ * pass vxl_volume_check_limits before any allocation. */
+/* NRRD (.nrrd attached, .nhdr detached; raw/gzip); in nrrd.c. */
+int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* MetaImage (.mha, .mhd + ElementDataFile; raw/zlib); in metaimage.c. */
+int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* The readers that need OpenImageIO or dcmtk run in helper processes, so
+ * this library links only the C runtime (reader_stream.h); these start the
+ * helper and rebuild its volume after checking everything it sent; in
+ * remote_readers.c. A missing helper or library is an error naming it.
+ * TIFF/PNG: a multi-page TIFF, a numbered series (slice_0001.tif ...) or a
+ * folder of images (image_stack.cpp in voxlight-read-oiio). */
+int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* OpenVDB scalar grid (vdb.cpp in voxlight-read-oiio). */
+int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* DICOM: a folder, a DICOMDIR or one file of a series (dicom.cpp in
+ * voxlight-read-dicom). */
+int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* Whether a folder holds DICOM (a DICOMDIR, or "DICM" files) or a file is
+ * DICOM, for the dispatch; in dicom_detect.c. */
+int vxl_dicom_path_is_dicom(const char *path, int is_dir);
+
+#endif

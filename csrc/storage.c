@@ -1,0 +1,22 @@
+/* storage.c - which storage table serves a volume. A new mode is a new
+ * table (storage.h) and one line here. */
+#include "budget.h"
+#include "renderer_internal.h"
+
+static const vxl_storage_ops *const tables[VXL_STORAGE_COUNT] = {
+    [VXL_STORAGE_AUTO] = &vxl_storage_bricked, /* reached only when dense does not fit; the plan picks bricked or sparse */
+    [VXL_STORAGE_DENSE] = &vxl_storage_dense,
+    [VXL_STORAGE_BRICKED] = &vxl_storage_bricked,
+    [VXL_STORAGE_SPARSE] = &vxl_storage_sparse,
+    [VXL_STORAGE_COMPRESSED] = &vxl_storage_compressed,
+};
+
+const vxl_storage_ops *vxl_storage_ops_for(uint32_t mode) { return mode < VXL_STORAGE_COUNT ? tables[mode] : NULL; }
+
+uint32_t vxl_storage_choose(const vxl_renderer *r, const vxl_volume *v)
+{
+    if (r->storage.request != VXL_STORAGE_AUTO) return r->storage.request;
+    for (int a = 0; a < 3; a++)
+        if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size) return VXL_STORAGE_AUTO;
+    return vxl_budget_fits(r->budget, NULL, VXL_HOLD_STORAGE, v->storage_bytes) ? VXL_STORAGE_DENSE : VXL_STORAGE_AUTO;
+}

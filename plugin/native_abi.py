@@ -1,0 +1,261 @@
+"""The C ABI of libvoxlight (csrc/include/voxlight.h and voxlight_dev.h) as
+ctypes: constants, the parameter and result structs, the error types, and
+the pointer and matrix conversions every call uses. No library is loaded
+here. tests/python/test_abi.py checks every struct's size and field offsets
+against the C compiler's.
+
+Part of the ctypes binding; plugin/native.py re-exports it."""
+
+import ctypes
+
+import numpy as np
+
+ABI_VERSION = 1
+
+# The names this binding was written against, in VXL_* order. The library is
+# the authority: Library.names(kind) reads vxl_<kind>_name() up to the first
+# NULL, so a value added to the library shows up in the add-on without
+# editing this file; these tuples are only the fallback when no library can
+# be loaded (the UI still registers). tests/python/test_abi.py keeps them
+# equal to the library's.
+FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed", "cubic",
+           "cubic-smooth")
+PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
+BACKENDS = ("auto", "osmesa", "egl")
+STORAGES = ("auto", "dense", "bricked", "sparse", "compressed")  # VXL_STORAGE_*
+CLASSIFY_MODES = ("post", "pre", "preint")  # VXL_CLASSIFY_*
+GRADIENT_OPACITY_MODES = ("off", "boundary", "iso")  # VXL_GOPACITY_*
+# The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
+ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "storage": STORAGES,
+                  "classify": CLASSIFY_MODES, "gradient_opacity": GRADIENT_OPACITY_MODES,
+                  "gradient_store": ("8bit", "16f", "32f")}
+MAX_LIGHTS = 8
+RENDER_PARAMS_RESERVED = 17  # VXL_RENDER_PARAMS_RESERVED
+
+_DTYPES = {
+    np.dtype(np.uint8): 1, np.dtype(np.int8): 2,
+    np.dtype(np.uint16): 3, np.dtype(np.int16): 4,
+    np.dtype(np.uint32): 5, np.dtype(np.int32): 6,
+    np.dtype(np.float32): 7, np.dtype(np.float64): 8,
+}
+
+c_float4x4 = ctypes.c_float * 16
+c_double4x4 = ctypes.c_double * 16
+
+
+# --------------------------------------------------------------- structs
+# Field order and types copied from voxlight.h (vxl_phantom_desc from
+# voxlight_dev.h); only fixed-width types.
+
+class LoadOptions(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("max_dim", ctypes.c_uint32),
+                ("memory_budget_bytes", ctypes.c_uint64),
+                ("voxel_size", ctypes.c_double * 3),
+                ("frame", ctypes.c_uint32),      # 4D inputs: which volume
+                ("reserved0", ctypes.c_uint32),
+                ("series", ctypes.c_char_p)]     # DICOM: index or SeriesInstanceUID
+
+
+class DicomSeries(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("slice_count", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("loadable", ctypes.c_uint32),
+                ("frame_count", ctypes.c_uint32),
+                ("gantry_tilt_deg", ctypes.c_double),
+                ("uid", ctypes.c_char * 72),
+                ("modality", ctypes.c_char * 20),
+                ("description", ctypes.c_char * 72),
+                ("problem", ctypes.c_char * 256)]
+
+
+class VolumeDesc(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("dtype", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("has_affine", ctypes.c_uint32),
+                ("data", ctypes.c_void_p),
+                ("spacing", ctypes.c_double * 3),
+                ("affine", c_double4x4),
+                ("scl_slope", ctypes.c_double),
+                ("scl_inter", ctypes.c_double)]
+
+
+class VolumeInfo(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("dtype", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("nifti_version", ctypes.c_uint32),
+                ("spacing", ctypes.c_double * 3),
+                ("affine", c_double4x4),
+                ("value_min", ctypes.c_double),
+                ("value_max", ctypes.c_double),
+                ("nan_count", ctypes.c_uint64),
+                ("inf_count", ctypes.c_uint64),
+                ("storage_bytes", ctypes.c_uint64),
+                ("texture_bits", ctypes.c_uint32),
+                ("affine_source", ctypes.c_uint32),
+                ("frame_count", ctypes.c_uint32),
+                ("frame", ctypes.c_uint32)]
+
+
+class PhantomDesc(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("kind", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("seed", ctypes.c_uint32),
+                ("noise_sigma", ctypes.c_double)]
+
+
+class RendererOptions(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("backend", ctypes.c_uint32),
+                ("memory_budget_bytes", ctypes.c_uint64),
+                ("shader_dir", ctypes.c_char_p),
+                ("storage", ctypes.c_uint32),
+                ("page_brick", ctypes.c_uint32),
+                ("compressed_domain", ctypes.c_uint32)]  # developer hook (voxlight_dev.h)
+
+
+class RendererInfo(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("backend", ctypes.c_uint32),
+                ("max_3d_texture_size", ctypes.c_int32),
+                ("reserved", ctypes.c_uint32),
+                ("backend_name", ctypes.c_char * 32),
+                ("gl_renderer", ctypes.c_char * 128),
+                ("gl_version", ctypes.c_char * 128)]
+
+
+class Light(ctypes.Structure):
+    _fields_ = [("position", ctypes.c_float * 4),
+                ("color", ctypes.c_float * 3),
+                ("intensity", ctypes.c_float)]
+
+
+class RenderParams(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("width", ctypes.c_uint32),
+                ("height", ctypes.c_uint32),
+                ("has_camera", ctypes.c_uint32),
+                ("view", c_float4x4),
+                ("proj", c_float4x4),
+                ("azimuth_deg", ctypes.c_float),
+                ("elevation_deg", ctypes.c_float),
+                ("has_model", ctypes.c_uint32),
+                ("model", c_float4x4),
+                ("scene_depth", ctypes.POINTER(ctypes.c_float)),
+                ("filter", ctypes.c_uint32),
+                ("sample_distance", ctypes.c_float),
+                ("reuse_gradients", ctypes.c_uint32),
+                ("gradient_store", ctypes.c_uint32),
+                ("step", ctypes.c_float),
+                ("jitter_off", ctypes.c_uint32),
+                ("jitter_seed", ctypes.c_uint32),
+                ("preset", ctypes.c_uint32),
+                ("tf_size", ctypes.c_uint32),
+                ("tf_rgba", ctypes.POINTER(ctypes.c_float)),
+                ("has_window", ctypes.c_uint32),
+                ("window_low", ctypes.c_float),
+                ("window_high", ctypes.c_float),
+                ("opacity_scale", ctypes.c_float),
+                ("classify", ctypes.c_uint32),
+                ("shading_off", ctypes.c_uint32),
+                ("has_material", ctypes.c_uint32),
+                ("ambient", ctypes.c_float),
+                ("diffuse", ctypes.c_float),
+                ("specular", ctypes.c_float),
+                ("shininess", ctypes.c_float),
+                ("light_count", ctypes.c_uint32),
+                ("lights", Light * MAX_LIGHTS),
+                ("early_termination", ctypes.c_float),
+                ("depth_threshold", ctypes.c_float),
+                ("no_skip", ctypes.c_uint32),
+                ("preint_size", ctypes.c_uint32),
+                ("gradient_opacity", ctypes.c_uint32),
+                ("gradient_ref", ctypes.c_float),
+                ("gradient_exp", ctypes.c_float),
+                ("iso_value", ctypes.c_float),
+                ("iso_thickness", ctypes.c_float),
+                ("reserved", ctypes.c_uint32 * RENDER_PARAMS_RESERVED)]  # must stay 0
+
+
+class RenderStats(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("sample_bound", ctypes.c_uint32),
+                ("samples", ctypes.c_uint64),
+                ("max_ray_samples", ctypes.c_uint32),
+                ("rays", ctypes.c_uint32),
+                ("effective_step", ctypes.c_float),
+                ("bricks_total", ctypes.c_uint32),
+                ("bricks_occupied", ctypes.c_uint32),
+                ("brick_size", ctypes.c_uint32),
+                ("storage", ctypes.c_uint32),
+                ("resident_bytes", ctypes.c_uint64),
+                ("page_brick", ctypes.c_uint32),
+                ("pages_total", ctypes.c_uint32),
+                ("pages_resident", ctypes.c_uint32),
+                ("pages_constant", ctypes.c_uint32),
+                ("lod_level", ctypes.c_uint32),
+                ("lod_wanted_bytes", ctypes.c_uint64),
+                ("decode_ms", ctypes.c_double)]
+
+
+def _sized(struct_type):
+    s = struct_type()
+    s.struct_size = ctypes.sizeof(struct_type)
+    return s
+
+
+# ---------------------------------------------------------------- errors
+
+class VoxlightError(RuntimeError):
+    """A library call failed; .code is the VXL_ERR_* value, str() the message."""
+
+    def __init__(self, message, code=0, name=""):
+        super().__init__(message)
+        self.code = code
+        self.name = name
+
+
+class LibraryUnavailable(VoxlightError):
+    """libvoxlight.so is missing, fails to load or has another ABI."""
+
+
+class LibraryObject:
+    """Base of the objects that hold a library handle (Volume, Renderer):
+    close() frees it, and so do garbage collection and the end of a with
+    block."""
+
+    def close(self):
+        raise NotImplementedError
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+# --------------------------------------------------------------- helpers
+
+def _fptr(arr):
+    return arr.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+
+
+def _matrix_cm(m, ctype=ctypes.c_float):
+    """4x4 math matrix (m[row][col]) -> 16 column-major values."""
+    a = np.asarray(m, dtype=np.float64).reshape(4, 4)
+    return (ctype * 16)(*a.T.ravel().tolist())
+
+
+def matrix_from_cm(values):
+    """16 column-major values -> numpy 4x4 math matrix."""
+    return np.array(list(values), dtype=np.float64).reshape(4, 4).T

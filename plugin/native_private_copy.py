@@ -1,0 +1,216 @@
+"""Private copies of libvoxlight and its reader helpers, so the library is
+never mapped from the add-on's own folder (see below), and the execute bit
+Blender's zip install drops from the helpers.
+
+Part of the ctypes binding; plugin/native.py re-exports it."""
+
+import errno
+import fcntl
+import hashlib
+import os
+import shutil
+import tempfile
+import time
+
+# The reader processes the library starts, found next to the library itself
+# (csrc/reader_spawn.c, csrc/reader_stream.h): voxlight-read-oiio (TIFF/PNG
+# stacks and OpenVDB) and voxlight-read-dicom; every voxlight-read-* file is
+# shipped and copied with the library.
+HELPER_PREFIX = "voxlight-read-"
+VDB_HELPER_NAME = "voxlight-read-oiio"  # the one that reads .vdb files
+OLD_VDB_HELPER_NAME = "voxlight-vdb-read"  # its name in older builds
+
+
+# ------------------------------------------------- private library copies
+#
+# Installing an add-on over itself writes the new files where the old ones
+# are; if libvoxlight.so were mapped from there, the running Blender would
+# crash at its next call into it. So the library is loaded from a copy in a
+# cache folder named by the content's hash, together with the reader helpers
+# it starts from its own folder (found with dladdr, csrc/reader_spawn.c). An
+# updated add-on has another hash, hence a new folder and a fresh dlopen
+# (dlopen of the old path would hand back the old, already loaded library).
+# Each process holds a shared flock on the folder it uses; a folder nobody
+# holds is stale and removed by the next load.
+
+_LOCK_NAME = ".in-use"
+_held_locks = {}  # folder -> open lock file, kept for the life of the process
+
+
+def helper_names(folder):
+    """The helper executables shipped next to the library in folder."""
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    return sorted(n for n in names
+                  if (n.startswith(HELPER_PREFIX) or n == OLD_VDB_HELPER_NAME)
+                  and os.path.isfile(os.path.join(folder, n)))
+
+
+# Set by the add-on when Blender gives it a folder of its own (an
+# extension's user folder, 4.2+; compat.private_data_dir).
+CACHE_DIR = None
+
+
+def cache_roots():
+    """Where private copies may go, best first: VOXLIGHT_CACHE_DIR, the
+    add-on's own folder (CACHE_DIR), the XDG cache folder, then the
+    temporary folder."""
+    roots = []
+    for d in (os.environ.get("VOXLIGHT_CACHE_DIR"), CACHE_DIR):
+        if d:
+            roots.append(d)
+    xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    roots.append(os.path.join(xdg, "voxlight", "lib"))
+    roots.append(os.path.join(tempfile.gettempdir(), "voxlight-%d" % os.getuid(), "lib"))
+    return roots
+
+
+def _content_key(files):
+    h = hashlib.sha256()
+    for f in files:
+        h.update(os.path.basename(f).encode() + b"\0")
+        with open(f, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+        h.update(b"\0")
+    return h.hexdigest()[:24]
+
+
+def _hold(folder):
+    """Take a shared lock on folder's lock file; False when the folder went
+    away meanwhile (a cleaner removed it)."""
+    if folder in _held_locks:
+        return True
+    lock = os.path.join(folder, _LOCK_NAME)
+    try:
+        fd = os.open(lock, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH)
+        st, held = os.stat(lock), os.fstat(fd)
+        if (st.st_dev, st.st_ino) != (held.st_dev, held.st_ino):
+            raise OSError(errno.ESTALE, "%s was replaced" % lock)
+    except OSError:
+        os.close(fd)
+        return False
+    _held_locks[folder] = fd
+    return True
+
+
+def _complete(folder, files):
+    return all(os.path.isfile(os.path.join(folder, os.path.basename(f))) and
+               os.path.getsize(os.path.join(folder, os.path.basename(f))) == os.path.getsize(f)
+               for f in files)
+
+
+def _make_copy(root, key, files):
+    """root/key holding a copy of files (made atomically by renaming a
+    finished folder into place); returns the folder."""
+    folder = os.path.join(root, key)
+    if os.path.isdir(folder) and _complete(folder, files) and _hold(folder):
+        return folder
+    os.makedirs(root, exist_ok=True)
+    stage = tempfile.mkdtemp(prefix=".stage-", dir=root)
+    try:
+        for i, f in enumerate(files):
+            dest = os.path.join(stage, os.path.basename(f))
+            shutil.copyfile(f, dest)
+            os.chmod(dest, 0o644 if i == 0 else 0o755)  # files[0] is the library
+        open(os.path.join(stage, _LOCK_NAME), "w").close()
+        try:
+            os.rename(stage, folder)
+        except OSError:
+            # Another process put it in place first, or a broken copy is in
+            # the way: use this process's own copy under another name.
+            if os.path.isdir(folder) and _complete(folder, files) and _hold(folder):
+                shutil.rmtree(stage, ignore_errors=True)
+                return folder
+            folder = "%s-%d" % (folder, os.getpid())
+            shutil.rmtree(folder, ignore_errors=True)
+            os.rename(stage, folder)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    if not _hold(folder):
+        raise OSError(errno.ENOENT, "%s vanished" % folder)
+    return folder
+
+
+def clean_stale_copies(root):
+    """Remove copies no process holds (their flock is free). Safe while
+    other Blenders run: a held folder is never touched."""
+    try:
+        names = os.listdir(root)
+    except OSError:
+        return
+    for name in names:
+        folder = os.path.join(root, name)
+        if folder in _held_locks or not os.path.isdir(folder):
+            continue
+        if name.startswith(".stage-"):
+            # A copy being made now, or left by a crash: only old ones go.
+            try:
+                if time.time() - os.path.getmtime(folder) > 3600:
+                    shutil.rmtree(folder, ignore_errors=True)
+            except OSError:
+                pass
+            continue
+        try:
+            fd = os.open(os.path.join(folder, _LOCK_NAME), os.O_RDONLY)
+        except OSError:
+            continue  # not ours (no lock file): leave it
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue  # in use by a running process
+        try:
+            # Unlink the lock file last, so that a loader that opened it
+            # before the removal sees it gone (_hold compares inodes).
+            for entry in os.listdir(folder):
+                if entry != _LOCK_NAME:
+                    os.unlink(os.path.join(folder, entry))
+            os.unlink(os.path.join(folder, _LOCK_NAME))
+            os.rmdir(folder)
+        except OSError:
+            pass
+        finally:
+            os.close(fd)
+
+
+def private_copy(path):
+    """The path of a private copy of the library at path, with the helpers
+    that sit next to it, or None when no cache folder is writable (the
+    library is then loaded in place)."""
+    src = os.path.dirname(os.path.abspath(path))
+    files = [os.path.abspath(path)] + [os.path.join(src, n) for n in helper_names(src)]
+    try:
+        key = _content_key(files)
+    except OSError:
+        return None
+    for root in cache_roots():
+        try:
+            folder = _make_copy(root, key, files)
+        except OSError:
+            continue
+        clean_stale_copies(root)
+        return os.path.join(folder, os.path.basename(path))
+    return None
+
+
+def restore_execute_bit(path):
+    """Blender installs an add-on zip with zipfile.extractall, which drops
+    file modes, so the shipped helper arrives without its execute bit: give
+    it back (execute where it is readable). Returns whether path is now
+    executable; a missing or read-only helper is left to the library, whose
+    error names it when a .vdb is loaded."""
+    try:
+        mode = os.stat(path).st_mode
+        if not os.access(path, os.X_OK):
+            os.chmod(path, mode | ((mode & 0o444) >> 2))
+    except OSError:
+        return False
+    return os.access(path, os.X_OK)

@@ -1,0 +1,238 @@
+"""libvoxlight renderers: the render params built from the add-on's
+settings (make_params), and the Renderer, whole-frame or tiled.
+
+Part of the ctypes binding; plugin/native.py re-exports it."""
+
+import ctypes
+import os
+import time
+
+import numpy as np
+
+from .native_abi import (LibraryObject, MAX_LIGHTS, RenderParams, RenderStats, RendererInfo,
+                         RendererOptions, VoxlightError, matrix_from_cm, _fptr, _matrix_cm, _sized)
+from .native_library import load_library
+from .native_tiles import _empty_stats, _merge_stats, tile_params
+
+
+# ----------------------------------------------------------- render params
+
+def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth=None,
+                filter="central", sample_distance=1.0, reuse_gradients=False,
+                gradient_16f=False, step=0.5, jitter=True, jitter_seed=0,
+                preset="auto", window=None, opacity_scale=1.0, shading=True,
+                material=None, lights=(), azimuth=0.0, elevation=0.0,
+                early_termination=0.0, depth_threshold=0.0, no_skip=False,
+                tf_rgba=None, classify="post", gradient_opacity="off", gradient_ref=0.0,
+                gradient_exp=0.0, iso_value=0.0, iso_thickness=0.0, preint_size=0,
+                lib=None):
+    """Build a RenderParams. Keyword names are the Blender panel's. `lights`
+    is a sequence of (position4, color3, intensity); `material` is
+    (ambient, diffuse, specular, shininess) or None for the defaults;
+    `window` is (low, high) or None for the preset's default. `tf_rgba` is
+    an (n, 4) straight-RGBA table (alpha = opacity per voxel of path) that
+    replaces the preset; `window` maps its [0, 1] onto data values.
+    `classify` and `gradient_opacity` are the library's names of their modes
+    (Library.names("classify"), ...) or their VXL_* numbers."""
+    lib = lib or load_library()
+    p = _sized(RenderParams)
+    p.width, p.height = int(width), int(height)
+    if view is not None or proj is not None:
+        if view is None or proj is None:
+            raise ValueError("view and proj must be given together")
+        p.has_camera = 1
+        p.view = _matrix_cm(view)
+        p.proj = _matrix_cm(proj)
+    p.azimuth_deg, p.elevation_deg = azimuth, elevation
+    if model is not None:
+        p.has_model = 1
+        p.model = _matrix_cm(model)
+    p._keep = []
+    if scene_depth is not None:
+        w, h = p.width or 512, p.height or 512
+        d = np.ascontiguousarray(scene_depth, dtype=np.float32)
+        if d.size != w * h:
+            raise ValueError("scene_depth has %d values, image has %dx%d" % (d.size, w, h))
+        p._keep.append(d)
+        p.scene_depth = _fptr(d)
+        p._scene_depth = d
+    p.filter = filter if isinstance(filter, int) else lib.filter_index(filter)
+    p.sample_distance = sample_distance
+    p.reuse_gradients = 1 if reuse_gradients else 0
+    p.gradient_store = 1 if gradient_16f else 0
+    p.step = step
+    p.jitter_off = 0 if jitter else 1
+    p.jitter_seed = jitter_seed
+    p.preset = preset if isinstance(preset, int) else lib.preset_index(preset)
+    if window is not None:
+        p.has_window = 1
+        p.window_low, p.window_high = float(window[0]), float(window[1])
+    if tf_rgba is not None:
+        tf = np.ascontiguousarray(tf_rgba, dtype=np.float32).reshape(-1, 4)
+        if len(tf) < 2:
+            raise ValueError("tf_rgba needs at least 2 entries")
+        p._keep.append(tf)
+        p._tf = tf
+        p.tf_size = len(tf)
+        p.tf_rgba = _fptr(tf)
+    p.classify = classify if isinstance(classify, int) else lib.index("classify", classify)
+    p.gradient_opacity = (gradient_opacity if isinstance(gradient_opacity, int)
+                          else lib.index("gradient_opacity", gradient_opacity))
+    p.gradient_ref = gradient_ref
+    p.gradient_exp = gradient_exp
+    p.iso_value = iso_value
+    p.iso_thickness = iso_thickness
+    p.preint_size = preint_size
+    p.opacity_scale = opacity_scale
+    p.shading_off = 0 if shading else 1
+    if material is not None:
+        p.has_material = 1
+        p.ambient, p.diffuse, p.specular, p.shininess = [float(v) for v in material]
+    lights = list(lights)
+    if len(lights) > MAX_LIGHTS:
+        raise ValueError("at most %d lights" % MAX_LIGHTS)
+    p.light_count = len(lights)
+    for i, (pos, col, inten) in enumerate(lights):
+        p.lights[i].position[:] = [float(v) for v in pos]
+        p.lights[i].color[:] = [float(v) for v in col]
+        p.lights[i].intensity = float(inten)
+    p.early_termination = early_termination
+    p.depth_threshold = depth_threshold
+    p.no_skip = 1 if no_skip else 0
+    return p
+
+
+# -------------------------------------------------------------- renderer
+
+class Renderer(LibraryObject):
+    """One library renderer: its own GL context on its own thread, holding
+    one volume. Safe to call from any Python thread."""
+
+    def __init__(self, backend="auto", memory_budget=0, shader_dir=None, lib=None,
+                 storage="auto", page_brick=0):
+        self.lib = lib or load_library()
+        opt = _sized(RendererOptions)
+        opt.backend = self.lib.index("backend", backend) if isinstance(backend, str) else int(backend)
+        opt.memory_budget_bytes = memory_budget
+        opt.storage = self.lib.index("storage", storage) if isinstance(storage, str) else int(storage)
+        opt.page_brick = page_brick
+        opt.shader_dir = os.fsencode(shader_dir) if shader_dir else None
+        h = ctypes.c_void_p()
+        self.lib.check(self.lib.cdll.vxl_renderer_create(ctypes.byref(opt), ctypes.byref(h)),
+                       what="renderer")
+        self._handle = h
+        self.volume_info = None
+        # Called with no arguments after every vxl_render (counts library calls).
+        self.on_render = None
+
+    @property
+    def handle(self):
+        if not self._handle:
+            raise VoxlightError("renderer is closed")
+        return self._handle
+
+    def _check(self, code, what=""):
+        self.lib.check(code, self._handle, what)
+
+    def info(self):
+        i = _sized(RendererInfo)
+        self._check(self.lib.cdll.vxl_renderer_get_info(self.handle, ctypes.byref(i)))
+        return {"backend": i.backend, "backend_name": i.backend_name.decode(),
+                "gl_renderer": i.gl_renderer.decode(), "gl_version": i.gl_version.decode(),
+                "max_3d_texture_size": i.max_3d_texture_size}
+
+    def set_volume(self, volume):
+        self._check(self.lib.cdll.vxl_renderer_set_volume(self.handle, volume.handle),
+                    "set volume")
+        self.volume_info = dict(volume.info)
+
+    def render(self, params=None, want_depth=True, **kwargs):
+        """Render; returns (rgba[h, w, 4], depth[h, w] or None), float32,
+        row 0 = bottom, premultiplied RGBA."""
+        if params is None:
+            params = make_params(lib=self.lib, **kwargs)
+        w, h = params.width or 512, params.height or 512
+        rgba = np.empty((h, w, 4), np.float32)
+        depth = np.empty((h, w), np.float32) if want_depth else None
+        self._check(self.lib.cdll.vxl_render(self.handle, ctypes.byref(params), _fptr(rgba),
+                                             _fptr(depth) if want_depth else None), "render")
+        if self.on_render is not None:
+            self.on_render()
+        return rgba, depth
+
+    def stats(self):
+        """What the last render did (vxl_renderer_get_stats) as a dict."""
+        st = _sized(RenderStats)
+        self._check(self.lib.cdll.vxl_renderer_get_stats(self.handle, ctypes.byref(st)), "stats")
+        d = {k: getattr(st, k) for k, _t in RenderStats._fields_ if k != "struct_size"}
+        d["storage_name"] = self.lib.name("storage", d["storage"]) or "?"
+        return d
+
+    def render_tiled(self, params, rect=None, rows=None, target_seconds=0.05,
+                     should_stop=None):
+        """Render the image `params` describes as horizontal bands of the
+        pixel rectangle `rect` = (x0, y0, x1, y1) (default: the whole
+        image); pixels outside it are empty (alpha 0, depth +inf), which is
+        exact when rect holds the volume's screen footprint.
+
+        Each band is one library call, sized to take about target_seconds
+        (or `rows` rows), and should_stop() is asked before every band: a
+        caller on another thread abandons a stale frame within one band,
+        and the renderer (whose calls serialize) is free again. Returns
+        (rgba, depth, stats), or None when stopped. Equals render() up to
+        float rounding of the narrowed projections (the jitter pattern is
+        the same)."""
+        W, H = params.width or 512, params.height or 512
+        rgba = np.zeros((H, W, 4), np.float32)
+        depth = np.full((H, W), np.inf, np.float32)
+        acc = _empty_stats()
+        x0, y0, x1, y1 = rect if rect is not None else (0, 0, W, H)
+        x0, y0, x1, y1 = max(0, x0), max(0, y0), min(W, x1), min(H, y1)
+        if x1 <= x0 or y1 <= y0:
+            return rgba, depth, acc
+        n = int(rows) if rows else max(1, 16384 // (x1 - x0))  # first band ~16k pixels
+        y = y0
+        t_start = time.perf_counter()
+        while y < y1:
+            if should_stop is not None and should_stop():
+                return None
+            n = max(1, min(n, y1 - y))
+            tp = tile_params(params, x0, y, x1, y + n)
+            t = time.perf_counter()
+            c, d = self.render(tp)
+            dt = time.perf_counter() - t
+            rgba[y:y + n, x0:x1] = c
+            depth[y:y + n, x0:x1] = d
+            _merge_stats(acc, self.stats())
+            acc["calls"] += 1
+            y += n
+            if not rows:  # aim at target_seconds, growing at most 2x per band
+                n = int(max(1, min(2 * n, y1 - y0, target_seconds * n / max(dt, 1e-4))))
+        acc["seconds"] = time.perf_counter() - t_start
+        return rgba, depth, acc
+
+    def default_camera(self, params=None, **kwargs):
+        """(view, proj) as numpy 4x4 math matrices."""
+        if params is None:
+            params = make_params(lib=self.lib, **kwargs)
+        view = (ctypes.c_float * 16)()
+        proj = (ctypes.c_float * 16)()
+        self._check(self.lib.cdll.vxl_default_camera(self.handle, ctypes.byref(params),
+                                                     view, proj), "default camera")
+        return matrix_from_cm(view), matrix_from_cm(proj)
+
+    def probe_gradients(self, points, params=None, **kwargs):
+        """Gradient of the selected filter at voxel-space points (n, 3)."""
+        if params is None:
+            params = make_params(lib=self.lib, **kwargs)
+        pts = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+        out = np.empty_like(pts)
+        self._check(self.lib.cdll.vxl_probe_gradients(self.handle, ctypes.byref(params),
+                                                      _fptr(pts), len(pts), _fptr(out)),
+                    "probe gradients")
+        return out
+
+    def close(self):
+        if self._handle:
+            self.lib.cdll.vxl_renderer_destroy(self._handle)
+            self._handle = None

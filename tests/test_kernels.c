@@ -1,0 +1,212 @@
+/* test_kernels.c - the kernels that derive volumes exist once in GLSL
+ * (shaders/lib/, shaders/compute/); the two CPU copies that bricked and
+ * sparse storage need (csrc/bspline_bricks.c: the B-spline prefilter of a
+ * brick from the CPU bricks, and the precomputed filter's largest gradient)
+ * must give what the GLSL gives on the same data. The volume is small
+ * enough that every brick's prefilter window spans whole lines (P = 8, at
+ * most 16 voxels an axis: a window reaches 12 voxels past the brick and its
+ * ghost), so the CPU and the GLSL filter exactly the same lines:
+ * - the prefilter: to float rounding. The CPU runs the GLSL's recursion
+ *   step for step, but C11 rounds every product and sum (-std=c11 does not
+ *   contract a*b+c), while GLSL lets the compiler fuse and reorder float
+ *   operations that are not `precise`; on llvmpipe about a tenth of the
+ *   probed components differ by 1-2 ulp (still a twentieth with `precise`
+ *   on the accumulators). Bit-exactness would need the GLSL changed, and
+ *   with it every dense cubic render.
+ * - the largest gradient: to float rounding, because the CPU runs the blur
+ *   and the Sobel as separable 3-tap passes (9 + 3x9 multiplies a voxel
+ *   instead of 2 x 27) and so sums in another order than the GLSL.
+ * A kernel that differs in anything but rounding (pole, gain, boundary,
+ * weights, clamping) is off by orders more than that bound (ROUNDINGS). */
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "test_util.h"
+#include "voxlight_dev.h"
+
+/* "to float rounding": within 64 roundings (relative 2^-24 each) of the
+ * largest component, one per term of the longest sum involved (the cubic
+ * weighs 64 coefficients, the Sobel 26 taps of 27-tap blurs); measured: 1
+ * (cubic) and 4 (precomputed), against what test_paging's
+ * storage comparison allows (5e-4, about 2^13; its windows are truncated). */
+#define ROUNDINGS (64.0 / 16777216.0)
+
+#define NX 16
+#define NY 15
+#define NZ 13
+
+/* deterministic white noise in [0, 1): every line has detail to filter */
+static double field_noise(double x, double y, double z, const double *prm)
+{
+    (void)prm;
+    uint32_t h = (uint32_t)x * 73856093u ^ (uint32_t)y * 19349663u ^ (uint32_t)z * 83492791u;
+    h ^= h >> 13;
+    h *= 0x5bd1e995u;
+    h ^= h >> 15;
+    return (double)(h >> 8) / 16777216.0;
+}
+
+static vxl_renderer *make_stored(uint32_t storage)
+{
+    vxl_renderer_options o;
+    memset(&o, 0, sizeof o);
+    o.struct_size = sizeof o;
+    o.backend = software_backend();
+    o.storage = storage;
+    o.page_brick = storage == VXL_STORAGE_DENSE ? 0 : 8;
+    vxl_renderer *r = NULL;
+    return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
+}
+
+/* dense and bricked renderers holding the noise volume; 0 on failure */
+static int make_pair(vxl_renderer *rs[2])
+{
+    rs[0] = make_stored(VXL_STORAGE_DENSE);
+    rs[1] = make_stored(VXL_STORAGE_BRICKED);
+    vxl_volume *v = make_volume_f32(NX, NY, NZ, field_noise, NULL);
+    int ok = rs[0] && rs[1] && v && vxl_renderer_set_volume(rs[0], v) == VXL_OK &&
+             vxl_renderer_set_volume(rs[1], v) == VXL_OK;
+    vxl_volume_destroy(v);
+    return ok;
+}
+
+/* the page brick the last frame used (0: dense): renders one */
+static uint32_t page_brick_of(vxl_renderer *r, const vxl_render_params *p)
+{
+    static float img[16 * 16 * 4];
+    if (vxl_render(r, p, img, NULL) != VXL_OK) return 0;
+    vxl_render_stats s;
+    memset(&s, 0, sizeof s);
+    s.struct_size = sizeof s;
+    return vxl_renderer_get_stats(r, &s) == VXL_OK ? s.page_brick : 0;
+}
+
+/* The cubic filter reads the coefficients texel-exact and weighs them with
+ * the same GLSL in both storages: the probed gradients, at points all over
+ * the box (brick faces included), differ only as the GLSL prefilter's
+ * (dense) and the CPU's (bricked) coefficients do. */
+TEST(bspline_prefilter_cpu_equals_glsl_to_rounding)
+{
+    vxl_renderer *rs[2] = {NULL, NULL};
+    REQUIRE(make_pair(rs));
+    enum { N = 3000 };
+    static float pts[N * 3], out[2][N * 3];
+    const float dims[3] = {NX, NY, NZ};
+    uint32_t seed = 777;
+    for (int i = 0; i < N * 3; i++) {
+        seed = seed * 1664525u + 1013904223u;
+        pts[i] = (float)(seed >> 8) / 16777216.0f * dims[i % 3] - 0.5f;
+    }
+    vxl_render_params p = phantom_scene(16, 16, VXL_FILTER_CUBIC, VXL_CLASSIFY_POST);
+    for (int i = 0; i < 2; i++)
+        CHECKF(vxl_probe_gradients(rs[i], &p, pts, N, out[i]) == VXL_OK, "%s", vxl_last_error());
+    CHECK(page_brick_of(rs[1], &p) == 8); /* really bricked: coefficients from bspline_bricks.c */
+    int differ = 0, first = -1;
+    double gmax = 0, err = 0;
+    for (int i = 0; i < N * 3; i++) {
+        gmax = fmax(gmax, fabs(out[0][i]));
+        err = fmax(err, fabs(out[1][i] - out[0][i]));
+        if (memcmp(&out[0][i], &out[1][i], sizeof(float))) {
+            differ++;
+            if (first < 0) first = i;
+        }
+    }
+    fprintf(stderr, "    cubic: %d of %d components differ, by at most %.2e (largest component %.3f)\n", differ, N * 3, err, gmax);
+    CHECK(gmax > 0.1);
+    CHECKF(err <= ROUNDINGS * gmax, "%.3g of the largest component; first differing: %d, dense %.9g, bricked %.9g",
+           err / gmax, first, first < 0 ? 0.0 : out[0][first], first < 0 ? 0.0 : out[1][first]);
+    vxl_renderer_destroy(rs[0]);
+    vxl_renderer_destroy(rs[1]);
+}
+
+/* The precomputed filter stores gradient / largest |gradient|: dense finds
+ * that maximum with the GLSL blur and Sobel, bricked on the CPU. At voxel
+ * centres (no interpolation) the probe gives stored * maximum, so the two
+ * agree to float rounding of the maximum and the stored value. */
+TEST(gradient_max_cpu_equals_glsl_to_rounding)
+{
+    vxl_renderer *rs[2] = {NULL, NULL};
+    REQUIRE(make_pair(rs));
+    enum { N = NX * NY * NZ };
+    static float pts[N * 3], out[2][N * 3];
+    for (int i = 0; i < N; i++) {
+        pts[3 * i] = (float)(i % NX);
+        pts[3 * i + 1] = (float)(i / NX % NY);
+        pts[3 * i + 2] = (float)(i / (NX * NY));
+    }
+    vxl_render_params p = phantom_scene(16, 16, VXL_FILTER_PRECOMPUTED, VXL_CLASSIFY_POST);
+    p.gradient_store = VXL_GRADIENT_STORE_32F;
+    for (int i = 0; i < 2; i++)
+        CHECKF(vxl_probe_gradients(rs[i], &p, pts, N, out[i]) == VXL_OK, "%s", vxl_last_error());
+    CHECK(page_brick_of(rs[1], &p) == 8);
+    double gmax = 0, err = 0;
+    for (int i = 0; i < N * 3; i++) {
+        gmax = fmax(gmax, fabs(out[0][i]));
+        err = fmax(err, fabs(out[1][i] - out[0][i]));
+    }
+    fprintf(stderr, "    precomputed: largest component %.4f, off by at most %.2e (%.2g of it)\n", gmax, err,
+            err / gmax);
+    CHECK(gmax > 0.01);
+    CHECKF(err <= ROUNDINGS * gmax, "%.3g of the largest component", err / gmax);
+    vxl_renderer_destroy(rs[0]);
+    vxl_renderer_destroy(rs[1]);
+}
+
+/* The source tree's shaders/, from this binary's place (BUILD/tests/):
+ * found from any working directory; 0 when not found. */
+static int source_shader_dir(char *out, size_t n)
+{
+    char exe[PATH_MAX];
+    if (!realpath("/proc/self/exe", exe)) return 0;
+    for (int up = 0; up < 3; up++) {
+        char *slash = strrchr(exe, '/');
+        if (!slash) return 0;
+        *slash = '\0';
+    }
+    return snprintf(out, n, "%s/shaders", exe) < (int)n;
+}
+
+/* VOXLIGHT_SHADER_DIR / shader_dir names the shaders/ folder and resolves
+ * every name (programs in compute/ and render/, includes from lib/) as the
+ * embedded copies do: the same image, bit for bit, for a filter that
+ * includes the shared stencils and for the precomputed passes. */
+TEST(shader_dir_reads_the_layout_the_library_embeds)
+{
+    char dir[PATH_MAX];
+    REQUIRE(source_shader_dir(dir, sizeof dir));
+    vxl_renderer_options o;
+    memset(&o, 0, sizeof o);
+    o.struct_size = sizeof o;
+    o.backend = software_backend();
+    vxl_renderer *re = NULL, *rd = NULL;
+    REQUIRE(vxl_renderer_create(&o, &re) == VXL_OK);
+    o.shader_dir = dir;
+    REQUIRE(vxl_renderer_create(&o, &rd) == VXL_OK);
+    vxl_volume *v = make_volume_f32(NX, NY, NZ, field_noise, NULL);
+    REQUIRE(v && vxl_renderer_set_volume(re, v) == VXL_OK && vxl_renderer_set_volume(rd, v) == VXL_OK);
+    vxl_volume_destroy(v);
+    const uint32_t filters[2] = {VXL_FILTER_SOBEL26, VXL_FILTER_PRECOMPUTED};
+    static float a[32 * 32 * 4], b[32 * 32 * 4];
+    for (int f = 0; f < 2; f++) {
+        vxl_render_params p = phantom_scene(32, 32, filters[f], VXL_CLASSIFY_POST);
+        CHECKF(vxl_render(re, &p, a, NULL) == VXL_OK, "embedded: %s", vxl_renderer_error(re));
+        CHECKF(vxl_render(rd, &p, b, NULL) == VXL_OK, "from %s: %s", dir, vxl_renderer_error(rd));
+        CHECKF(!memcmp(a, b, sizeof a) && alpha_sum(a, 32 * 32) > 1, "%s: the images differ or are empty",
+               vxl_filter_name(filters[f]));
+    }
+    vxl_renderer_destroy(re);
+    vxl_renderer_destroy(rd);
+}
+
+int main(void)
+{
+    RUN(bspline_prefilter_cpu_equals_glsl_to_rounding);
+    RUN(gradient_max_cpu_equals_glsl_to_rounding);
+    RUN(shader_dir_reads_the_layout_the_library_embeds);
+    return TEST_SUMMARY();
+}

@@ -48,6 +48,170 @@ void emit_nothing()
     o_depth = uintBitsToFloat(0x7f800000u); // +inf
 }
 
+// What march knows of a ray for add_sample: view-space position pos0 + t *
+// dpos, planar distance z0 + t * dz, the lighting (shade()).
+struct RaySetup {
+    float z0, dz;
+    vec3 pos0, dpos;
+    bool one_directional;
+#ifdef SHADING
+    RayLighting lighting;
+#endif
+};
+
+// What add_sample carries from sample to sample.
+struct Compositing {
+    vec4 acc; // premultiplied
+    float depth;
+#ifdef REUSE_GRADIENTS
+    // "previous sample" is the previous sample along the ray: a transparent
+    // or skipped one has no gradient, so the state restarts after it
+    GradientState gs;
+    int last_shaded;
+#endif
+};
+
+// The work on sample i, at t, position p, value v, that adds something: c is
+// its straight colour and per-voxel opacity (the premultiplied segment for
+// CLASSIFY_PREINT, the final opacity for GOPACITY 2, whose gradient is g).
+// Opacity correction, gradient, shading, compositing into s; false once the
+// ray is opaque enough to stop.
+bool add_sample(inout Compositing s, RaySetup r, int i, float t, vec3 p, float v, vec4 c, vec3 g)
+{
+#if GOPACITY == 2
+    float a = c.a;
+    vec3 rgb = c.rgb;
+#elif defined(CLASSIFY_PREINT)
+    float a = c.a;
+    vec3 rgb = c.rgb / a;
+#else
+    float a = correct_opacity(c.a, u_step);
+    vec3 rgb = c.rgb;
+#endif
+#if GOPACITY == 1
+    g = gradient_at(p, v);
+    a = gradient_opacity(a, v, length(g)); // region boundaries: scaled by |grad|
+    if (a <= 0.0) return true;
+#endif
+#ifdef SHADING
+#if GOPACITY == 0
+    g = gradient_at(p, v);
+#endif
+#ifdef REUSE_GRADIENTS
+    if (s.last_shaded != i - 1) s.gs = gradient_state_init();
+    s.last_shaded = i;
+    g = reuse_gradient(s.gs, g);
+#endif
+    rgb = shade(rgb, g, r.pos0 + t * r.dpos, r.lighting, r.one_directional);
+#endif
+    s.acc += (1.0 - s.acc.a) * a * vec4(rgb, 1.0);
+    if (isinf(s.depth) && s.acc.a >= u_depth_threshold) s.depth = -(r.z0 + r.dz * t);
+    return s.acc.a < u_early_termination;
+}
+
+// With a gradient per visible sample, march's inner loop stops at each
+// visible sample and the outer one does its work (see there); without, that
+// work is too cheap to wait for and the inner loop does it on the way.
+#if defined(SHADING) || GOPACITY == 1
+#define DEFER_VISIBLE 1
+#endif
+
+// One ray from t0 to t1 (o + t * dir in voxels): premultiplied colour, the
+// depth where it reached u_depth_threshold, the samples taken.
+vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, out uint taken)
+{
+    float jitter = u_jitter != 0 ? jitter_hash(uvec2(gl_FragCoord.xy), u_jitter_seed) : 0.0;
+    // Sample positions are t_start + i * step for integer i, whether or not
+    // empty space is skipped, so skipping changes no sample that counts.
+    float t_start = t0 + jitter * u_step;
+    Compositing s;
+    s.acc = vec4(0.0);
+    s.depth = uintBitsToFloat(0x7f800000u);
+#ifdef REUSE_GRADIENTS
+    s.gs = gradient_state_init();
+    s.last_shaded = -2;
+#endif
+#ifdef CLASSIFY_PREINT
+    // the first segment is a point: constant value over its step
+    float v_prev = sample_value(o + t_start * dir);
+#endif
+    taken = 0u;
+    // Two loops: the inner one walks over the samples that add nothing
+    // (skipped or transparent), the outer one does the work of a sample that
+    // adds something. On 8-wide SIMD (llvmpipe) every lane runs a branch that
+    // any lane takes, so with one loop every lane paid for a gradient and
+    // shading at every step where a neighbour needed them; here a lane that
+    // found its next visible sample waits for the others to find theirs.
+    int i = 0;
+    for (;; i++) {
+        bool visible = false;
+        float t = 0.0, v = 0.0;
+        vec3 p = vec3(0.0), g = vec3(0.0);
+        vec4 c = vec4(0.0);
+        for (; i < u_max_steps; i++) {
+            t = t_start + float(i) * u_step;
+            if (t >= t1) break;
+            p = o + t * dir;
+            int leap = -1;
+            if (u_skip != 0) {
+                ivec3 b = ivec3(floor((p + 0.5) / float(u_brick_size)));
+                uint k = texelFetch(u_brick_distance, clamp(b, ivec3(0), textureSize(u_brick_distance, 0) - 1), 0).r;
+                if (k > 0u) {
+                    // Leap to where the ray leaves the cube of 2k-1 empty bricks
+                    // around this one (Chebyshev distance map).
+                    vec3 lo = vec3(b - ivec3(k - 1u)) * float(u_brick_size) - 0.5;
+                    vec3 hi = vec3(b + ivec3(k)) * float(u_brick_size) - 0.5;
+                    vec3 tb = vec3(1e30);
+                    for (int a = 0; a < 3; a++)
+                        if (abs(dir[a]) >= 1e-12) tb[a] = ((dir[a] > 0.0 ? hi[a] : lo[a]) - o[a]) / dir[a];
+                    float t_exit = min(tb.x, min(tb.y, tb.z));
+                    // the sample at the exit is evaluated (minus a hair for rounding)
+                    int next = int(min(ceil((t_exit - t_start) / u_step - 1e-3), float(u_max_steps)));
+                    leap = max(i, next - 1); // the loop's i++ lands on `next`
+#ifndef CLASSIFY_PREINT
+                    i = leap;
+                    continue;
+#endif
+                }
+            }
+            taken++;
+            v = sample_value(p);
+#if GOPACITY == 2
+            // iso-surface of constant thickness: the colour and opacity of the
+            // iso value, fading out over iso_thickness voxels of the gradient
+            c = classify(u_gopacity_param.x);
+            g = gradient_at(p, v);
+            c.a = correct_opacity(gradient_opacity(c.a, v, length(g)), u_step);
+#elif defined(CLASSIFY_PREINT)
+            // A segment ending in an empty brick is still integrated: its front
+            // may lie in an occupied one. After a leap the next segment starts
+            // from the last sample inside the empty region.
+            c = preint_segment(v_prev, v);
+            if (leap >= 0 && leap > i) {
+                i = leap;
+                v_prev = sample_value(o + (t_start + float(i) * u_step) * dir);
+            } else {
+                v_prev = v;
+            }
+#elif defined(CLASSIFY_PRE)
+            c = pre_classified(p);
+#else
+            c = classify(v);
+#endif
+            if (c.a <= 0.0) continue;
+#ifdef DEFER_VISIBLE
+            visible = true;
+            break;
+#else
+            if (!add_sample(s, r, i, t, p, v, c, g)) break;
+#endif
+        }
+        if (!visible || !add_sample(s, r, i, t, p, v, c, g)) break;
+    }
+    depth = s.depth;
+    return s.acc;
+}
+
 void main()
 {
     vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
@@ -85,106 +249,29 @@ void main()
     }
     if (!(t0 < t1)) { emit_nothing(); return; }
 
-    vec3 view_dir = -normalize(mat3(u_mv) * dir);
-    float jitter = u_jitter != 0 ? jitter_hash(uvec2(gl_FragCoord.xy), u_jitter_seed) : 0.0;
-    // Sample positions are t_start + i * step for integer i, whether or not
-    // empty space is skipped, so skipping changes no sample that counts.
-    float t_start = t0 + jitter * u_step;
-    vec4 acc = vec4(0.0);
-    float depth = uintBitsToFloat(0x7f800000u);
-#ifdef REUSE_GRADIENTS
-    // "previous sample" is the previous sample along the ray: a transparent
-    // or skipped one has no gradient, so the state restarts after it
-    GradientState gs = gradient_state_init();
-    int last_shaded = -2;
-#endif
-#ifdef CLASSIFY_PREINT
-    // the first segment is a point: constant value over its step
-    float v_prev = sample_value(o + t_start * dir);
-#endif
-    uint taken = 0u;
-    for (int i = 0; i < u_max_steps; i++) {
-        float t = t_start + float(i) * u_step;
-        if (t >= t1) break;
-        vec3 p = o + t * dir;
-        int leap = -1;
-        if (u_skip != 0) {
-            ivec3 b = ivec3(floor((p + 0.5) / float(u_brick_size)));
-            uint k = texelFetch(u_brick_distance, clamp(b, ivec3(0), textureSize(u_brick_distance, 0) - 1), 0).r;
-            if (k > 0u) {
-                // Leap to where the ray leaves the cube of 2k-1 empty bricks
-                // around this one (Chebyshev distance map).
-                vec3 lo = vec3(b - ivec3(k - 1u)) * float(u_brick_size) - 0.5;
-                vec3 hi = vec3(b + ivec3(k)) * float(u_brick_size) - 0.5;
-                vec3 tb = vec3(1e30);
-                for (int a = 0; a < 3; a++)
-                    if (abs(dir[a]) >= 1e-12) tb[a] = ((dir[a] > 0.0 ? hi[a] : lo[a]) - o[a]) / dir[a];
-                float t_exit = min(tb.x, min(tb.y, tb.z));
-                // the sample at the exit is evaluated (minus a hair for rounding)
-                int next = int(min(ceil((t_exit - t_start) / u_step - 1e-3), float(u_max_steps)));
-                leap = max(i, next - 1); // the loop's i++ lands on `next`
-#ifndef CLASSIFY_PREINT
-                i = leap;
-                continue;
-#endif
-            }
-        }
-        taken++;
-        float v = sample_value(p);
-#if GOPACITY == 2
-        // iso-surface of constant thickness: the colour and opacity of the
-        // iso value, fading out over iso_thickness voxels of the gradient
-        vec4 c = classify(u_gopacity_param.x);
-        vec3 g = gradient_at(p, v);
-        float a = correct_opacity(gradient_opacity(c.a, v, length(g)), u_step);
-        if (a <= 0.0) continue;
-        vec3 rgb = c.rgb;
-#elif defined(CLASSIFY_PREINT)
-        // A segment ending in an empty brick is still integrated: its front
-        // may lie in an occupied one. After a leap the next segment starts
-        // from the last sample inside the empty region.
-        vec4 seg = preint_segment(v_prev, v);
-        if (leap >= 0 && leap > i) {
-            i = leap;
-            v_prev = sample_value(o + (t_start + float(i) * u_step) * dir);
-        } else {
-            v_prev = v;
-        }
-        float a = seg.a;
-        if (a <= 0.0) continue;
-        vec3 rgb = seg.rgb / a;
-#elif defined(CLASSIFY_PRE)
-        vec4 c = pre_classified(p);
-        if (c.a <= 0.0) continue;
-        float a = correct_opacity(c.a, u_step);
-        vec3 rgb = c.rgb;
-#else
-        vec4 c = classify(v);
-        if (c.a <= 0.0) continue;
-        float a = correct_opacity(c.a, u_step);
-        vec3 rgb = c.rgb;
-#endif
-#if GOPACITY == 1
-        vec3 g = gradient_at(p, v);
-        a = gradient_opacity(a, v, length(g)); // region boundaries: scaled by |grad|
-        if (a <= 0.0) continue;
-#endif
+    // View-space position is affine in t too: no matrix product per sample.
+    RaySetup r;
+    r.z0 = z0;
+    r.dz = dz;
+    r.pos0 = (u_mv * vec4(o, 1.0)).xyz;
+    r.dpos = mat3(u_mv) * dir;
+    r.one_directional = true;
+    float depth;
+    uint taken;
 #ifdef SHADING
-#if GOPACITY == 0
-        vec3 g = gradient_at(p, v);
-#endif
-#ifdef REUSE_GRADIENTS
-        if (last_shaded != i - 1) gs = gradient_state_init();
-        last_shaded = i;
-        g = reuse_gradient(gs, g);
-#endif
-        vec3 pos = (u_mv * vec4(p, 1.0)).xyz;
-        rgb = shade(rgb, g, pos, view_dir);
-#endif
-        acc += (1.0 - acc.a) * a * vec4(rgb, 1.0);
-        if (isinf(depth) && acc.a >= u_depth_threshold) depth = -(z0 + dz * t);
-        if (acc.a >= u_early_termination) break;
+    r.lighting = ray_lighting(-normalize(r.dpos));
+    // Two copies of the march, one without a loop over the lights (shade()):
+    // one_directional is a constant at each call.
+    vec4 acc;
+    if (u_light_count == 1 && u_light_pos[0].w == 0.0) {
+        acc = march(o, dir, t0, t1, r, depth, taken);
+    } else {
+        r.one_directional = false;
+        acc = march(o, dir, t0, t1, r, depth, taken);
     }
+#else
+    vec4 acc = march(o, dir, t0, t1, r, depth, taken);
+#endif
     uint old = atomicAdd(st_samples_lo, taken);
     if (old + taken < old) atomicAdd(st_samples_hi, 1u); // carry into the high word
     atomicMax(st_max_ray, taken);

@@ -1,6 +1,6 @@
 /* bspline.c - coefficients of the interpolating cubic B-spline for the
  * `cubic` gradient filter, computed on the GL side once per volume
- * (shaders/bspline_prefilter.comp) and kept until the volume changes. */
+ * (shaders/compute/bspline_prefilter.comp) and kept until the volume changes. */
 #include <stdlib.h>
 
 #include "holdings.h"

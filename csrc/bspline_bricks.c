@@ -5,7 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#define POLE (-0.26794919243112270f) /* sqrt(3) - 2, as shaders/bspline_prefilter.comp */
+#define POLE (-0.26794919243112270f) /* sqrt(3) - 2, as shaders/compute/bspline_prefilter.comp */
 #define GAIN 6.0f
 
 #define MAX_LINES 128 /* lines filtered together: at most a window edge */

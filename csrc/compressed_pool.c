@@ -3,7 +3,7 @@
  * pool), the palettes, and deferred filtering: the bricks a frame needs are
  * decoded (palette[code]) into the ordinary data pool, a small linear cache
  * the PAGED ray caster filters with hardware trilinear
- * (shaders/decode_bricks.comp). Filtering the codes themselves would be
+ * (shaders/compute/decode_bricks.comp). Filtering the codes themselves would be
  * wrong: reconstruction is a table lookup, not linear in the codes. */
 #include <stdlib.h>
 #include <string.h>

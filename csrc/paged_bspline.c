@@ -1,7 +1,7 @@
 /* paged_bspline.c - the cubic filter with bricked and sparse storage: B-spline
  * coefficients brick by brick (bspline_bricks.c, on the CPU from the bricks'
  * values) in a coefficient pool with a one-voxel ghost and its own page
- * table, laid out like the data (shaders/gradients.glsl, coeff()). Only the
+ * table, laid out like the data (shaders/lib/gradients.glsl, coeff()). Only the
  * bricks a frame can read are made: those within the cubic footprint of a
  * visible sample whose coefficients are not one constant. */
 #include <stdlib.h>

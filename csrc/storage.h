@@ -39,7 +39,7 @@ typedef struct vxl_storage_ops {
     int (*prepare)(vxl_renderer *r, const vxl_frame *f);
     /* Program flags (VXL_FLAG_*) of shaders that sample this volume. */
     uint32_t (*sample_flags)(const vxl_renderer *r);
-    /* Binds the values on unit 0 and what translates samples, for prog. */
+    /* Binds the values on VXL_VOLUME_UNIT and what translates samples, for prog. */
     void (*bind)(vxl_renderer *r, GLuint prog);
     /* The texture holding the values texel for texel, and its size: what a
      * derived volume computed texel for texel (pre-classification) reads. */
@@ -181,7 +181,7 @@ uint64_t vxl_paged_derived_bytes(const vxl_renderer *r, const vxl_frame *f, uint
 
 #define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
 #define VXL_FLAG_COMPRESSED_DOMAIN 128u /* with PAGED: the pool holds codes, every tap decodes its 8 neighbours */
-#define VXL_PALETTES_PER_ROW 16 /* palettes per texel row of palette_tex (as shaders/palette.glsl) */
+#define VXL_PALETTES_PER_ROW 16 /* palettes per texel row of palette_tex (as shaders/lib/palette.glsl) */
 
 /* compressed_pool.c: compressed storage on the GL side */
 uint64_t vxl_code_bytes_for(const vxl_renderer *r, const vxl_pages *pg); /* UINT64_MAX: over the texture limit */

@@ -397,6 +397,13 @@ def busy():
         or runtime.busy()
 
 
+def busy_full():
+    """True while a full-resolution refine (not the half step) is queued or
+    being rendered."""
+    return any(st.job is not None and not st.job.done and getattr(st.job, "full", False)
+               for st in _states.values())
+
+
 # --------------------------------------------------------------- frames
 
 class _Frame:
@@ -633,6 +640,7 @@ def _refine_still(st, s, args, owner):
     if st.job is None or st.job.key != step.key or (st.job.done and st.job.result is None):
         st.cancel_job()
         st.job = args[1].worker.submit(runtime.Job(owner, step.key, step.params, step.rect))
+        st.job.full = step is full  # for busy_full(): the last, slowest refine step
         st.job_entry = args[1]
         st.announced = False
         _ensure_poll()

@@ -299,11 +299,11 @@ def steps():
     for i in range(3):
         r3d.view_rotation = Quaternion((0, 0, 1), math.radians(10)) @ r3d.view_rotation
         redraw(("VIEW_3D",))
-        for _ in range(100):  # until the refine has started
+        for _ in range(200):  # until the full-resolution refine has started (after the half)
             yield 0.05
-            if vp.busy():
+            if vp.busy_full():
                 break
-        in_flight_seen += vp.busy()
+        in_flight_seen += vp.busy_full()
         mark = vp.draw_count
         r3d.view_rotation = Quaternion((0, 0, 1), math.radians(-7)) @ r3d.view_rotation
         redraw(("VIEW_3D",))

@@ -230,7 +230,11 @@ run_c_tests() {
         set -e
         echo "$out" | grep -E 'FAIL|CHECK failed|REQUIRE failed|ERROR|runtime error|^software backend:' || true
         local line
-        line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1)
+        # || true: under pipefail a crashed test (no summary line) must not
+        # end the suite and hide the tests after it
+        line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1 || true)
+        # a crash: show the end of its output (the sanitizer's report and stack)
+        [ -n "$line" ] || echo "$out" | tail -n 60
         echo "$(basename "$t"): ${line:-crashed (exit $rc)}"
         if [ -n "$line" ]; then
             p=$((p + $(echo "$line" | grep -oE '^[0-9]+')))

@@ -3,7 +3,7 @@ Also Blender's own frame (PRE_VIEW -> POST_PIXEL, synced by a 1-pixel depth read
 the volume shown and hidden."""
 import math, os, sys, time
 import bpy, gpu
-from mathutils import Euler, Quaternion
+from mathutils import Quaternion
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "blender"))
 import _gui, _util as u
 
@@ -35,12 +35,7 @@ def steps():
     bpy.types.SpaceView3D.draw_handler_add(post_pixel, (), "WINDOW", "POST_PIXEL")
     scene = u.reset_scene()
     win, area, space = view3d()
-    space.shading.type = "SOLID"
-    r3d = space.region_3d
-    r3d.view_perspective = "PERSP"
-    r3d.view_location = (0.0, 0.0, 0.0)
-    r3d.view_rotation = Euler((math.radians(90), 0.0, 0.0)).to_quaternion()
-    r3d.view_distance = 4.0
+    r3d = _gui.front_view(space)
     region = [r for r in area.regions if r.type == "WINDOW"][0]
     print("region %dx%d" % (region.width, region.height), flush=True)
     with bpy.context.temp_override(window=win, area=area):

@@ -14,12 +14,26 @@ Pixels of the 3D viewport are read by a POST_PIXEL handler (Capture), after
 the add-on's own POST_VIEW composite.
 """
 
+import math
 import os
 import sys
 import time
 import traceback
 
 import bpy
+from mathutils import Euler
+
+
+def front_view(space):
+    """The GUI tests' view: Solid shading, perspective, from the front (-Y),
+    4 units from the origin. Returns the view's RegionView3D."""
+    space.shading.type = "SOLID"
+    r3d = space.region_3d
+    r3d.view_perspective = "PERSP"
+    r3d.view_location = (0.0, 0.0, 0.0)
+    r3d.view_rotation = Euler((math.radians(90), 0.0, 0.0)).to_quaternion()  # front, from -Y
+    r3d.view_distance = 4.0
+    return r3d
 
 
 class Run:

@@ -22,7 +22,7 @@ import time
 
 import bpy
 import numpy as np
-from mathutils import Euler, Quaternion
+from mathutils import Quaternion
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import _gui  # noqa: E402
@@ -61,13 +61,8 @@ def steps():
     scene.voxlight.viewport_resolution = 0.5  # llvmpipe: keep each render short
     scene.voxlight.settle_time = 0.3
     win, area, space = view3d()
-    space.shading.type = "SOLID"
     space.overlay.show_overlays = False  # no grid or outlines in the pixels
-    r3d = space.region_3d
-    r3d.view_perspective = "PERSP"
-    r3d.view_location = (0.0, 0.0, 0.0)
-    r3d.view_rotation = Euler((math.radians(90), 0.0, 0.0)).to_quaternion()  # front, from -Y
-    r3d.view_distance = 4.0
+    r3d = _gui.front_view(space)
     region = [r for r in area.regions if r.type == "WINDOW"][0]
     for a in win.screen.areas:  # the Voxlight panel (with its frame stats) is drawn too
         if a.type == "PROPERTIES":

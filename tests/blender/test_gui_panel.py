@@ -18,13 +18,11 @@ The steps run from a timer once the window exists; the script exits itself
 (a timer's exception would not reach --python-exit-code).
 """
 
-import math
 import os
 import sys
 
 import blf
 import bpy
-from mathutils import Euler
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import _gui  # noqa: E402
@@ -100,12 +98,7 @@ def steps():
     v3d = area_of(win, "VIEW_3D")
     props = area_of(win, "PROPERTIES")
     space = v3d.spaces.active
-    space.shading.type = "SOLID"
-    r3d = space.region_3d
-    r3d.view_perspective = "PERSP"
-    r3d.view_location = (0.0, 0.0, 0.0)
-    r3d.view_rotation = Euler((math.radians(90), 0.0, 0.0)).to_quaternion()
-    r3d.view_distance = 4.0
+    r3d = _gui.front_view(space)
     yield 0.5
     with bpy.context.temp_override(window=win, area=v3d):
         ob = u.import_volume(u.CH2)

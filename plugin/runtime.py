@@ -54,6 +54,7 @@ class Job:
         self.result = None   # (rgba, depth, stats) when finished
         self.error = None    # the exception when the library failed
         self.submitted = time.monotonic()
+        self.full = False    # the viewport's last refine step (full resolution), not the half
 
     @property
     def pending(self):

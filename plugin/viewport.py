@@ -400,7 +400,7 @@ def busy():
 def busy_full():
     """True while a full-resolution refine (not the half step) is queued or
     being rendered."""
-    return any(st.job is not None and not st.job.done and getattr(st.job, "full", False)
+    return any(st.job is not None and not st.job.done and st.job.full
                for st in _states.values())
 
 

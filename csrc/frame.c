@@ -211,7 +211,7 @@ static int resolve_matrices(vxl_frame *f, const vxl_render_params *p, const vxl_
 /* Every release of ABI 1 before the reserved room grew had this size (fields
  * were taken from reserved[] until one word was left): the oldest layout a
  * caller can have compiled against. */
-#define RENDER_PARAMS_OLDEST_SIZE (offsetof(vxl_render_params, reserved) + sizeof(uint32_t))
+#define RENDER_PARAMS_OLDEST_SIZE (offsetof(vxl_render_params, shading_model) + sizeof(uint32_t))
 
 int vxl_render_params_read(vxl_render_params *q, const vxl_render_params *p, vxl_err *e)
 {

@@ -30,7 +30,7 @@ ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "st
                   "classify": CLASSIFY_MODES, "gradient_opacity": GRADIENT_OPACITY_MODES,
                   "gradient_store": ("8bit", "16f", "32f")}
 MAX_LIGHTS = 8
-RENDER_PARAMS_RESERVED = 17  # VXL_RENDER_PARAMS_RESERVED
+RENDER_PARAMS_RESERVED = 9  # VXL_RENDER_PARAMS_RESERVED
 
 _DTYPES = {
     np.dtype(np.uint8): 1, np.dtype(np.int8): 2,
@@ -134,6 +134,14 @@ class Light(ctypes.Structure):
                 ("intensity", ctypes.c_float)]
 
 
+class LightShape(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("spot_direction", ctypes.c_float * 3),
+                ("spot_angle", ctypes.c_float),
+                ("spot_blend", ctypes.c_float),
+                ("size", ctypes.c_float)]
+
+
 class RenderParams(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("width", ctypes.c_uint32),
@@ -178,6 +186,13 @@ class RenderParams(ctypes.Structure):
                 ("gradient_exp", ctypes.c_float),
                 ("iso_value", ctypes.c_float),
                 ("iso_thickness", ctypes.c_float),
+                ("shading_model", ctypes.c_uint32),
+                ("light_shapes", ctypes.POINTER(LightShape)),
+                ("ambient_occlusion", ctypes.c_float),
+                ("occlusion_strength", ctypes.c_float),
+                ("anisotropy", ctypes.c_float),
+                ("illumination_size", ctypes.c_uint32),
+                ("technique", ctypes.c_uint32),
                 ("reserved", ctypes.c_uint32 * RENDER_PARAMS_RESERVED)]  # must stay 0
 
 

@@ -269,8 +269,56 @@ typedef struct vxl_light {
     float intensity;    /* 0 = 1 */
 } vxl_light;
 
-/* 17 words of room: the struct then ends on its 8-byte alignment, with no padding. */
-#define VXL_RENDER_PARAMS_RESERVED 17
+/* How a light is shaped (issue 17). params.light_shapes[i] goes with
+ * params.lights[i]; all zero is a plain light (today's). The array's stride
+ * is light_shapes[0].struct_size. */
+typedef struct vxl_light_shape {
+    uint32_t struct_size;
+    float spot_direction[3]; /* point light (w = 1) only: world direction the spot points along */
+    float spot_angle;        /* full cone angle, radians (Blender's spot_size); 0 = no cone */
+    float spot_blend;        /* 0..1, soft edge as Blender's spot_blend: the cone's mask is
+                                smoothstep(0, 1, (cos a - cos(angle/2)) / ((1 - cos(angle/2)) * blend)),
+                                a hard edge at 0 */
+    float size;              /* softness of its shadows: a directional light's angular diameter
+                                (radians, Blender's sun angle), a point light's radius (world
+                                units, Blender's shadow_soft_size); 0 = hard */
+} vxl_light_shape;
+
+/* Shading models (issue 17), params.shading_model. With T_i the transmittance
+ * from the sample to light i through the classified volume (exp of minus the
+ * optical depth, opacity per voxel of path as the ray caster composites it),
+ * AO the ambient occlusion (the mean transmittance over all directions along
+ * rays of ambient_occlusion voxels; 1 when that is 0) and s the
+ * occlusion_strength:
+ *   PHONG     today's local shading: ambient + sum of the lights' diffuse and
+ *             specular terms; no shadows.
+ *   SHADOWED  ambient * (1 - s (1 - AO)) + sum of T_i * (the light's diffuse
+ *             and specular terms).
+ *   SCATTER   ambient * (1 - s (1 - AO)) + sum of T_i * I_i * (w * (diffuse +
+ *             specular terms) + (1 - w) * diffuse * 4 pi * HG(cos t, g)), the
+ *             hybrid of Kroes et al. 2012: w = min(1, |grad| / gradient_ref) of
+ *             the normalised value per voxel (gradient_ref 0 = 0.05), HG the
+ *             Henyey-Greenstein phase function with g = anisotropy and t the
+ *             angle between the light's travel and the direction to the eye
+ *             (g > 0 scatters forward, towards a viewer facing the light).
+ * shading_off still gives pure emission-absorption. */
+#define VXL_SHADING_PHONG 0
+#define VXL_SHADING_SHADOWED 1
+#define VXL_SHADING_SCATTER 2
+#define VXL_SHADING_COUNT 3
+VXL_API const char *vxl_shading_model_name(uint32_t model); /* "phong", "shadowed", "scatter" */
+
+/* Rendering techniques (issue 16), params.technique. The slice-based ones are
+ * comparison modes for the benchmark (Engel et al., Real-Time Volume Graphics,
+ * ch. 3), with the ray caster's classification and shading. */
+#define VXL_TECHNIQUE_RAYCAST 0
+#define VXL_TECHNIQUE_SLICES2D 1 /* object-aligned slice stacks, the stack chosen by view direction */
+#define VXL_TECHNIQUE_SLICES3D 2 /* view-aligned slices, proxy polygons clipped to the box */
+#define VXL_TECHNIQUE_COUNT 3
+VXL_API const char *vxl_technique_name(uint32_t technique); /* "raycast", "slices2d", "slices3d" */
+
+/* 9 words of room: the struct then ends on its 8-byte alignment, with no padding. */
+#define VXL_RENDER_PARAMS_RESERVED 9
 
 typedef struct vxl_render_params {
     uint32_t struct_size;
@@ -328,6 +376,15 @@ typedef struct vxl_render_params {
     float gradient_exp;              /* 0 = 1 */
     float iso_value;                 /* data units (ISO) */
     float iso_thickness;             /* voxels; 0 = 1 (ISO) */
+    /* lighting (issue 17): see VXL_SHADING_* */
+    uint32_t shading_model;          /* VXL_SHADING_* */
+    const vxl_light_shape *light_shapes; /* NULL, or light_count entries (stride: their struct_size) */
+    float ambient_occlusion;         /* occlusion radius, voxels; 0 = off */
+    float occlusion_strength;        /* 0..1; 0 = 1 */
+    float anisotropy;                /* Henyey-Greenstein g in (-1, 1), SCATTER */
+    uint32_t illumination_size;      /* cells along the illumination volumes' longest side; 0 = automatic */
+    /* technique (issue 16): VXL_TECHNIQUE_* */
+    uint32_t technique;
     /* Room for the next features (fields taken from here keep the struct's
      * size and offsets). Must be zero: vxl_render fails with
      * VXL_ERR_INVALID_ARGUMENT naming the word otherwise. */

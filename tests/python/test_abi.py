@@ -29,6 +29,7 @@ BINDINGS = {
     "vxl_renderer_options": native.RendererOptions,
     "vxl_renderer_info": native.RendererInfo,
     "vxl_light": native.Light,
+    "vxl_light_shape": native.LightShape,
     "vxl_render_params": native.RenderParams,
     "vxl_render_stats": native.RenderStats,
     "vxl_phantom_desc": native.PhantomDesc,

@@ -372,15 +372,20 @@ def test_closed_handles(lib, ball_file):
 def test_render_params_tail_matches_header():
     """Issue 6's fields replaced the reserved slots, keeping the size (624
     bytes up to reserved[0]) until issue 15 gave the struct new reserved room
-    after them (offsets and sizes against the compiler: test_abi.py)."""
+    after them (offsets and sizes against the compiler: test_abi.py), from
+    which issues 16 and 17 took their fields: the oldest layout still ends
+    where the first of them begins plus one word."""
     import ctypes
     P = native.RenderParams
-    assert P.reserved.offset + 4 == 624
+    assert P.shading_model.offset + 4 == 624
+    assert ctypes.sizeof(P) == 688
     assert ctypes.sizeof(P) == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
-    names = [n for n, _t in P._fields_][-7:]
+    names = [n for n, _t in P._fields_][-14:]
     assert names == ["preint_size", "gradient_opacity", "gradient_ref", "gradient_exp",
-                     "iso_value", "iso_thickness", "reserved"]
+                     "iso_value", "iso_thickness", "shading_model", "light_shapes",
+                     "ambient_occlusion", "occlusion_strength", "anisotropy", "illumination_size",
+                     "technique", "reserved"]
 
 
 def test_make_params_transfer_function_and_modes(lib):

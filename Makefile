@@ -37,11 +37,11 @@ HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume error loader_uti
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
-STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study
+STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlight-slicingbench
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
-all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(STUDIES) $(TESTS)
+all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(STUDIES) $(TESTS)
 
 $(BUILD)/obj/%.o: csrc/%.c $(wildcard csrc/*.h csrc/include/*.h) | $(BUILD)/obj
 	$(CC) $(CFLAGS) -c $< -o $@
@@ -103,7 +103,13 @@ $(BUILD)/filter-scan-study: bench/filter_scan_study.c $(BUILD)/libvoxlight.so
 $(BUILD)/cubic-probe-study: bench/cubic_probe_study.c $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
+$(BUILD)/voxlight-slicingbench: bench/slicing_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
 $(BUILD)/voxlight-storagebench: bench/storage_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
+$(BUILD)/voxlight-lightbench: bench/lighting_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h tests/fuzz/*.h) $(BUILD)/libvoxlight.so | $(BUILD)/tests

@@ -303,13 +303,27 @@ case "$cmd" in
         mkdir -p bench/out
         ./build/voxlight-bench "$mode" --out bench/results.csv --scene-dir bench/out
         ./build/voxlight-skipbench $([ "$mode" = --quick ] && echo --quick) --out bench/skipping.csv
+        ./build/voxlight-slicingbench $([ "$mode" = --quick ] && echo --quick) \
+            --out "$([ "$mode" = --quick ] && echo bench/out/slicing.csv || echo bench/slicing.csv)"
         ./build/voxlight-storagebench $([ "$mode" = --quick ] && echo --quick) \
             --out "$([ "$mode" = --quick ] && echo bench/out/storage.csv || echo bench/storage.csv)"
+        # Issue 17: shadows, occlusion and scattering (docs/lighting.md pastes bench/out/lighting_tables.md).
+        light_csv=$([ "$mode" = --quick ] && echo bench/out/lighting.csv || echo bench/lighting.csv)
+        ./build/voxlight-lightbench $([ "$mode" = --quick ] && echo --quick) --out "$light_csv"
+        /usr/bin/python3 bench/plot_lighting.py "$light_csv" \
+            --png "$([ "$mode" = --quick ] && echo bench/out/lighting.png || echo docs/lighting.png)" \
+            --md bench/out/lighting_tables.md --command "./build.sh bench $mode"
         steps=$([ "$mode" = --quick ] && echo 0.5 || echo 1,0.5,0.25)
         xvfb-run -a -s "-screen 0 1024x768x24" /usr/bin/python3 bench/vtk_peer.py bench/out/scene_ch2better.json \
             --out bench/results.csv --steps "$steps"
+        # Per covered pixel against VTK: two transfer functions on two volumes.
+        cmp_csv=$([ "$mode" = --quick ] && echo bench/out/vtk_compare.csv || echo bench/vtk_compare.csv)
+        xvfb-run -a -s "-screen 0 1024x768x24" /usr/bin/python3 bench/vtk_compare.py \
+            --size "$([ "$mode" = --quick ] && echo 64 || echo 512)" --frames "$([ "$mode" = --quick ] && echo 3 || echo 5)" \
+            --out "$cmp_csv" --md bench/out/vtk_compare.md --command "./build.sh bench $mode"
         if [ "$mode" = --quick ]; then dest=bench/out/benchmark; else dest=docs/benchmark; fi
-        /usr/bin/python3 bench/plot.py bench/results.csv --png "$dest.png" --md "$dest.md" --command "./build.sh bench $mode" ;;
+        /usr/bin/python3 bench/plot.py bench/results.csv --png "$dest.png" --md "$dest.md" --command "./build.sh bench $mode"
+        { echo; cat bench/out/vtk_compare.md; } >> "$dest.md" ;;
     bpy)
         bpy_venvs ;;
     clean)

@@ -75,7 +75,7 @@ def transfer_function(scene):
         table = mri_table()
     else:
         sys.exit("vtk_peer: preset %r has no mirror here; add tf_rgba to the scene JSON" % scene["preset"])
-    lo, hi = scene.get("window", [scene["value_min"], scene["value_max"]])
+    lo, hi = scene["window"] if "window" in scene else (scene["value_min"], scene["value_max"])
     # One node per table entry at the data value our shader maps onto that
     # entry's centre: both sides then interpolate the same piecewise-linear
     # function (VTK resamples it into its own texture, a small difference).
@@ -166,6 +166,81 @@ def write_png(path, pic):
     writer.Write()
 
 
+class Peer:
+    """VTK's GPU ray caster set up for one frame: VTK's defaults except what
+    must match ours (the settings table in docs/benchmark.md): the sample distance
+    (automatic adjustment off), trilinear interpolation, opacity per voxel
+    of path, shading with our material, the camera. The light is VTK's
+    default headlight; jittering off and image sample distance 1 are VTK's
+    defaults, set here so a change of default cannot slip in."""
+
+    def __init__(self, img, voxel, color, opacity, material, w, h, view, proj):
+        ambient, diffuse, specular, shininess = material
+        prop = vtk.vtkVolumeProperty()
+        prop.SetColor(color)
+        prop.SetScalarOpacity(opacity)
+        prop.SetScalarOpacityUnitDistance(voxel)  # table alpha = opacity per voxel of path
+        prop.SetInterpolationTypeToLinear()  # VTK's default is nearest
+        prop.ShadeOn()
+        prop.SetAmbient(ambient)
+        prop.SetDiffuse(diffuse)
+        prop.SetSpecular(specular)
+        prop.SetSpecularPower(shininess)
+
+        mapper = vtk.vtkGPUVolumeRayCastMapper()  # the factory gives vtkOpenGLGPUVolumeRayCastMapper
+        mapper.SetInputData(img)
+        mapper.SetBlendModeToComposite()
+        mapper.AutoAdjustSampleDistancesOff()  # otherwise VTK changes the step to meet a frame rate
+        mapper.LockSampleDistanceToInputSpacingOff()
+        mapper.SetImageSampleDistance(1.0)
+        mapper.UseJitteringOff()  # VTK's default; our bench frame is jittered, the reference is not (see docs)
+
+        volume = vtk.vtkVolume()
+        volume.SetMapper(mapper)
+        volume.SetProperty(prop)
+
+        ren = vtk.vtkRenderer()
+        ren.SetBackground(0, 0, 0)
+        ren.SetBackgroundAlpha(0)  # black transparent: the read-back is premultiplied like ours
+        ren.AutomaticLightCreationOff()
+        light = vtk.vtkLight()
+        light.SetLightTypeToHeadlight()  # white, intensity 1, from the eye: what VTK creates by default
+        ren.AddLight(light)
+        ren.TwoSidedLightingOn()
+        ren.AddVolume(volume)
+
+        win = vtk.vtkRenderWindow()
+        win.SetOffScreenRendering(1)
+        win.SetAlphaBitPlanes(1)
+        win.SetMultiSamples(0)
+        win.SetSize(w, h)
+        win.AddRenderer(ren)
+        self.camera_diff = set_camera(ren.GetActiveCamera(), view, proj, w, h)
+        win.Render()  # creates the GL context (and uploads the volume) so the renderer string can be read
+        self.gl_renderer = gl_renderer(win)
+        self.backend = ("llvmpipe-glx" if "llvmpipe" in self.gl_renderer
+                        else self.gl_renderer.split()[0].lower() + "-glx")
+        self.win, self.ren, self.mapper, self.prop, self.w, self.h = win, ren, mapper, prop, w, h
+        self.buf = vtk.vtkFloatArray()
+        self.voxel = voxel
+
+    def frame(self):
+        self.win.Render()
+        self.win.GetRGBAPixelData(0, 0, self.w - 1, self.h - 1, 0, self.buf)  # back buffer, row 0 = bottom
+
+    def image(self):
+        """The last frame as premultiplied float RGBA (h, w, 4), row 0 = bottom.
+        RGBA8 framebuffer over black with alpha 0: rgb is already
+        premultiplied; clamp away float read-back noise."""
+        return np.clip(numpy_support.vtk_to_numpy(self.buf).reshape(self.h, self.w, 4), 0, 1).astype(np.float32)
+
+    def set_step(self, step):
+        self.mapper.SetSampleDistance(step * self.voxel)
+
+    def clipping_range(self):
+        return self.ren.GetActiveCamera().GetClippingRange()
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scene")
@@ -195,61 +270,15 @@ def main():
     if np.ptp(spacing) > 1e-6 * voxel:
         print("vtk_peer: warning: anisotropic spacing %s, using the mean" % spacing, file=sys.stderr)
     color, opacity = transfer_function(scene)
-    ambient, diffuse, specular, shininess = scene["material"]
 
-    prop = vtk.vtkVolumeProperty()
-    prop.SetColor(color)
-    prop.SetScalarOpacity(opacity)
-    prop.SetScalarOpacityUnitDistance(voxel)  # table alpha = opacity per voxel of path
-    prop.SetInterpolationTypeToLinear()
-    prop.ShadeOn()
-    prop.SetAmbient(ambient)
-    prop.SetDiffuse(diffuse)
-    prop.SetSpecular(specular)
-    prop.SetSpecularPower(shininess)
-
-    mapper = vtk.vtkGPUVolumeRayCastMapper()  # the factory gives vtkOpenGLGPUVolumeRayCastMapper
-    mapper.SetInputData(img)
-    mapper.SetBlendModeToComposite()
-    mapper.AutoAdjustSampleDistancesOff()  # otherwise VTK changes the step to meet a frame rate
-    mapper.LockSampleDistanceToInputSpacingOff()
-    mapper.SetImageSampleDistance(1.0)
-    mapper.UseJitteringOff()  # our bench frame is jittered; the reference is not (see docs)
-
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetProperty(prop)
-
-    ren = vtk.vtkRenderer()
-    ren.SetBackground(0, 0, 0)
-    ren.SetBackgroundAlpha(0)  # black transparent: the read-back is premultiplied like ours
-    ren.AutomaticLightCreationOff()
-    light = vtk.vtkLight()
-    light.SetLightTypeToHeadlight()  # white, intensity 1, from the eye
-    ren.AddLight(light)
-    ren.TwoSidedLightingOn()
-    ren.AddVolume(volume)
-
-    win = vtk.vtkRenderWindow()
-    win.SetOffScreenRendering(1)
-    win.SetAlphaBitPlanes(1)
-    win.SetMultiSamples(0)
-    win.SetSize(w, h)
-    win.AddRenderer(ren)
-    dv, dp = set_camera(ren.GetActiveCamera(), view, proj, w, h)
-    win.Render()  # creates the GL context (and uploads the volume) so the renderer string can be read
-    renderer = gl_renderer(win)
-    backend = "llvmpipe-glx" if "llvmpipe" in renderer else renderer.split()[0].lower() + "-glx"
+    peer = Peer(img, voxel, color, opacity, scene["material"], w, h, view, proj)
+    dv, dp = peer.camera_diff
+    renderer, backend, frame = peer.gl_renderer, peer.backend, peer.frame
     reference = reference_label(a.out, name)
-    buf = vtk.vtkFloatArray()
-
-    def frame():
-        win.Render()
-        win.GetRGBAPixelData(0, 0, w - 1, h - 1, 0, buf)  # back buffer, row 0 = bottom
 
     runs, rows = [], []
     for step in steps:
-        mapper.SetSampleDistance(step * voxel)
+        peer.set_step(step)
         t0 = time.perf_counter()
         frame()  # warm-up: shader variant, tables for this sample distance
         warm_ms = (time.perf_counter() - t0) * 1e3
@@ -259,9 +288,7 @@ def main():
             frame()
             times.append((time.perf_counter() - t0) * 1e3)
         ms = statistics.median(times)
-        # RGBA8 framebuffer over black with alpha 0: rgb is already
-        # premultiplied; clamp away float read-back noise.
-        pic = np.clip(numpy_support.vtk_to_numpy(buf).reshape(h, w, 4), 0, 1).astype(np.float32)
+        pic = peer.image()
         rmse, psnr, maxabs = errors(pic, ref)
         run = dict(step=step, sample_distance_world=step * voxel, ms_median=ms, frames_ms=[round(t, 2) for t in times],
                    warmup_ms=round(warm_ms, 1), vtk_vs_ref=dict(rmse=rmse, psnr_db=psnr))
@@ -291,7 +318,7 @@ def main():
             wr.writeheader()
         wr.writerows(rows)
 
-    near, far = ren.GetActiveCamera().GetClippingRange()  # after rendering: VTK must not have reset it
+    near, far = peer.clipping_range()  # after rendering: VTK must not have reset it
     print("vtk_peer: match: view max|diff| %.2g, proj max rel diff %.2g, clip %.1f..%.1f" % (dv, dp, near, far),
           file=sys.stderr)
     # Sidecar for the docs: what ran, and how well the camera was matched.

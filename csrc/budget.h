@@ -25,6 +25,7 @@ typedef enum vxl_holder {
     VXL_HOLD_GRADIENTS,  /* precomputed gradients (texture, or pool + page table) */
     VXL_HOLD_BSPLINE,    /* cubic B-spline coefficients (texture, or pool + page table) */
     VXL_HOLD_CLASSIFIED, /* the pre-classified volume (RGBA8) */
+    VXL_HOLD_ILLUMINATION, /* the illumination volumes: extinction, the lights' transmittance, occlusion */
     VXL_HOLD_COUNT
 } vxl_holder;
 

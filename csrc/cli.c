@@ -20,7 +20,9 @@ static const char usage_format[] =
     "                  [--gradient-store %s] [--classify %s] [--no-jitter] [--no-skip]\n"
     "                  [--gradient-opacity %s] [--gradient-ref G] [--iso VALUE] [--iso-thickness R]\n"
     "                  [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
-    "                  [--storage %s] [--page-brick 8|16|32|64]\n"
+    "                  [--storage %s] [--page-brick 8|16|32|64] [--renderer %s]\n"
+    "                  [--light dir:X,Y,Z[,INTENSITY] | point:X,Y,Z[,INTENSITY]]... [--shading %s]\n"
+    "                  [--ambient-occlusion RADIUS] [--anisotropy G]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
@@ -30,6 +32,11 @@ static const char usage_format[] =
     "         sparse keeps only the bricks the transfer function can show; compressed holds every brick\n"
     "         as a palette of <= 256 values + 8-bit codes and decodes the visible ones into a cache\n"
     "         (compressed storage: every filter but precomputed and cubic; bricked and sparse: every filter and mode)\n"
+    "renderer: raycast (default); slices2d / slices3d are the slice-based comparison modes (docs/slicing.md)\n"
+    "lights: --light (repeatable, up to 8) replaces the headlight: dir: the world direction towards a\n"
+    "         directional light, point: a point light's world position; INTENSITY > 0, default 1.\n"
+    "         --shading phong: local lighting; shadowed: with shadows and --ambient-occlusion (voxels,\n"
+    "         0 = off); scatter: also single scattering, forward for --anisotropy G > 0 (-0.99..0.99)\n"
     "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of\n"
     "         %s\n"
     "         (large-sparse: default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
@@ -52,12 +59,15 @@ static const char *name_list(name_fn name, uint32_t first, const char *sep, char
 
 static void print_usage(FILE *out)
 {
-    char backends[64], stores[64], classify[64], gopacity[64], storage[128], filters[256], presets[128], phantoms[256];
+    char backends[64], stores[64], classify[64], gopacity[64], storage[128], filters[256], presets[128], phantoms[256],
+        techniques[64], shading[64];
     fprintf(out, usage_format, name_list(vxl_backend_name, 0, "|", backends, sizeof backends),
             name_list(vxl_gradient_store_name, 0, "|", stores, sizeof stores),
             name_list(vxl_classify_name, 0, "|", classify, sizeof classify),
             name_list(vxl_gradient_opacity_name, 0, "|", gopacity, sizeof gopacity),
             name_list(vxl_storage_name, 0, "|", storage, sizeof storage),
+            name_list(vxl_technique_name, 0, "|", techniques, sizeof techniques),
+            name_list(vxl_shading_model_name, 0, "|", shading, sizeof shading),
             name_list(vxl_filter_name, 0, " ", filters, sizeof filters),
             name_list(vxl_preset_name, 0, " ", presets, sizeof presets),
             name_list(vxl_phantom_name, 1, " ", phantoms, sizeof phantoms));
@@ -138,6 +148,74 @@ static int enum_option(const char *what, const char *val, name_fn name, int (*fr
     if (from_name(val, out) == VXL_OK) return 0;
     char names[256];
     return die("unknown %s '%s' (%s)", what, val, name_list(name, 0, ", ", names, sizeof names));
+}
+
+/* The library has no reverse lookup for techniques: the names are few. */
+static int technique_from_name(const char *val, uint32_t *out)
+{
+    for (uint32_t i = 0; vxl_technique_name(i); i++)
+        if (!strcasecmp(vxl_technique_name(i), val)) {
+            *out = i;
+            return VXL_OK;
+        }
+    return VXL_ERR_INVALID_ARGUMENT;
+}
+
+/* "dir:X,Y,Z[,INTENSITY]" or "point:X,Y,Z[,INTENSITY]" -> a light in world
+ * space. */
+static int light_option(const char *val, vxl_render_params *p)
+{
+    if (p->light_count >= VXL_MAX_LIGHTS) return die("more than %d --light options", VXL_MAX_LIGHTS);
+    vxl_light *l = &p->lights[p->light_count];
+    memset(l, 0, sizeof *l);
+    const char *s;
+    if (!strncmp(val, "dir:", 4)) s = val + 4;
+    else if (!strncmp(val, "point:", 6)) s = val + 6, l->position[3] = 1;
+    else return die("bad --light '%s': use dir:X,Y,Z[,INTENSITY] or point:X,Y,Z[,INTENSITY]", val);
+    float v[4] = {0, 0, 0, 1}; /* X, Y, Z, intensity */
+    int n = 0;
+    for (;;) {
+        char *end;
+        double x = strtod(s, &end);
+        if (n == 4 || end == s || !isfinite(x) || (*end && *end != ','))
+            return die("bad --light '%s': three numbers X,Y,Z and an optional intensity", val);
+        v[n++] = (float)x;
+        if (!*end) break;
+        s = end + 1;
+    }
+    if (n < 3) return die("bad --light '%s': three numbers X,Y,Z and an optional intensity", val);
+    if (!(v[3] > 0) || v[3] > 1e6) return die("bad --light '%s': the intensity must be in (0, 1e6]", val);
+    if (l->position[3] == 0 && v[0] == 0 && v[1] == 0 && v[2] == 0)
+        return die("bad --light '%s': a direction cannot be zero", val);
+    memcpy(l->position, v, 3 * sizeof *v);
+    l->intensity = v[3];
+    p->light_count++;
+    return 0;
+}
+
+/* --light, --shading, --ambient-occlusion, --anisotropy (issue 17). Returns
+ * 1 if argv[*i] was one of them (*i advanced past its value), -1 on a bad
+ * value, 0 otherwise. The library checks the ranges and names the field. */
+static int parse_lighting_option(int argc, char **argv, int *i, vxl_render_params *p)
+{
+    const char *o = argv[*i];
+    if (strcmp(o, "--light") && strcmp(o, "--shading") && strcmp(o, "--ambient-occlusion") &&
+        strcmp(o, "--anisotropy"))
+        return 0;
+    if (*i + 1 >= argc) { die("%s needs a value", o); return -1; }
+    const char *val = argv[++*i];
+    if (!strcmp(o, "--light")) return light_option(val, p) ? -1 : 1;
+    if (!strcmp(o, "--shading"))
+        return enum_option("--shading", val, vxl_shading_model_name, vxl_shading_model_from_name, &p->shading_model)
+                   ? -1 : 1;
+    if (!strcmp(o, "--ambient-occlusion")) {
+        if (!parse_float(val, &p->ambient_occlusion) || p->ambient_occlusion < 0)
+            return die("bad --ambient-occlusion '%s': a radius in voxels, 0 = off", val), -1;
+        return 1;
+    }
+    if (!parse_float(val, &p->anisotropy) || !(fabsf(p->anisotropy) < 1))
+        return die("bad --anisotropy '%s': a number between -1 and 1 (exclusive)", val), -1;
+    return 1;
 }
 
 /* --frame N / --series S / --voxel-size X[,Y,Z], shared by render and info.
@@ -323,6 +401,9 @@ static int parse_render(int argc, char **argv, render_args *a)
         } else if (!strcmp(o, "--classify")) {
             NEED_VALUE();
             if (enum_option("--classify", val, vxl_classify_name, vxl_classify_from_name, &p->classify)) return 1;
+        } else if (!strcmp(o, "--renderer")) {
+            NEED_VALUE();
+            if (enum_option("--renderer", val, vxl_technique_name, technique_from_name, &p->technique)) return 1;
         }
         else if (!strcmp(o, "--gradient-store")) {
             NEED_VALUE();
@@ -346,6 +427,8 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (*end || (b != 8 && b != 16 && b != 32 && b != 64)) return die("bad --page-brick '%s': 8, 16, 32 or 64", val);
             a->ro.page_brick = (uint32_t)b;
         } else if ((r = parse_input_option(argc, argv, &i, &a->lo)) != 0) {
+            if (r < 0) return 1;
+        } else if ((r = parse_lighting_option(argc, argv, &i, p)) != 0) {
             if (r < 0) return 1;
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;

@@ -256,6 +256,10 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     f->gopacity = p->gradient_opacity;
     if (f->gopacity >= VXL_GOPACITY_COUNT)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown gradient_opacity mode %u", f->gopacity);
+    if (p->technique >= VXL_TECHNIQUE_COUNT)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown technique %u (0 raycast, 1 slices2d, 2 slices3d)",
+                        p->technique);
+    f->technique = p->technique;
     f->gradient_ref = p->gradient_ref == 0 ? 0.05f : p->gradient_ref;
     f->gradient_exp = p->gradient_exp == 0 ? 1.0f : p->gradient_exp;
     f->iso_thickness = p->iso_thickness == 0 ? 1.0f : p->iso_thickness;
@@ -299,6 +303,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     f->scene_depth = p->scene_depth;
     rc = resolve_matrices(f, p, g, e);
     if (!rc) rc = resolve_lights(f, p, e);
+    if (!rc) rc = vxl_frame_resolve_lighting(f, p, e);
     if (!rc) rc = resolve_tf(f, p, g, e);
     if (rc) vxl_frame_free(f);
     return rc;

@@ -23,6 +23,7 @@ typedef struct vxl_frame {
     uint32_t filter, shading, reuse, store, jitter, seed;
     uint32_t classify, preint_size;
     uint32_t gopacity;          /* VXL_GOPACITY_* */
+    uint32_t technique;         /* VXL_TECHNIQUE_*: the ray caster or a slicing comparison mode (slices.c) */
     float gradient_ref, gradient_exp, iso_pos, iso_thickness; /* iso_pos: normalised value */
     float sample_distance, step;
     int max_steps;
@@ -38,6 +39,20 @@ typedef struct vxl_frame {
     float material[4];
     int light_count;
     float light_pos[VXL_MAX_LIGHTS][4], light_color[VXL_MAX_LIGHTS][3];
+    /* Lighting beyond Phong (issue 17, frame_lighting.c; the formulas are
+     * voxlight.h's VXL_SHADING_*). Per light i < light_count: */
+    uint32_t shading_model;     /* VXL_SHADING_* */
+    float ao_radius;            /* voxels; 0 = no occlusion */
+    float ao_strength;          /* occlusion_strength, 0 resolved to 1 */
+    float anisotropy;           /* Henyey-Greenstein g, [-0.99, 0.99] */
+    uint32_t illumination_size; /* cells along the longest side; 0 = automatic (the GL side decides) */
+    float light_world[VXL_MAX_LIGHTS][4];     /* world space, w 0 or 1; a direction (w = 0) is unit
+                                                 length; the headlight's is the eye's direction */
+    float light_spot_dir[VXL_MAX_LIGHTS][3];  /* view space unit vector the spot points along */
+    float light_spot_cos[VXL_MAX_LIGHTS];     /* cos(spot_angle / 2); -2 when the light has no cone */
+    float light_spot_blend[VXL_MAX_LIGHTS];   /* spot_blend, 0..1 (0 = hard edge) */
+    float light_size[VXL_MAX_LIGHTS];         /* directional: angular diameter (radians); point:
+                                                 radius (world units); 0 = hard shadows */
     float early_termination, depth_threshold;
     int skip;                   /* empty-space skipping and the screen-space bound */
     const float *scene_depth;
@@ -83,6 +98,16 @@ int vxl_render_params_read(vxl_render_params *q, const vxl_render_params *p, vxl
 /* p may be NULL (all defaults). On success free with vxl_frame_free. */
 int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e);
 void vxl_frame_free(vxl_frame *f);
+
+/* Validates the lighting fields of p (shading_model, light_shapes,
+ * ambient_occlusion, occlusion_strength, anisotropy, illumination_size) into
+ * f; needs f->view and the lights resolved. Part of vxl_frame_resolve. */
+int vxl_frame_resolve_lighting(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+
+/* Blender's spot mask (voxlight.h, vxl_light_shape.spot_blend) of light i
+ * for a sample whose direction from the light makes cos_a with the spot's
+ * axis: 1 inside the cone, 0 outside, smooth over the blend. */
+double vxl_frame_spot_mask(const vxl_frame *f, int i, double cos_a);
 
 /* The default camera: frames the volume's bounding sphere, orbiting about
  * world +Z by azimuth and elevation (degrees). */

@@ -22,9 +22,13 @@
 #define VXL_CODE_UNIT 10          /* compressed storage: the code pool while decoding */
 #define VXL_PALETTE_UNIT 11       /* compressed storage: the palettes */
 #define VXL_CPAGE_UNIT 12         /* bricked storage: the coefficient pool's page table */
+#define VXL_ILLUMINATION_UNIT 13  /* raycast, illumination.comp: the lights' transmittance and the occlusion, stacked */
+#define VXL_EXTINCTION_UNIT 14    /* illumination.comp: the optical depth per cell the lights and occlusion read */
 
 /* Image units. */
 #define VXL_IMAGE_OUT 0           /* every compute pass: the texture it writes (the B-spline prefilter also reads it) */
+#define VXL_IMAGE_SLICE_ACCUM 1   /* slices.frag: the colour attachment, read and composited slice by slice */
+#define VXL_IMAGE_SLICE_DEPTH 2   /* slices.frag: the depth attachment, the same way */
 
 /* Shader-storage buffer bindings. */
 #define VXL_SSBO_GRADIENT_MAX 0   /* gradient_sobel.comp's max pass: the largest |gradient| as float bits */
@@ -42,7 +46,8 @@
 static inline const char *vxl_glsl_binding_defines(void)
 {
     return VXL_GLSL_DEFINE(VXL_IMAGE_OUT) VXL_GLSL_DEFINE(VXL_SSBO_GRADIENT_MAX) VXL_GLSL_DEFINE(VXL_SSBO_PROBE_POINTS)
-        VXL_GLSL_DEFINE(VXL_SSBO_PROBE_RESULTS) VXL_GLSL_DEFINE(VXL_SSBO_STATS) VXL_GLSL_DEFINE(VXL_SSBO_BRICK_LIST);
+        VXL_GLSL_DEFINE(VXL_SSBO_PROBE_RESULTS) VXL_GLSL_DEFINE(VXL_SSBO_STATS) VXL_GLSL_DEFINE(VXL_SSBO_BRICK_LIST)
+        VXL_GLSL_DEFINE(VXL_IMAGE_SLICE_ACCUM) VXL_GLSL_DEFINE(VXL_IMAGE_SLICE_DEPTH);
 }
 
 #endif

@@ -14,7 +14,7 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
 /* flags bits for RAYCAST: 1 shading, 2 reuse gradients, bits 2-3 the
  * classify mode, bits 4-5 the gradient-opacity mode, bit 6 (also PROBE)
  * bricked storage, bit 7 compressed storage filtered in the compressed
- * domain; for GRAD_STORE: the store format; for DECODE_BRICKS: the cache's
+ * domain, bits 8-9 the shading model (issue 17); for GRAD_STORE: the store format; for DECODE_BRICKS: the cache's
  * bytes per voxel - 1 */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
 static const char *const cache_formats[] = {"r8", "r16", "r32f", "r32f"};
@@ -79,15 +79,19 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     int rc;
     switch (kind) {
     case VXL_PROG_RAYCAST:
+    case VXL_PROG_SLICES:
         snprintf(defines, sizeof defines, "%s%s#define GOPACITY %u\n%s%s%s", paged, fdef, (flags >> 4) & 3,
                  (flags & 1) ? "#define SHADING 1\n" : "",
                  (flags & 2) ? "#define REUSE_GRADIENTS 1\n" : "",
                  ((flags >> 2) & 3) == VXL_CLASSIFY_PRE      ? "#define CLASSIFY_PRE 1\n"
                  : ((flags >> 2) & 3) == VXL_CLASSIFY_PREINT ? "#define CLASSIFY_PREINT 1\n"
                                                              : "");
-        rc = compile(r, GL_VERTEX_SHADER, "render/raycast.vert", NULL, &a);
+        if ((flags >> 8) & 3) /* issue 17: shadowed / scatter; PHONG compiles as before */
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define SHADING_MODEL %u\n",
+                     (flags >> 8) & 3);
+        rc = compile(r, GL_VERTEX_SHADER, kind == VXL_PROG_SLICES ? "render/slices.vert" : "render/raycast.vert", NULL, &a);
         if (rc) return rc;
-        rc = compile(r, GL_FRAGMENT_SHADER, "render/raycast.frag", defines, &b);
+        rc = compile(r, GL_FRAGMENT_SHADER, kind == VXL_PROG_SLICES ? "render/slices.frag" : "render/raycast.frag", defines, &b);
         if (rc) {
             r->gl.DeleteShader(a);
             return rc;
@@ -124,6 +128,10 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
     case VXL_PROG_DECODE_BRICKS:
         snprintf(defines, sizeof defines, "#define CACHE_FORMAT %s\n", cache_formats[flags & 3]);
         rc = compile(r, GL_COMPUTE_SHADER, "compute/decode_bricks.comp", defines, &a);
+        return rc ? rc : link(r, a, 0, out);
+    case VXL_PROG_ILLUMINATION: /* illumination.c: flags & 3 the pass, bits 2-3 the gradient-opacity mode, plus the storage's sample flags */
+        snprintf(defines, sizeof defines, "%s#define PASS %u\n#define GOPACITY %u\n", paged, flags & 3, (flags >> 2) & 3);
+        rc = compile(r, GL_COMPUTE_SHADER, "compute/illumination.comp", defines, &a);
         return rc ? rc : link(r, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
         rc = compile(r, GL_COMPUTE_SHADER, "compute/brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);

@@ -11,6 +11,7 @@ void vxl_holdings(const vxl_renderer *r, uint64_t held[VXL_HOLD_COUNT])
     held[VXL_HOLD_GRADIENTS] = r->gradients.bytes;
     held[VXL_HOLD_BSPLINE] = r->bspline.bytes;
     held[VXL_HOLD_CLASSIFIED] = r->classification.classified_bytes;
+    held[VXL_HOLD_ILLUMINATION] = r->illumination.bytes;
 }
 
 int vxl_holdings_ask(vxl_renderer *r, vxl_holder who, uint64_t bytes, const char *hint, const char *what, ...)

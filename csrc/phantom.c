@@ -14,7 +14,7 @@
 
 static const char *const names[VXL_PHANTOM_COUNT] = {NULL,         "marschner-lobb", "sphere",      "ramp",
                                                      "noisy-blob", "sparse-balls",   "dense-balls",
-                                                     "large-sparse"};
+                                                     "large-sparse", "two-blobs"};
 
 #define LATTICE 8
 #define BALL_SIGMA 0.06
@@ -100,6 +100,17 @@ static double field(uint32_t kind, const double u[3], double g[3])
         return balls(kind, u, g);
     case VXL_PHANTOM_LARGE_SPARSE:
         return vxl_large_sparse_field(u, g);
+    case VXL_PHANTOM_TWO_BLOBS: { /* one casts its shadow on the other under a light along x */
+        const double cx = 0.45, s2 = 0.04;
+        double v = 0;
+        g[0] = g[1] = g[2] = 0;
+        for (int b = -1; b <= 1; b += 2) {
+            double d[3] = {x - b * cx, y, z}, e = exp(-(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / (2 * s2));
+            v += e;
+            for (int a = 0; a < 3; a++) g[a] -= d[a] / s2 * e;
+        }
+        return v;
+    }
     default: { /* NOISY_BLOB: Gaussian blob, sigma 0.4 */
         double r2 = x * x + y * y + z * z, s2 = 0.16, v = exp(-r2 / (2 * s2));
         g[0] = -x / s2 * v;

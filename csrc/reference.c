@@ -1,24 +1,15 @@
 /* reference.c - the ground-truth renderer: the ray caster's equations
  * (raycast.frag, classify.glsl, shading.glsl) in double precision on the CPU,
  * sampling a phantom's analytic field and gradient at a fine step with no
- * jitter. Any change to those shaders' equations must be mirrored here. */
+ * jitter. Any change to those shaders' equations must be mirrored here.
+ * Shadows, occlusion and scattering are in reference_light.c. */
 #include <math.h>
 #include <string.h>
 
-#include "frame.h"
 #include "mat4.h"
-#include "volume.h"
-#include "voxlight_dev.h"
+#include "reference.h"
 
 #define REF_MAX_STEP (1.0 / 16.0)
-
-typedef struct ref_ctx {
-    const vxl_phantom_desc *d;
-    const vxl_frame *f;
-    const vxl_volume *vol;
-    double inv_mvp[16], mv[16], normal[9];
-    double step;
-} ref_ctx;
 
 /* GL_LINEAR lookup of a 1D texture at the coordinate classify.glsl uses. */
 static void classify(const ref_ctx *c, double v, double out[4])
@@ -71,6 +62,30 @@ static double correct_opacity(double a, double step)
     double t = 1 - a;
     t = t < 0 ? 0 : t > 1 ? 1 : t;
     return t <= 0 ? 1 : 1 - pow(t, step);
+}
+
+double vxl_ref_sample(const ref_ctx *c, const double p[3], double step, double col[4], double g[3], double *gm)
+{
+    const vxl_frame *f = c->f;
+    double value, span = c->vol->tex_hi - c->vol->tex_lo;
+    vxl_phantom_eval(c->d, p, &value, g);
+    double vn = (value - c->vol->tex_lo) / span;
+    /* gradient magnitude in normalised value per voxel, as the shader sees it */
+    *gm = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) / fabs(span);
+    if (f->gopacity == VXL_GOPACITY_ISO) {
+        classify(c, f->iso_pos, col);
+        double dist = fabs(f->iso_pos - vn), r = f->iso_thickness, m = *gm;
+        double a = m > 0 ? (dist <= r * m ? col[3] * (1 - dist / (r * m)) : 0) : (dist == 0 ? col[3] : 0);
+        return correct_opacity(a, step);
+    }
+    /* PREINT approximates the same continuous integral as POST, so both
+     * share this reference; PRE is a different image model. */
+    if (f->classify == VXL_CLASSIFY_PRE) classify_pre(c, p, col);
+    else classify(c, vn, col);
+    if (col[3] <= 0) return 0;
+    double alpha = correct_opacity(col[3], step);
+    if (f->gopacity == VXL_GOPACITY_BOUNDARY) alpha *= pow(fmin(*gm / f->gradient_ref, 1.0), f->gradient_exp);
+    return alpha;
 }
 
 static void shade(const ref_ctx *c, double rgb[3], const double g[3], const double pos[3], const double v[3])
@@ -144,36 +159,17 @@ static void trace(const ref_ctx *c, double px, double py, float *out_rgba, float
     for (int r = 0; r < 3; r++) view_dir[r] = -(c->mv[r] * dir[0] + c->mv[4 + r] * dir[1] + c->mv[8 + r] * dir[2]);
     double vl = sqrt(view_dir[0] * view_dir[0] + view_dir[1] * view_dir[1] + view_dir[2] * view_dir[2]);
     for (int k = 0; k < 3; k++) view_dir[k] /= vl;
-    double span = c->vol->tex_hi - c->vol->tex_lo;
     double acc[4] = {0, 0, 0, 0};
     for (double t = t0; t < t1; t += c->step) {
-        double p[3] = {o[0] + t * dir[0], o[1] + t * dir[1], o[2] + t * dir[2]}, value, g[3];
-        vxl_phantom_eval(c->d, p, &value, g);
-        double col[4], vn = (value - c->vol->tex_lo) / span;
-        /* gradient magnitude in normalised value per voxel, as the shader sees it */
-        double gm = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) / fabs(span);
-        double alpha;
-        if (f->gopacity == VXL_GOPACITY_ISO) {
-            classify(c, f->iso_pos, col);
-            double dist = fabs(f->iso_pos - vn), r = f->iso_thickness;
-            double a = gm > 0 ? (dist <= r * gm ? col[3] * (1 - dist / (r * gm)) : 0) : (dist == 0 ? col[3] : 0);
-            alpha = correct_opacity(a, c->step);
-        } else {
-            /* PREINT approximates the same continuous integral as POST, so
-             * both share this reference; PRE is a different image model. */
-            if (f->classify == VXL_CLASSIFY_PRE) classify_pre(c, p, col);
-            else classify(c, vn, col);
-            if (col[3] <= 0) continue;
-            alpha = correct_opacity(col[3], c->step);
-            if (f->gopacity == VXL_GOPACITY_BOUNDARY)
-                alpha *= pow(fmin(gm / f->gradient_ref, 1.0), f->gradient_exp);
-        }
+        double p[3] = {o[0] + t * dir[0], o[1] + t * dir[1], o[2] + t * dir[2]}, g[3], col[4], gm;
+        double alpha = vxl_ref_sample(c, p, c->step, col, g, &gm);
         if (alpha <= 0) continue;
         if (f->shading) {
             double pos[3];
             for (int r = 0; r < 3; r++) pos[r] = c->mv[r] * p[0] + c->mv[4 + r] * p[1] + c->mv[8 + r] * p[2] + c->mv[12 + r];
             /* the shader's gradient is of normalised values: same direction */
-            shade(c, col, g, pos, view_dir);
+            if (f->shading_model == VXL_SHADING_PHONG) shade(c, col, g, pos, view_dir);
+            else vxl_ref_shade_lit(c, col, g, gm, p, pos, view_dir);
         }
         double w = (1 - acc[3]) * alpha;
         for (int k = 0; k < 3; k++) acc[k] += w * col[k];
@@ -207,6 +203,10 @@ int vxl_reference_render(const vxl_phantom_desc *d, const vxl_volume *vol, const
     vxl_mat4_mul(c.mv, f.view, f.model);
     vxl_mat4_mul(mvp, f.proj, c.mv);
     vxl_mat4_invert(c.inv_mvp, mvp); /* resolve already proved it invertible */
+    if (!vxl_mat4_invert(c.inv_model, f.model)) {
+        vxl_frame_free(&f);
+        return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "the model matrix is singular");
+    }
     for (int i = 0; i < 9; i++) c.normal[i] = f.normal[i];
     c.step = fmin(f.step, REF_MAX_STEP);
     for (uint32_t y = 0; y < f.height; y++)

@@ -4,8 +4,10 @@
 #include <string.h>
 
 #include "frame.h"
+#include "illumination.h"
 #include "mat4.h"
 #include "renderer_internal.h"
+#include "slices.h"
 
 static void geom_of(const vxl_renderer *r, vxl_volume_geom *g)
 {
@@ -166,10 +168,11 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     vxl_gl *gl = &r->gl;
     GLuint prog;
     uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2) |
-                     (f->gopacity << 4) | r->storage.ops->sample_flags(r);
+                     (f->gopacity << 4) | r->storage.ops->sample_flags(r) | (f->shading ? f->shading_model << 8 : 0);
     uint32_t filter = vxl_frame_filter(f);
     int rc = r->storage.ops->check_filter(r, filter, f->classify);
-    if (!rc) rc = vxl_program_get(r, VXL_PROG_RAYCAST, filter, flags, &prog);
+    if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);
+    if (!rc) rc = vxl_program_get(r, f->technique ? VXL_PROG_SLICES : VXL_PROG_RAYCAST, filter, flags, &prog);
     if (!rc) rc = ensure_framebuffer(r, f->width, f->height);
     if (rc) return rc;
     gl->GetError();
@@ -179,9 +182,11 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     if ((f->skip || r->storage.ops->needs_occupancy) && (rc = vxl_skipping_prepare(r, f))) return rc;
     if ((rc = r->storage.ops->prepare(r, f))) return rc;
     if ((rc = vxl_classification_prepare(r, f))) return rc;
+    if ((rc = vxl_illumination_prepare(r, f))) return rc; /* shadows, occlusion (issue 17) */
     rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
     if (rc) return rc;
     set_frame_uniforms(r, prog, f);
+    vxl_illumination_bind(r, prog, f);
     vxl_uniform_i(r, prog, "u_skip", f->skip);
     vxl_uniform_i(r, prog, "u_brick_size", (int)(r->skipping.bricks.size ? r->skipping.bricks.size : VXL_DEFAULT_BRICK));
     vxl_uniform_i(r, prog, "u_brick_distance", VXL_DISTANCE_UNIT);
@@ -211,8 +216,12 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     gl->Enable(GL_SCISSOR_TEST);
     gl->Scissor(rect[0], rect[1], rect[2], rect[3]);
     gl->BindVertexArray(r->vao);
-    gl->DrawArrays(GL_TRIANGLES, 0, 3);
+    if (f->technique == VXL_TECHNIQUE_RAYCAST)
+        gl->DrawArrays(GL_TRIANGLES, 0, 3);
+    else
+        rc = vxl_slices_draw(r, f, prog); /* the same state, proxy polygons instead of one triangle */
     gl->Disable(GL_SCISSOR_TEST);
+    if (rc) return rc;
     gl->ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl->ReadPixels(0, 0, (GLsizei)f->width, (GLsizei)f->height, GL_RGBA, GL_FLOAT, rgba);
     if (depth) {
@@ -241,6 +250,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     r->stats.storage = r->storage.mode;
     r->stats.resident_bytes = r->storage.ops->resident_bytes(r);
     r->storage.ops->report(r, &r->stats);
+    vxl_illumination_report(r, &r->stats);
     return VXL_OK;
 }
 

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "illumination.h"
 #include "renderer_internal.h"
 #include "volume.h"
 
@@ -64,6 +65,7 @@ static void release_volume(vxl_renderer *r)
     vxl_bspline_release(r);
     vxl_skipping_release(r);
     vxl_classification_release(r);
+    vxl_illumination_release(r);
     if (r->storage.ops) r->storage.ops->release(r);
     r->storage.ops = NULL;
     r->storage.mode = 0;

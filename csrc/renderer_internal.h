@@ -12,6 +12,7 @@
 #include "gl_funcs.h"
 #include "gl_bindings.h"
 #include "gl_thread.h"
+#include "illumination_state.h"
 #include "lod.h"
 #include "frame.h"
 #include "storage.h"
@@ -35,6 +36,8 @@
 /* 10: was the bricked texture's max pass, now on the CPU */
 #define VXL_PROG_PAGED_GRAD_STORE 11
 #define VXL_PROG_DECODE_BRICKS 12 /* flags: the cache's bytes per voxel - 1 */
+#define VXL_PROG_SLICES 13 /* the slicing comparison modes (slices.c); flags as RAYCAST */
+#define VXL_PROG_ILLUMINATION 14 /* illumination.c: flags & 3 the pass, plus the sample flags */
 
 typedef struct vxl_program_entry {
     uint32_t key;
@@ -106,6 +109,7 @@ struct vxl_renderer {
     vxl_bspline_state bspline;
     vxl_skipping_state skipping;
     vxl_classification_state classification;
+    vxl_illumination_state illumination;     /* illumination.h: shadows and occlusion (issue 17) */
 
     vxl_program_entry programs[VXL_MAX_PROGRAMS];
     int n_programs;

@@ -31,8 +31,8 @@ from . import (native_abi, native_library, native_private_copy, native_renderer,
 from .native_abi import (ABI_VERSION, BACKENDS, CLASSIFY_MODES, ENUM_FALLBACKS, FILTERS,  # noqa: F401
                          GRADIENT_OPACITY_MODES, MAX_LIGHTS, PRESETS, RENDER_PARAMS_RESERVED,
                          STORAGES, DicomSeries, Light, LightShape, LibraryUnavailable, LoadOptions, PhantomDesc,
-                         RendererInfo, RendererOptions, RenderParams, RenderStats, VolumeDesc,
-                         VolumeInfo, VoxlightError, c_double4x4, c_float4x4, matrix_from_cm)
+                         RendererInfo, RendererOptions, RenderParams, RenderStats, SHADING_MODELS,
+                         VolumeDesc, VolumeInfo, VoxlightError, c_double4x4, c_float4x4, matrix_from_cm)
 from .native_library import (LIBRARY_NAME, Library, candidate_paths, filter_names,  # noqa: F401
                              library_status, load_library)
 from .native_private_copy import (CACHE_DIR, HELPER_PREFIX, OLD_VDB_HELPER_NAME,  # noqa: F401

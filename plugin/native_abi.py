@@ -25,10 +25,11 @@ BACKENDS = ("auto", "osmesa", "egl")
 STORAGES = ("auto", "dense", "bricked", "sparse", "compressed")  # VXL_STORAGE_*
 CLASSIFY_MODES = ("post", "pre", "preint")  # VXL_CLASSIFY_*
 GRADIENT_OPACITY_MODES = ("off", "boundary", "iso")  # VXL_GOPACITY_*
+SHADING_MODELS = ("phong", "shadowed", "scatter")  # VXL_SHADING_*
 # The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
 ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "storage": STORAGES,
                   "classify": CLASSIFY_MODES, "gradient_opacity": GRADIENT_OPACITY_MODES,
-                  "gradient_store": ("8bit", "16f", "32f")}
+                  "gradient_store": ("8bit", "16f", "32f"), "shading_model": SHADING_MODELS}
 MAX_LIGHTS = 8
 RENDER_PARAMS_RESERVED = 9  # VXL_RENDER_PARAMS_RESERVED
 
@@ -214,7 +215,9 @@ class RenderStats(ctypes.Structure):
                 ("pages_constant", ctypes.c_uint32),
                 ("lod_level", ctypes.c_uint32),
                 ("lod_wanted_bytes", ctypes.c_uint64),
-                ("decode_ms", ctypes.c_double)]
+                ("decode_ms", ctypes.c_double),
+                ("illumination_size", ctypes.c_uint32),
+                ("illumination_rebuilt", ctypes.c_uint32)]
 
 
 def _sized(struct_type):

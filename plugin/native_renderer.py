@@ -9,13 +9,30 @@ import time
 
 import numpy as np
 
-from .native_abi import (LibraryObject, MAX_LIGHTS, RenderParams, RenderStats, RendererInfo,
-                         RendererOptions, VoxlightError, matrix_from_cm, _fptr, _matrix_cm, _sized)
+from .native_abi import (LibraryObject, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
+                         RendererInfo, RendererOptions, VoxlightError, matrix_from_cm, _fptr,
+                         _matrix_cm, _sized)
 from .native_library import load_library
 from .native_tiles import _empty_stats, _merge_stats, tile_params
 
 
 # ----------------------------------------------------------- render params
+
+def _light_shapes(lights):
+    """The LightShape array of `lights` (entries (position4, color3,
+    intensity[, shape]) with shape = (spot_direction3, spot_angle,
+    spot_blend, size)), or None when every light is plain."""
+    shapes = [l[3] if len(l) > 3 and l[3] is not None else None for l in lights]
+    if all(s is None or not any(s[0]) and not any(s[1:]) for s in shapes):
+        return None
+    arr = (LightShape * len(lights))()
+    for dst, s in zip(arr, shapes):
+        dst.struct_size = ctypes.sizeof(LightShape)
+        if s is not None:
+            dst.spot_direction[:] = [float(v) for v in s[0]]
+            dst.spot_angle, dst.spot_blend, dst.size = float(s[1]), float(s[2]), float(s[3])
+    return arr
+
 
 def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth=None,
                 filter="central", sample_distance=1.0, reuse_gradients=False,
@@ -25,7 +42,8 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 early_termination=0.0, depth_threshold=0.0, no_skip=False,
                 tf_rgba=None, classify="post", gradient_opacity="off", gradient_ref=0.0,
                 gradient_exp=0.0, iso_value=0.0, iso_thickness=0.0, preint_size=0,
-                lib=None):
+                shading_model=0, ambient_occlusion=0.0, occlusion_strength=0.0, anisotropy=0.0,
+                illumination_size=0, lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -33,7 +51,10 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     an (n, 4) straight-RGBA table (alpha = opacity per voxel of path) that
     replaces the preset; `window` maps its [0, 1] onto data values.
     `classify` and `gradient_opacity` are the library's names of their modes
-    (Library.names("classify"), ...) or their VXL_* numbers."""
+    (Library.names("classify"), ...) or their VXL_* numbers, and so is
+    `shading_model`. A light may carry a fourth item, its shape
+    (spot_direction3, spot_angle, spot_blend, size, as vxl_light_shape);
+    the shapes' array lives as long as the params."""
     lib = lib or load_library()
     p = _sized(RenderParams)
     p.width, p.height = int(width), int(height)
@@ -92,10 +113,23 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     if len(lights) > MAX_LIGHTS:
         raise ValueError("at most %d lights" % MAX_LIGHTS)
     p.light_count = len(lights)
-    for i, (pos, col, inten) in enumerate(lights):
+    for i, light in enumerate(lights):
+        pos, col, inten = light[:3]
         p.lights[i].position[:] = [float(v) for v in pos]
         p.lights[i].color[:] = [float(v) for v in col]
         p.lights[i].intensity = float(inten)
+    shapes = _light_shapes(lights)
+    if shapes is not None:
+        # The digest hashes _keep; this view also keeps the array alive.
+        p._shapes = np.frombuffer(shapes, np.uint8)
+        p._keep.append(p._shapes)
+        p.light_shapes = ctypes.cast(shapes, ctypes.POINTER(LightShape))
+    p.shading_model = (shading_model if isinstance(shading_model, int)
+                       else lib.index("shading_model", shading_model))
+    p.ambient_occlusion = ambient_occlusion
+    p.occlusion_strength = occlusion_strength
+    p.anisotropy = anisotropy
+    p.illumination_size = int(illumination_size)
     p.early_termination = early_termination
     p.depth_threshold = depth_threshold
     p.no_skip = 1 if no_skip else 0

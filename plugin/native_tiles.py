@@ -19,6 +19,7 @@ def params_digest(params, *extra):
     c = RenderParams.from_buffer_copy(params)
     c.scene_depth = None
     c.tf_rgba = None
+    c.light_shapes = None  # their contents are in _keep
     h = hashlib.blake2b(bytes(c), digest_size=16)
     for a in getattr(params, "_keep", ()):
         a = np.ascontiguousarray(a)
@@ -58,6 +59,12 @@ def tile_params(params, x0, y0, x1, y1):
     if tf is not None:  # the copy points at the same table: keep it alive
         t._keep.append(tf)
         t._tf = tf
+    shapes = getattr(params, "_shapes", None)
+    if params.light_shapes and shapes is None:
+        raise ValueError("params.light_shapes was not set by make_params")
+    if shapes is not None:  # the same light shapes
+        t._keep.append(shapes)
+        t._shapes = shapes
     t.width, t.height = x1 - x0, y1 - y0
     a, b = 2.0 * x0 / W - 1.0, 2.0 * x1 / W - 1.0
     c, d = 2.0 * y0 / H - 1.0, 2.0 * y1 / H - 1.0

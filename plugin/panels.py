@@ -165,12 +165,22 @@ class VOXLIGHT_PT_volume_lighting(_VolumePanel, bpy.types.Panel):
     def draw(self, context):
         p = context.object.voxlight
         layout = _split(self.layout)
+        layout.active = p.shading
+        layout.prop(p, "shading_model", text="Model")
         col = layout.column(align=True)
-        col.active = p.shading
         col.prop(p, "ambient", slider=True)
         col.prop(p, "diffuse", slider=True)
         col.prop(p, "specular", slider=True)
         col.prop(p, "shininess")
+        # Shadows, occlusion and scattering (issue 17): not in Phong.
+        col = layout.column(align=True)
+        col.active = p.shading_model != "phong"
+        col.prop(p, "occlusion_radius", text="Occlusion")
+        col.prop(p, "occlusion_strength", text="Strength", slider=True)
+        col.prop(p, "shadow_quality", text="Shadows")
+        sub = layout.column()
+        sub.active = p.shading_model == "scatter"
+        sub.prop(p, "anisotropy", slider=True)
 
 
 class VOXLIGHT_PT_volume_advanced(_VolumePanel, bpy.types.Panel):

@@ -4,6 +4,7 @@ scripting API so all three render the same thing."""
 
 import numpy as np
 
+from . import lighting
 from . import lights as _lights
 from . import native
 from . import tf as _tf
@@ -15,9 +16,10 @@ def model_matrix(obj):
     return np.array(obj.matrix_world, np.float64) @ v2l
 
 
-def look_kwargs(props, fast=False):
+def look_kwargs(props, fast=False, dragging=False):
     """The properties that decide how the volume looks, as make_params
-    keyword arguments. `fast` doubles the step for interactive frames."""
+    keyword arguments. `fast` doubles the step for interactive frames;
+    `dragging` (a light is being dragged) coarsens the illumination volume."""
     # The ColorRamp and the window are the transfer function. Volumes not
     # converted yet (tf_version 0: appended from an old file) keep the old
     # switches: library preset unless Use ColorRamp, preset window unless
@@ -49,6 +51,7 @@ def look_kwargs(props, fast=False):
         gradient_exp=props.gradient_exp,
         iso_value=props.iso_value,
         iso_thickness=props.iso_thickness,
+        **lighting.look_kwargs(props, dragging),
     )
 
 
@@ -64,8 +67,27 @@ def scene_lights(scene, depsgraph, for_render=False):
     return _lights.collect(depsgraph, for_render)
 
 
+class _Lights(list):
+    """Scene lights, marked while one of them is being dragged."""
+    dragged = False
+
+
+_light_watch = lighting.LightWatch()
+
+
+def while_lights_move(lights, now, settle_time):
+    """Viewport: (lights, seconds until they settle, or None when they are
+    still). Frames built with lights that are being dragged get a coarse
+    illumination volume (lighting.DRAG_ILLUMINATION_SIZE); the viewport
+    redraws once they settle, and the full one is built then."""
+    left = _light_watch.update(lights, now, settle_time)
+    out = _Lights(lights)
+    out.dragged = left is not None
+    return out, left
+
+
 def build(obj, width, height, view, proj, scene_depth=None, lights=(), fast=False, lib=None):
-    kw = look_kwargs(obj.voxlight, fast)
+    kw = look_kwargs(obj.voxlight, fast, dragging=getattr(lights, "dragged", False))
     return native.make_params(width=width, height=height, view=view, proj=proj,
                               model=model_matrix(obj), scene_depth=scene_depth,
                               lights=lights, lib=lib, **kw)

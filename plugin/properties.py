@@ -6,7 +6,7 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, IntVectorProperty, PointerProperty, StringProperty)
 
-from . import native, tf
+from . import lighting, native, tf
 
 # UI names of the filters this add-on knows. The list itself comes from the
 # library (vxl_filter_name up to VXL_FILTER_COUNT), so a filter added there
@@ -77,6 +77,14 @@ _GRADIENT_OPACITY_UI = {
                              "opaque; uniform regions fade"),
     "iso": ("Iso-surface", "Iso-surface: a thin shell at one value, like a surface mesh"),
 }
+_SHADING_MODEL_UI = {
+    "phong": ("Phong", "Phong: each sample lit on its own, no shadows (the look of files from "
+                       "before shadows)"),
+    "shadowed": ("Shadowed", "Shadowed: Phong with the volume's own shadows from every light "
+                             "and ambient occlusion in folds and crevices"),
+    "scatter": ("Scatter", "Scatter: shadows, and light scattered through soft tissue where "
+                           "there is no clear surface (Anisotropy sets its direction)"),
+}
 _BACKEND_UI = {
     "auto": ("Auto", "EGL on a GPU, then OSMesa, then EGL on Mesa"),
     "osmesa": ("OSMesa", "Software rendering (llvmpipe)"),
@@ -97,6 +105,8 @@ PRESET_ITEMS = _items(_library_names("preset"), _PRESET_UI, "Transfer-function p
 CLASSIFY_ITEMS = _items(_library_names("classify"), _CLASSIFY_UI, "Classification")
 GRADIENT_OPACITY_ITEMS = _items(_library_names("gradient_opacity"), _GRADIENT_OPACITY_UI,
                                 "Gradient opacity mode")
+SHADING_MODEL_ITEMS = _items(_library_names("shading_model"), _SHADING_MODEL_UI,
+                             "Shading model")
 BACKEND_ITEMS = _items(_library_names("backend"), _BACKEND_UI, "Backend")
 STORAGE_ITEMS = _items(_library_names("storage"), _STORAGE_UI, "Storage")
 
@@ -266,6 +276,32 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                              update=tag_redraw,
                              description="Size of the highlights: higher is smaller and "
                                          "sharper, like a glossier surface")
+    # --- lighting (issue 17; defaults and old files: lighting.py)
+    shading_model: EnumProperty(name="Shading Model", items=SHADING_MODEL_ITEMS,
+                                default=lighting.DEFAULT_MODEL, update=tag_redraw,
+                                description="How light reaches each sample: local Phong, with "
+                                            "shadows and occlusion, or with scattering too")
+    occlusion_radius: FloatProperty(name="Occlusion Radius",
+                                    default=lighting.DEFAULT_OCCLUSION_RADIUS, min=0.0, max=64.0,
+                                    soft_max=16.0, update=tag_redraw,
+                                    description="How far, in voxels, the surroundings of a "
+                                                "sample shade it (ambient occlusion): folds "
+                                                "and crevices darken; 0 is off")
+    occlusion_strength: FloatProperty(name="Occlusion Strength", subtype="FACTOR",
+                                      default=lighting.DEFAULT_OCCLUSION_STRENGTH, min=0.0,
+                                      max=1.0, update=tag_redraw,
+                                      description="How much ambient occlusion darkens the "
+                                                  "ambient light: 1 fully, 0 not at all")
+    anisotropy: FloatProperty(name="Anisotropy", default=0.0, min=-0.99, max=0.99,
+                              subtype="FACTOR", update=tag_redraw,
+                              description="Scatter: which way light scatters in tissue; above "
+                                          "0 forward (glows when lit from behind), below 0 "
+                                          "back towards the light, 0 evenly")
+    shadow_quality: EnumProperty(name="Shadow Quality", items=lighting.SHADOW_QUALITIES,
+                                 default="AUTO", update=tag_redraw,
+                                 description="Resolution of the volumes that hold each light's "
+                                             "shadows: higher is crisper and slower to update "
+                                             "when a light moves")
 
 
 class VoxlightSceneProperties(bpy.types.PropertyGroup):

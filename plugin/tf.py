@@ -26,16 +26,18 @@ import os
 import bpy
 import numpy as np
 
-from . import runtime, tf_fit, tf_presets
+from . import lighting, runtime, tf_fit, tf_presets
 from .operators import OnActiveVolume
 
 TABLE_SIZE = tf_presets.TABLE_SIZE
 # Object.voxlight.tf_version: the file format of a volume's look.
 # 1: the single editor (ramp + explicit window); 2: the gradient filter's
 # default became sobel8, so a volume saved before with the old default
-# (central, never set, so not stored) is given central when its file opens.
+# (central, never set, so not stored) is given central when its file opens;
+# 3: shading models (issue 17), new volumes default to shadowed, so a volume
+# from before is given phong, its look then (lighting.upgrade).
 TF_SINGLE_EDITOR = 1
-TF_VERSION = 2
+TF_VERSION = 3
 
 # Kept for scripts written against the ColorRamp presets of issue 6.
 SLICER_PRESETS = tf_presets.SLICER_PRESETS
@@ -386,6 +388,7 @@ def upgrade(obj):
         migrate_legacy(obj)
     if old < 2 and p.get("filter") is None:
         p.filter = "central"  # the default it was saved with
+    lighting.upgrade(p, old)
     p.tf_version = TF_VERSION
 
 

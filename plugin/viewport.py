@@ -16,13 +16,18 @@ Per region and volume, on every redraw:
   4. Otherwise, progressive refinement:
        * an interactive frame (reduced resolution, doubled step) is
          rendered synchronously so the view follows the mouse; its
-         resolution adapts to the measured frame time so a moving view
-         keeps about 10 frames a second (resolution_policy.ScalePolicy,
-         at most the "While Moving" resolution);
+         resolution adapts to the measured frame time so that it takes
+         about PREVIEW_SECONDS, half of a 10 fps frame
+         (resolution_policy.ScalePolicy, at most the "While Moving"
+         resolution);
        * once the view has been still for "Refine After" seconds, refined
          frames are queued on the renderer's background worker
          (runtime.Worker): half the still resolution first (when that is
-         sharper than the preview), then the full still resolution. The
+         sharper than the preview and the full frame is predicted slow:
+         _worth_a_half_step), then the full still resolution. When the
+         full frame is predicted quick, each moving draw prepares it
+         (_prepare_refine) and the settle timer queues it directly,
+         without waiting for a redraw. The
          worker renders them in bands and drops one between bands as soon
          as it is stale (the view or anything else changed); a timer polls
          for the result and redraws. The draw handler never waits for a
@@ -56,6 +61,7 @@ _shader = None
 _batch = None
 _states = {}          # (region pointer, object name) -> _State
 _refine_pending = False
+_refine_redraw = False  # the settle timer also redraws (someone asked for it)
 _poll_registered = False
 last_error = ""
 
@@ -183,6 +189,10 @@ class _State:
         self.job_entry = None
         self.announced = False
         self.error_key = None
+        self.refine_spp = None  # seconds a pixel of the last refined frame took (worker)
+        # (entry, _Frame, is the full step, owner): the first refine step of
+        # the view the last moving draw showed, queued by the settle timer
+        self.next_refine = None
 
     # compatibility with older tests and scripts: the drawn textures
     @property
@@ -193,6 +203,16 @@ class _State:
         if self.job is not None and not self.job.done and self.job_entry is not None:
             self.job_entry.worker.cancel(self.job)
         self.job = None
+        self.next_refine = None
+
+    def submit(self, entry, frame, full, owner):
+        """Queue `frame` on the entry's worker as this volume's refine job."""
+        self.cancel_job()
+        self.job = entry.worker.submit(runtime.Job(owner, frame.key, frame.params, frame.rect))
+        self.job.full = full  # for busy_full(): the last, slowest refine step
+        self.job_entry = entry
+        self.announced = False
+        _ensure_poll()
 
 
 _VERT = "void main() { uv = pos * 0.5 + 0.5; gl_Position = vec4(pos, 0.0, 1.0); }"
@@ -332,15 +352,43 @@ def _outside_frustum(model, dims, view, proj):
 # ------------------------------------------------------------- timers
 
 def _refine():
-    global _refine_pending
+    """The settle timer. A volume whose view has been still for Refine After
+    gets its first refine step queued now, from the frame its last moving
+    draw prepared: waiting for a redraw to queue it would add one of
+    Blender's own redraws (0.2-0.4 s on software GL) before the render
+    starts; the poll timer redraws once the step is done. A volume without
+    a prepared frame (or whose renderer closed) gets the redraw that queues
+    it, as does every other caller of _schedule_refine (a light that
+    settles); a view still moving (not settled yet) brings the timer back."""
+    global _refine_pending, _refine_redraw
     _refine_pending = False
-    from .properties import tag_redraw
-    tag_redraw()
+    redraw, _refine_redraw = _refine_redraw, False
+    now = time.monotonic()
+    for st in list(_states.values()):
+        pending = st.next_refine
+        if pending is None:
+            continue
+        entry, frame, full, owner, settle = pending
+        wait = settle - (now - st.moved_at)
+        if wait > 0.0:
+            _schedule_refine(wait + 0.01, redraw=False)
+            continue
+        try:
+            st.submit(entry, frame, full, owner)
+        except native.VoxlightError:
+            st.next_refine = None
+            redraw = True
+    if redraw:
+        from .properties import tag_redraw
+        tag_redraw()
     return None
 
 
-def _schedule_refine(delay):
-    global _refine_pending
+def _schedule_refine(delay, redraw=True):
+    """Run the settle timer in `delay` s; `redraw`: it must also redraw
+    (not needed by a volume whose refine frame is prepared)."""
+    global _refine_pending, _refine_redraw
+    _refine_redraw |= redraw
     if not _refine_pending:
         _refine_pending = True
         bpy.app.timers.register(_refine, first_interval=max(delay, 0.02))
@@ -539,6 +587,11 @@ def _draw():
                 depth_read = True
                 _profile.mark("depth_read")
                 lights = params.scene_lights(scene, depsgraph)
+                # Issue 17: a light being dragged gets a coarse illumination
+                # volume, refined by a redraw once it settles (params.py).
+                lights, light_settles_in = params.while_lights_move(lights, now, s.settle_time)
+                if light_settles_in is not None:
+                    _schedule_refine(light_settles_in + 0.01)
                 _profile.mark("lights")
             try:
                 shown = _update(st, ob, entry, W, H, view, proj, model, window_depth, lights,
@@ -548,7 +601,8 @@ def _draw():
                 continue
             last_error = ""
             if moving:
-                _schedule_refine(s.settle_time - (now - st.moved_at) + 0.01)
+                _schedule_refine(s.settle_time - (now - st.moved_at) + 0.01,
+                                 redraw=st.next_refine is None)
             if shown is not None and shown is not st.shown:
                 shown_log.append((obj.name, _kind(st, shown), shown.scale, shown.width,
                                   shown.height))
@@ -580,7 +634,8 @@ def _update(st, ob, entry, W, H, view, proj, model, window_depth, lights, moving
     """Decide what to show for one volume; render only what is missing."""
     s = bpy.context.scene.voxlight
     if st.policy is None:
-        st.policy = resolution_policy.ScalePolicy(s.interactive_resolution)
+        st.policy = resolution_policy.ScalePolicy(s.interactive_resolution,
+                                                  target_seconds=PREVIEW_SECONDS)
     args = (ob, entry, W, H, view, proj, model, window_depth, lights)
     if not moving:
         decided, shown = _refine_still(st, s, args, owner)
@@ -588,7 +643,57 @@ def _update(st, ob, entry, W, H, view, proj, model, window_depth, lights, moving
             return shown
     else:
         st.cancel_job()
-    return _preview(st, s, args)
+    shown = _preview(st, s, args)
+    if moving and shown is not None and st.next_refine is None:
+        _prepare_refine(st, s, args, owner)
+    return shown
+
+
+def _prepare_refine(st, s, args, owner):
+    """A moving draw: build the full-resolution frame of this view (what
+    _refine_still would queue), for the settle timer to queue as soon as
+    the view has been still for Refine After. Only when that frame is
+    predicted quick, so that one redraw less is what the artist waits for;
+    a slow one shows the half step first and is queued by a redraw as
+    before. Costs a few milliseconds (scene depth in the footprint,
+    parameters, key) per new preview, and the still draw finds that scene
+    depth cached."""
+    ob, entry, W, H, view, proj, model = args[:7]
+    steps = resolution_policy.refine_scales(st.fast.scale if st.fast is not None
+                                            else st.policy.scale, s.viewport_resolution)
+    w, h = _size(W, H, steps[-1])
+    rect = volume_space.screen_rect(model, tuple(ob.voxlight.dims), view, proj, w, h)
+    if rect is None or st.refine_spp is None or len(_worth_a_half_step(st, steps, rect)) > 1:
+        return
+    full = _frame_at(steps[-1], *args, fast=False)
+    if full.rect is not None and st.error_key != full.key:
+        st.next_refine = (entry, full, True, owner, s.settle_time)
+    _profile.mark("prepare_refine")
+
+
+# The library's time budget for an interactive frame: half of a 10 fps
+# frame, the other half left to Blender's own scene (which alone takes
+# 0.2-0.4 s on 2-core software GL, docs/viewport_latency.md), so the
+# preview's resolution, not the add-on, gives way while orbiting.
+PREVIEW_SECONDS = 0.05
+
+# Showing the half-resolution step costs the artist one more of Blender's
+# redraws before the full image (0.3-0.4 s of Blender's own scene on
+# software GL), and its render delays the full one: it is only worth it when
+# the full frame itself is slow.
+HALF_STEP_WORTH_S = 0.3
+
+
+def _worth_a_half_step(st, steps, full_rect):
+    """`steps` (refine_scales), without the half step when the full frame
+    (footprint `full_rect`) is predicted, from the per-pixel time of this
+    volume's last refined frame, to take under HALF_STEP_WORTH_S. Unknown
+    (no refined frame yet): keep the half step."""
+    if len(steps) < 2 or st.refine_spp is None:
+        return steps
+    if st.refine_spp * _rect_pixels(full_rect) < HALF_STEP_WORTH_S:
+        return steps[-1:]
+    return steps
 
 
 def _refine_still(st, s, args, owner):
@@ -599,6 +704,7 @@ def _refine_still(st, s, args, owner):
     preview_scale = st.fast.scale if st.fast is not None else st.policy.scale
     steps = resolution_policy.refine_scales(preview_scale, s.viewport_resolution)
     full = _frame_at(steps[-1], *args, fast=False)
+    steps = _worth_a_half_step(st, steps, full.rect)
     built = {}
 
     def half_frame():
@@ -616,7 +722,9 @@ def _refine_still(st, s, args, owner):
         fr = full if job.key == full.key else half_frame()
     if fr is not None and job.key == fr.key:
         if job.result is not None:
-            rgba, vdepth, _stats = job.result
+            rgba, vdepth, stats = job.result
+            if _rect_pixels(fr.rect) > 0 and stats.get("seconds", 0.0) > 0.0:
+                st.refine_spp = stats["seconds"] / _rect_pixels(fr.rect)
             img = _Image(fr.key, rgba, vdepth, fr.win_small, args[5], fr is full, fr.scale, fr.rect)
             st.job = None
             if fr is full:
@@ -638,12 +746,7 @@ def _refine_still(st, s, args, owner):
     have_half = half is not None and st.half is not None and st.half.key == half.key
     step = full if half is None or have_half else half
     if st.job is None or st.job.key != step.key or (st.job.done and st.job.result is None):
-        st.cancel_job()
-        st.job = args[1].worker.submit(runtime.Job(owner, step.key, step.params, step.rect))
-        st.job.full = step is full  # for busy_full(): the last, slowest refine step
-        st.job_entry = args[1]
-        st.announced = False
-        _ensure_poll()
+        st.submit(args[1], step, step is full, owner)
     if have_half:
         st.half.update_depth(half.win_small)
         return True, st.half
@@ -707,7 +810,7 @@ def register():
 
 
 def unregister():
-    global _handle, _shader, _batch, _refine_pending, _poll_registered
+    global _handle, _shader, _batch, _refine_pending, _poll_registered, _refine_redraw
     if _handle is not None:
         bpy.types.SpaceView3D.draw_handler_remove(_handle, "WINDOW")
         _handle = None
@@ -717,7 +820,7 @@ def unregister():
     for fn in (_refine, _poll):
         if bpy.app.timers.is_registered(fn):
             bpy.app.timers.unregister(fn)
-    _refine_pending = _poll_registered = False
+    _refine_pending = _poll_registered = _refine_redraw = False
     for h in list(bpy.app.handlers.load_pre):
         if h is _on_load_pre or (getattr(h, "__name__", "") == _on_load_pre.__name__ and
                                  getattr(h, "__module__", "") == _on_load_pre.__module__):

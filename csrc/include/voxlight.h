@@ -274,7 +274,8 @@ typedef struct vxl_light {
  * is light_shapes[0].struct_size. */
 typedef struct vxl_light_shape {
     uint32_t struct_size;
-    float spot_direction[3]; /* point light (w = 1) only: world direction the spot points along */
+    float spot_direction[3]; /* point light (w = 1) only: world direction the spot points along
+                                (a cone on a directional light is an error) */
     float spot_angle;        /* full cone angle, radians (Blender's spot_size); 0 = no cone */
     float spot_blend;        /* 0..1, soft edge as Blender's spot_blend: the cone's mask is
                                 smoothstep(0, 1, (cos a - cos(angle/2)) / ((1 - cos(angle/2)) * blend)),
@@ -286,27 +287,46 @@ typedef struct vxl_light_shape {
 
 /* Shading models (issue 17), params.shading_model. With T_i the transmittance
  * from the sample to light i through the classified volume (exp of minus the
- * optical depth, opacity per voxel of path as the ray caster composites it),
- * AO the ambient occlusion (the mean transmittance over all directions along
- * rays of ambient_occlusion voxels; 1 when that is 0) and s the
- * occlusion_strength:
+ * optical depth, opacity per voxel of path as the ray caster composites it;
+ * the path ends where it leaves the volume, or at a point light's position),
+ * averaged over the light's extent when its shape has a size (a sun: the
+ * directions of a cone of angular diameter size around its direction; a
+ * point light: the points of a disc of radius size at its position, facing
+ * the sample), AO the ambient occlusion (the mean transmittance over all
+ * directions of the sphere, uniformly in voxel space, along rays of
+ * ambient_occlusion voxels from the sample; 1 when that is 0) and s the
+ * occlusion_strength; n the unit normal (the gradient's direction, turned
+ * to face the eye), l and h the unit vectors towards light i and halfway
+ * between it and the eye, and L_i the light's colour * intensity * its spot
+ * mask (vxl_light_shape.spot_blend, with a the angle between spot_direction
+ * and the direction from the light to the sample; 1 for a light without a
+ * cone):
  *   PHONG     today's local shading: ambient + sum of the lights' diffuse and
- *             specular terms; no shadows.
+ *             specular terms (L_i * (diffuse * max(n.l, 0) * colour + specular
+ *             * max(n.h, 0)^shininess), 0 where n.l <= 0); no shadows, and
+ *             light_shapes are ignored (no spot mask: L_i without it).
  *   SHADOWED  ambient * (1 - s (1 - AO)) + sum of T_i * (the light's diffuse
  *             and specular terms).
- *   SCATTER   ambient * (1 - s (1 - AO)) + sum of T_i * I_i * (w * (diffuse +
- *             specular terms) + (1 - w) * diffuse * 4 pi * HG(cos t, g)), the
+ *   SCATTER   ambient * (1 - s (1 - AO)) + sum of T_i * (w * (the light's
+ *             diffuse and specular terms) + (1 - w) * L_i * diffuse * colour
+ *             * 4 pi * HG(cos t, g)), the
  *             hybrid of Kroes et al. 2012: w = min(1, |grad| / gradient_ref) of
  *             the normalised value per voxel (gradient_ref 0 = 0.05), HG the
  *             Henyey-Greenstein phase function with g = anisotropy and t the
  *             angle between the light's travel and the direction to the eye
- *             (g > 0 scatters forward, towards a viewer facing the light).
+ *             (g > 0 scatters forward, towards a viewer facing the light):
+ *             4 pi HG = (1 - g^2) / (1 + g^2 - 2 g cos t)^1.5, 1 for g = 0.
+ * "ambient" is the material's ambient * colour; each model's result is
+ * clamped to [0, 1] per channel. A sample whose gradient vanishes has no
+ * normal: PHONG and SHADOWED leave it unlit (its colour, as today), SCATTER
+ * keeps only its ambient and phase terms (w = 0).
  * shading_off still gives pure emission-absorption. */
 #define VXL_SHADING_PHONG 0
 #define VXL_SHADING_SHADOWED 1
 #define VXL_SHADING_SCATTER 2
 #define VXL_SHADING_COUNT 3
 VXL_API const char *vxl_shading_model_name(uint32_t model); /* "phong", "shadowed", "scatter" */
+VXL_API int vxl_shading_model_from_name(const char *name, uint32_t *out);
 
 /* Rendering techniques (issue 16), params.technique. The slice-based ones are
  * comparison modes for the benchmark (Engel et al., Real-Time Volume Graphics,
@@ -431,6 +451,12 @@ typedef struct vxl_render_stats {
     /* Compressed storage: milliseconds the last decode into the linear cache
      * took (GPU, finished), 0 when nothing was decoded for this frame. */
     double decode_ms;
+    /* Appended (issue 17): the illumination volumes of the shadowed and
+     * scatter shading models. */
+    uint32_t illumination_size;  /* cells along their longest side (coarser than asked when the memory
+                                    budget is short); 0 when the frame used none */
+    uint32_t illumination_rebuilt; /* volumes (one per light, plus the occlusion) the frame rebuilt: 0
+                                      when only the camera moved */
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);

@@ -54,7 +54,8 @@ VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, con
 #define VXL_PHANTOM_DENSE_BALLS 6    /* its dense twin: a ball on every lattice site */
 #define VXL_PHANTOM_LARGE_SPARSE 7  /* 8-bit Gaussian ellipsoids on 30% of a 12x8x2 lattice; default
                                         2500x1500x400 (over every 2048 texture limit, for bricking) */
-#define VXL_PHANTOM_COUNT 8
+#define VXL_PHANTOM_TWO_BLOBS 8     /* Gaussian blobs (sigma 0.2) at x = -0.45 and +0.45 (shadows, issue 17) */
+#define VXL_PHANTOM_COUNT 9
 
 typedef struct vxl_phantom_desc {
     uint32_t struct_size;

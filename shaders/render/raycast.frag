@@ -1,7 +1,8 @@
 // raycast.frag - front-to-back ray casting with premultiplied compositing.
 // Variants by define: FILTER_* (lib/gradients.glsl), SHADING, REUSE_GRADIENTS,
 // CLASSIFY_PRE / CLASSIFY_PREINT (lib/classify.glsl; post-classification otherwise),
-// GOPACITY 1 (boundary) / 2 (iso-surface): Levoy's gradient-magnitude opacity.
+// GOPACITY 1 (boundary) / 2 (iso-surface): Levoy's gradient-magnitude opacity,
+// SHADING_MODEL 1 (shadowed) / 2 (scatter): lib/shading.glsl's shade_lit.
 #include "lib/gradients.glsl"
 #include "lib/classify.glsl"
 #include "lib/shading.glsl"
@@ -102,7 +103,11 @@ bool add_sample(inout Compositing s, RaySetup r, int i, float t, vec3 p, float v
     s.last_shaded = i;
     g = reuse_gradient(s.gs, g);
 #endif
+#if SHADING_MODEL > 0
+    rgb = shade_lit(rgb, g, r.pos0 + t * r.dpos, p, r.lighting, r.one_directional); // shadows, occlusion
+#else
     rgb = shade(rgb, g, r.pos0 + t * r.dpos, r.lighting, r.one_directional);
+#endif
 #endif
     s.acc += (1.0 - s.acc.a) * a * vec4(rgb, 1.0);
     if (isinf(s.depth) && s.acc.a >= u_depth_threshold) s.depth = -(r.z0 + r.dz * t);

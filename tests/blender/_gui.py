@@ -24,6 +24,15 @@ import bpy
 from mathutils import Euler
 
 
+def view3d():
+    """(window, area, space) of the first 3D viewport."""
+    for win in bpy.context.window_manager.windows:
+        for area in win.screen.areas:
+            if area.type == "VIEW_3D":
+                return win, area, area.spaces.active
+    raise RuntimeError("no 3D viewport")
+
+
 def front_view(space):
     """The GUI tests' view: Solid shading, perspective, from the front (-Y),
     4 units from the origin. Returns the view's RegionView3D."""

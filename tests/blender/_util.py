@@ -149,6 +149,18 @@ def run(name):
         sys.exit(1)
 
 
+def reopen(objects, filename):
+    """Save the file under TMP, drop the add-on's volumes and open it again,
+    as a user reopening their work; returns the objects of the reopened
+    file, in the order given."""
+    names = [ob.name for ob in objects]
+    path = os.path.join(TMP, filename)
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    installed_module().runtime.release_all()
+    bpy.ops.wm.open_mainfile(filepath=path)
+    return [bpy.data.objects[n] for n in names]
+
+
 def reset_scene():
     """Empty the scene (factory startup has a cube, camera and light)."""
     for ob in list(bpy.data.objects):

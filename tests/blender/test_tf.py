@@ -208,12 +208,7 @@ def files_from_before_the_sobel8_default_keep_their_filter():
     for ob in (old_default, chosen):
         ob.voxlight.tf_version = 1
     assert old_default.voxlight.get("filter") is None
-    names = old_default.name, chosen.name
-    path = os.path.join(u.TMP, "tf_v1.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=path)
-    vx.runtime.release_all()
-    bpy.ops.wm.open_mainfile(filepath=path)
-    old_default, chosen = (bpy.data.objects[n] for n in names)
+    old_default, chosen = u.reopen((old_default, chosen), "tf_v1.blend")
     assert old_default.voxlight.filter == "central", old_default.voxlight.filter
     assert chosen.voxlight.filter == "sobel26", chosen.voxlight.filter
     assert old_default.voxlight.tf_version == chosen.voxlight.tf_version == vx.tf.TF_VERSION

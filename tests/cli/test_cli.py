@@ -65,7 +65,14 @@ def png_size(path):
 
 
 def png_alpha_mean(path):
-    """Decodes our own 8-bit RGBA PNG (no filters assumed beyond the standard ones)."""
+    """The mean alpha of our own 8-bit RGBA PNG, in [0, 1]."""
+    rgba = png_rgba(path)
+    return rgba[..., 3].sum() / (rgba.shape[0] * rgba.shape[1] * 255.0)
+
+
+def png_rgba(path):
+    """Decodes our own 8-bit RGBA PNG (no filters assumed beyond the standard
+    ones): an array of (height, width, 4) bytes, the file's first row first."""
     b = Path(path).read_bytes()
     w, h = struct.unpack(">II", b[16:24])
     pos, idat = 8, b""
@@ -78,7 +85,7 @@ def png_alpha_mean(path):
     raw = zlib.decompress(idat)
     stride = w * 4
     prev = bytearray(stride)
-    alpha = 0
+    rows = []
     for y in range(h):
         f = raw[y * (stride + 1)]
         line = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
@@ -97,9 +104,9 @@ def png_alpha_mean(path):
                 pa, pb, pc = abs(p - a), abs(p - up), abs(p - c)
                 pred = a if pa <= pb and pa <= pc else (up if pb <= pc else c)
                 line[i] = (line[i] + pred) & 255
-        alpha += sum(line[3::4])
+        rows.append(bytes(line))
         prev = line
-    return alpha / (w * h * 255.0)
+    return np.frombuffer(b"".join(rows), np.uint8).reshape(h, w, 4)
 
 
 @pytest.fixture

@@ -42,7 +42,7 @@ LAYERS = [
     ["render"],                       # frames, the renderer object, the API
     ["classify", "gradients", "skip"],  # derived volumes the ray caster reads
     ["storage"],                      # dense/bricked/sparse/compressed
-    ["gl", "io"],                     # GL context and programs; file readers
+    ["gl", "io", "frame"],            # GL services; file readers; render parameters
     ["volume"],                       # CPU volumes, phantoms
     ["core"],                         # errors, math, names
     ["include"],                      # the public headers

@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "renderer_internal.h"
+#include "gpu.h"
 #include "shader_source.h"
 
 static const char *const filter_defines[VXL_FILTER_COUNT] = {
@@ -19,14 +19,14 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
 static const char *const cache_formats[] = {"r8", "r16", "r32f", "r32f"};
 
-static int compile(vxl_renderer *r, GLenum type, const char *file, const char *defines, GLuint *out)
+static int compile(vxl_gpu *g, GLenum type, const char *file, const char *defines, GLuint *out)
 {
-    vxl_gl *gl = &r->gl;
+    vxl_gl *gl = &g->gl;
     /* the binding numbers first, so layout(binding = VXL_...) reads gl_bindings.h */
     char all[1024];
     snprintf(all, sizeof all, "%s%s", vxl_glsl_binding_defines(), defines ? defines : "");
     char *src = NULL;
-    int rc = vxl_shader_source(r->shader_dir, file, all, &src, &r->err);
+    int rc = vxl_shader_source(g->shader_dir, file, all, &src, &g->err);
     if (rc) return rc;
     GLuint s = gl->CreateShader(type);
     const GLchar *srcs[1] = {src};
@@ -40,15 +40,15 @@ static int compile(vxl_renderer *r, GLenum type, const char *file, const char *d
         log[0] = '\0';
         gl->GetShaderInfoLog(s, sizeof log, NULL, log);
         gl->DeleteShader(s);
-        return vxl_fail(&r->err, VXL_ERR_SHADER, "shader %s failed to compile: %s", file, log);
+        return vxl_fail(&g->err, VXL_ERR_SHADER, "shader %s failed to compile: %s", file, log);
     }
     *out = s;
     return VXL_OK;
 }
 
-static int link(vxl_renderer *r, GLuint a, GLuint b, GLuint *out)
+static int link(vxl_gpu *g, GLuint a, GLuint b, GLuint *out)
 {
-    vxl_gl *gl = &r->gl;
+    vxl_gl *gl = &g->gl;
     GLuint p = gl->CreateProgram();
     gl->AttachShader(p, a);
     if (b) gl->AttachShader(p, b);
@@ -62,13 +62,13 @@ static int link(vxl_renderer *r, GLuint a, GLuint b, GLuint *out)
         log[0] = '\0';
         gl->GetProgramInfoLog(p, sizeof log, NULL, log);
         gl->DeleteProgram(p);
-        return vxl_fail(&r->err, VXL_ERR_SHADER, "shader program failed to link: %s", log);
+        return vxl_fail(&g->err, VXL_ERR_SHADER, "shader program failed to link: %s", log);
     }
     *out = p;
     return VXL_OK;
 }
 
-static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
+static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
 {
     char defines[256] = "";
     const char *fdef = filter < VXL_FILTER_COUNT ? filter_defines[filter] : filter_defines[0];
@@ -85,117 +85,117 @@ static int build(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags
                  ((flags >> 2) & 3) == VXL_CLASSIFY_PRE      ? "#define CLASSIFY_PRE 1\n"
                  : ((flags >> 2) & 3) == VXL_CLASSIFY_PREINT ? "#define CLASSIFY_PREINT 1\n"
                                                              : "");
-        rc = compile(r, GL_VERTEX_SHADER, "render/raycast.vert", NULL, &a);
+        rc = compile(g, GL_VERTEX_SHADER, "render/raycast.vert", NULL, &a);
         if (rc) return rc;
-        rc = compile(r, GL_FRAGMENT_SHADER, "render/raycast.frag", defines, &b);
+        rc = compile(g, GL_FRAGMENT_SHADER, "render/raycast.frag", defines, &b);
         if (rc) {
-            r->gl.DeleteShader(a);
+            g->gl.DeleteShader(a);
             return rc;
         }
-        return link(r, a, b, out);
+        return link(g, a, b, out);
     case VXL_PROG_PROBE:
         snprintf(defines, sizeof defines, "%s%s", paged, fdef);
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/probe.comp", defines, &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/probe.comp", defines, &a);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_GRAD_BLUR:
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/gradient_blur.comp", NULL, &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/gradient_blur.comp", NULL, &a);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_GRAD_MAX: /* the dense texture's largest gradient (bricked: found on the CPU) */
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_GRAD_STORE:
     case VXL_PROG_PAGED_GRAD_STORE:
         snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
-        rc = compile(r, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_STORE ? "compute/gradient_sobel.comp" : "compute/paged_gradient.comp",
+        rc = compile(g, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_STORE ? "compute/gradient_sobel.comp" : "compute/paged_gradient.comp",
                      defines, &a);
-        return rc ? rc : link(r, a, 0, out);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_BSPLINE_COPY:
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/bspline_prefilter.comp", "#define COPY_PASS 1\n", &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/bspline_prefilter.comp", "#define COPY_PASS 1\n", &a);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_BSPLINE_AXIS:
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/bspline_prefilter.comp", NULL, &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/bspline_prefilter.comp", NULL, &a);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_CLASSIFY_VOLUME:
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/classify_volume.comp", NULL, &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/classify_volume.comp", NULL, &a);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_PAGED_BLUR:
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_DECODE_BRICKS:
         snprintf(defines, sizeof defines, "#define CACHE_FORMAT %s\n", cache_formats[flags & 3]);
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/decode_bricks.comp", defines, &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/decode_bricks.comp", defines, &a);
+        return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_BRICK_MINMAX:
-        rc = compile(r, GL_COMPUTE_SHADER, "compute/brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);
-        return rc ? rc : link(r, a, 0, out);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);
+        return rc ? rc : link(g, a, 0, out);
     default:
-        return vxl_fail(&r->err, VXL_ERR_INVALID_ARGUMENT, "unknown program kind %u", kind);
+        return vxl_fail(&g->err, VXL_ERR_INVALID_ARGUMENT, "unknown program kind %u", kind);
     }
 }
 
-int vxl_program_get(vxl_renderer *r, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
+int vxl_program_get(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
 {
     uint32_t key = kind | (filter << 4) | (flags << 12);
-    for (int i = 0; i < r->n_programs; i++)
-        if (r->programs[i].key == key) {
-            *out = r->programs[i].program;
+    for (int i = 0; i < g->n_programs; i++)
+        if (g->programs[i].key == key) {
+            *out = g->programs[i].program;
             return VXL_OK;
         }
     GLuint p = 0;
-    int rc = build(r, kind, filter, flags, &p);
+    int rc = build(g, kind, filter, flags, &p);
     if (rc) return rc;
-    if (r->n_programs == VXL_MAX_PROGRAMS) { /* the key space is smaller than the cache */
-        r->gl.DeleteProgram(p);
-        return vxl_fail(&r->err, VXL_ERR_STATE, "program cache full");
+    if (g->n_programs == VXL_MAX_PROGRAMS) { /* the key space is smaller than the cache */
+        g->gl.DeleteProgram(p);
+        return vxl_fail(&g->err, VXL_ERR_STATE, "program cache full");
     }
-    r->programs[r->n_programs].key = key;
-    r->programs[r->n_programs++].program = p;
+    g->programs[g->n_programs].key = key;
+    g->programs[g->n_programs++].program = p;
     *out = p;
     return VXL_OK;
 }
 
-void vxl_programs_delete(vxl_renderer *r)
+void vxl_programs_delete(vxl_gpu *g)
 {
-    for (int i = 0; i < r->n_programs; i++) r->gl.DeleteProgram(r->programs[i].program);
-    r->n_programs = 0;
+    for (int i = 0; i < g->n_programs; i++) g->gl.DeleteProgram(g->programs[i].program);
+    g->n_programs = 0;
 }
 
-void vxl_uniform_i(vxl_renderer *r, GLuint prog, const char *name, int v)
+void vxl_uniform_i(vxl_gpu *g, GLuint prog, const char *name, int v)
 {
-    GLint loc = r->gl.GetUniformLocation(prog, name);
-    if (loc >= 0) r->gl.Uniform1i(loc, v);
+    GLint loc = g->gl.GetUniformLocation(prog, name);
+    if (loc >= 0) g->gl.Uniform1i(loc, v);
 }
 
-void vxl_uniform_f(vxl_renderer *r, GLuint prog, const char *name, float v)
+void vxl_uniform_f(vxl_gpu *g, GLuint prog, const char *name, float v)
 {
-    GLint loc = r->gl.GetUniformLocation(prog, name);
-    if (loc >= 0) r->gl.Uniform1f(loc, v);
+    GLint loc = g->gl.GetUniformLocation(prog, name);
+    if (loc >= 0) g->gl.Uniform1f(loc, v);
 }
 
 /* Created on the scratch unit, so making a texture never disturbs what a
  * program has bound on its sampler units. Leaves VXL_SCRATCH_UNIT active. */
-GLuint vxl_texture_new(vxl_renderer *r, GLenum target, GLint filter)
+GLuint vxl_texture_new(vxl_gpu *g, GLenum target, GLint filter)
 {
     GLuint t = 0;
-    r->gl.ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
-    r->gl.GenTextures(1, &t);
-    r->gl.BindTexture(target, t);
-    r->gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);
-    r->gl.TexParameteri(target, GL_TEXTURE_MAG_FILTER, filter);
-    r->gl.TexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    r->gl.TexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    r->gl.TexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-    r->gl.TexParameteri(target, GL_TEXTURE_BASE_LEVEL, 0);
-    r->gl.TexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
+    g->gl.ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
+    g->gl.GenTextures(1, &t);
+    g->gl.BindTexture(target, t);
+    g->gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);
+    g->gl.TexParameteri(target, GL_TEXTURE_MAG_FILTER, filter);
+    g->gl.TexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    g->gl.TexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    g->gl.TexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    g->gl.TexParameteri(target, GL_TEXTURE_BASE_LEVEL, 0);
+    g->gl.TexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
     return t;
 }
 
-int vxl_gl_check(vxl_renderer *r, const char *what)
+int vxl_gl_check(vxl_gpu *g, const char *what)
 {
-    GLenum e = r->gl.GetError(), first = e;
-    while (e != GL_NO_ERROR) e = r->gl.GetError(); /* drain */
+    GLenum e = g->gl.GetError(), first = e;
+    while (e != GL_NO_ERROR) e = g->gl.GetError(); /* drain */
     if (first == GL_NO_ERROR) return VXL_OK;
     if (first == GL_OUT_OF_MEMORY)
-        return vxl_fail(&r->err, VXL_ERR_NO_MEMORY, "%s: the OpenGL implementation ran out of memory", what);
-    return vxl_fail(&r->err, VXL_ERR_GL, "%s: OpenGL error 0x%04x", what, first);
+        return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "%s: the OpenGL implementation ran out of memory", what);
+    return vxl_fail(&g->err, VXL_ERR_GL, "%s: OpenGL error 0x%04x", what, first);
 }

@@ -1,25 +1,26 @@
-/* holdings.c - the renderer's holdings for the budget (holdings.h). */
+/* holdings.c - the holders of GL memory, read for the budget (holdings.h). */
 #include "holdings.h"
 
 #include <stdarg.h>
 
-#include "renderer_internal.h"
-
-void vxl_holdings(const vxl_renderer *r, uint64_t held[VXL_HOLD_COUNT])
+void vxl_holding_register(vxl_gpu *g, vxl_holder who, uint64_t (*bytes)(const void *state), const void *state)
 {
-    held[VXL_HOLD_STORAGE] = r->storage.ops ? r->storage.ops->resident_bytes(r) : 0;
-    held[VXL_HOLD_GRADIENTS] = r->gradients.bytes;
-    held[VXL_HOLD_BSPLINE] = r->bspline.bytes;
-    held[VXL_HOLD_CLASSIFIED] = r->classification.classified_bytes;
+    g->holdings[who] = (vxl_holding){bytes, state};
 }
 
-int vxl_holdings_ask(vxl_renderer *r, vxl_holder who, uint64_t bytes, const char *hint, const char *what, ...)
+void vxl_holdings(const vxl_gpu *g, uint64_t held[VXL_HOLD_COUNT])
+{
+    for (int h = 0; h < VXL_HOLD_COUNT; h++)
+        held[h] = g->holdings[h].bytes ? g->holdings[h].bytes(g->holdings[h].state) : 0;
+}
+
+int vxl_holdings_ask(vxl_gpu *g, vxl_holder who, uint64_t bytes, const char *hint, const char *what, ...)
 {
     uint64_t held[VXL_HOLD_COUNT];
-    vxl_holdings(r, held);
+    vxl_holdings(g, held);
     va_list ap;
     va_start(ap, what);
-    int rc = vxl_budget_vask(r->budget, held, who, bytes, &r->err, hint, what, ap);
+    int rc = vxl_budget_vask(g->budget, held, who, bytes, &g->err, hint, what, ap);
     va_end(ap);
     return rc;
 }

@@ -1,7 +1,8 @@
 /* storage.c - which storage table serves a volume. A new mode is a new
  * table (storage.h) and one line here. */
 #include "budget.h"
-#include "renderer_internal.h"
+#include "holdings.h"
+#include "storage.h"
 
 static const vxl_storage_ops *const tables[VXL_STORAGE_COUNT] = {
     [VXL_STORAGE_AUTO] = &vxl_storage_bricked, /* reached only when dense does not fit; the plan picks bricked or sparse */
@@ -13,10 +14,22 @@ static const vxl_storage_ops *const tables[VXL_STORAGE_COUNT] = {
 
 const vxl_storage_ops *vxl_storage_ops_for(uint32_t mode) { return mode < VXL_STORAGE_COUNT ? tables[mode] : NULL; }
 
-uint32_t vxl_storage_choose(const vxl_renderer *r, const vxl_volume *v)
+uint32_t vxl_storage_choose(const vxl_storage_state *st, const vxl_volume *v)
 {
-    if (r->storage.request != VXL_STORAGE_AUTO) return r->storage.request;
+    if (st->request != VXL_STORAGE_AUTO) return st->request;
     for (int a = 0; a < 3; a++)
-        if (v->dims[a] > (uint32_t)r->info.max_3d_texture_size) return VXL_STORAGE_AUTO;
-    return vxl_budget_fits(r->budget, NULL, VXL_HOLD_STORAGE, v->storage_bytes) ? VXL_STORAGE_DENSE : VXL_STORAGE_AUTO;
+        if (v->dims[a] > (uint32_t)st->gpu->info.max_3d_texture_size) return VXL_STORAGE_AUTO;
+    return vxl_budget_fits(st->gpu->budget, NULL, VXL_HOLD_STORAGE, v->storage_bytes) ? VXL_STORAGE_DENSE : VXL_STORAGE_AUTO;
+}
+
+static uint64_t held_bytes(const void *state)
+{
+    const vxl_storage_state *st = state;
+    return st->ops ? st->ops->resident_bytes(st) : 0;
+}
+
+void vxl_storage_init(vxl_storage_state *st, vxl_gpu *g)
+{
+    st->gpu = g;
+    vxl_holding_register(g, VXL_HOLD_STORAGE, held_bytes, st);
 }

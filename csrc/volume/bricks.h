@@ -38,6 +38,8 @@ typedef struct vxl_occupancy_rule {
     float sample_distance;  /* voxels between gradient taps */
 } vxl_occupancy_rule;
 
+/* The skipping grid's brick edge: VXL_DEFAULT_BRICK, or VOXLIGHT_BRICK_SIZE. */
+uint32_t vxl_skip_brick_size(void);
 /* Occupancy + distance map under the rule; returns 1 if it changed (the
  * caller re-uploads), 0 if the cached one still holds, -1 out of memory. */
 int vxl_bricks_classify(vxl_bricks *b, const vxl_occupancy_rule *c);

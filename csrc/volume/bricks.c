@@ -9,6 +9,15 @@
 
 #include "voxlight.h"
 
+/* VOXLIGHT_BRICK_SIZE (4..64) overrides the brick edge for measurements; the
+ * default is justified in docs/skipping.md. */
+uint32_t vxl_skip_brick_size(void)
+{
+    const char *env = getenv("VOXLIGHT_BRICK_SIZE");
+    long v = env ? strtol(env, NULL, 10) : 0;
+    return v >= 4 && v <= 64 ? (uint32_t)v : VXL_DEFAULT_BRICK;
+}
+
 /* Table index a normalised value maps to (as classify.glsl computes it). */
 static double table_pos(const vxl_occupancy_rule *f, double v)
 {

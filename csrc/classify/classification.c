@@ -113,11 +113,9 @@ int vxl_classification_prepare(vxl_classification_state *cl, const vxl_frame *f)
     }
 }
 
-static uint64_t held_bytes(const void *state) { return ((const vxl_classification_state *)state)->classified_bytes; }
-
 void vxl_classification_init(vxl_classification_state *cl, vxl_gpu *g, vxl_storage_state *st)
 {
     cl->gpu = g;
     cl->storage = st;
-    vxl_holding_register(g, VXL_HOLD_CLASSIFIED, held_bytes, cl);
+    vxl_holding_register(g, VXL_HOLD_CLASSIFIED, vxl_holding_counter, &cl->classified_bytes);
 }

@@ -9,8 +9,8 @@
  * derives; so the storage asks with held NULL. A derived volume (gradients,
  * B-spline coefficients, the classified volume) replaces only itself: the
  * others stay resident beside it and are charged (holdings.h: each holder
- * registers how to read its bytes). This file knows no renderer, so the storage can ask
- * without depending on what is derived from it. */
+ * registers how to read its bytes). This file knows no renderer, so the
+ * storage can ask without depending on what is derived from it. */
 #ifndef VXL_BUDGET_H
 #define VXL_BUDGET_H
 

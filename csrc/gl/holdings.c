@@ -8,6 +8,8 @@ void vxl_holding_register(vxl_gpu *g, vxl_holder who, uint64_t (*bytes)(const vo
     g->holdings[who] = (vxl_holding){bytes, state};
 }
 
+uint64_t vxl_holding_counter(const void *bytes) { return *(const uint64_t *)bytes; }
+
 void vxl_holdings(const vxl_gpu *g, uint64_t held[VXL_HOLD_COUNT])
 {
     for (int h = 0; h < VXL_HOLD_COUNT; h++)

@@ -13,6 +13,8 @@
 
 /* Holder `who` reports its bytes through bytes(state) from now on. */
 void vxl_holding_register(vxl_gpu *g, vxl_holder who, uint64_t (*bytes)(const void *state), const void *state);
+/* The bytes function of a holder whose state is its byte count (a uint64_t). */
+uint64_t vxl_holding_counter(const void *bytes);
 /* Fills held[VXL_HOLD_COUNT] with the bytes each holder holds now (0: none registered). */
 void vxl_holdings(const vxl_gpu *g, uint64_t held[VXL_HOLD_COUNT]);
 /* vxl_budget_ask against the budget, the holdings and the error slot of g. */

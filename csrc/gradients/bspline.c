@@ -74,8 +74,6 @@ static uint64_t pool_bytes(const void *state, uint32_t level, int unused, uint8_
     (void)unused;
     return vxl_paged_bspline_bytes(state, level, want, count);
 }
-static uint64_t held_bytes(const void *state) { return ((const vxl_bspline_state *)state)->bytes; }
-
 void vxl_bspline_init(vxl_bspline_state *bs, vxl_gpu *g, vxl_storage_state *st)
 {
     bs->gpu = g;
@@ -85,5 +83,5 @@ void vxl_bspline_init(vxl_bspline_state *bs, vxl_gpu *g, vxl_storage_state *st)
         .state = bs, .whole = whole, .per_brick = per_brick, .release = release, .pool_bytes = pool_bytes,
         .page_tex = &bs->page_tex, .pool_dims = bs->pool_dims, .page_unit = VXL_CPAGE_UNIT,
         .page_name = "u_cpage", .dims_name = "u_cpool_dims"};
-    vxl_holding_register(g, VXL_HOLD_BSPLINE, held_bytes, bs);
+    vxl_holding_register(g, VXL_HOLD_BSPLINE, vxl_holding_counter, &bs->bytes);
 }

@@ -121,8 +121,6 @@ static uint64_t pool_bytes(const void *state, uint32_t level, int store, uint8_t
 {
     return vxl_paged_gradient_bytes(state, level, store, want, count);
 }
-static uint64_t held_bytes(const void *state) { return ((const vxl_gradient_state *)state)->bytes; }
-
 void vxl_gradients_init(vxl_gradient_state *gr, vxl_gpu *g, vxl_storage_state *st)
 {
     gr->gpu = g;
@@ -133,5 +131,5 @@ void vxl_gradients_init(vxl_gradient_state *gr, vxl_gpu *g, vxl_storage_state *s
         .page_name = "u_gpage", .dims_name = "u_gpool_dims",
         /* computed on the GL side from the pool: the blur and the Sobel reach 2 voxels each */
         .reads_pool = 1, .support = VXL_GRADIENT_SUPPORT, .read_reach = VXL_GRADIENT_READ_REACH};
-    vxl_holding_register(g, VXL_HOLD_GRADIENTS, held_bytes, gr);
+    vxl_holding_register(g, VXL_HOLD_GRADIENTS, vxl_holding_counter, &gr->bytes);
 }

@@ -27,11 +27,11 @@
 #define VXL_IMAGE_OUT 0           /* every compute pass: the texture it writes (the B-spline prefilter also reads it) */
 
 /* Shader-storage buffer bindings. */
-#define VXL_SSBO_GRADIENT_MAX 0   /* gradient_sobel.comp's max pass: the largest |gradient| as float bits */
+#define VXL_SSBO_GRADIENT_MAX 0   /* gradients.comp's max pass: the largest |gradient| as float bits */
 #define VXL_SSBO_PROBE_POINTS 0   /* probe.comp: the points to probe */
 #define VXL_SSBO_PROBE_RESULTS 1  /* probe.comp: what it measured */
 #define VXL_SSBO_STATS 2          /* raycast.frag: the frame's sample counts */
-#define VXL_SSBO_BRICK_LIST 2     /* paged_gradient.comp, decode_bricks.comp: per slot, the brick (or code slot) to derive */
+#define VXL_SSBO_BRICK_LIST 2     /* gradients.comp (bricked), decode_bricks.comp: per slot, the brick (or code slot) to derive */
 
 #define VXL_GLSL_STR_(x) #x
 #define VXL_GLSL_STR(x) VXL_GLSL_STR_(x)

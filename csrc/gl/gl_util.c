@@ -98,16 +98,18 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         rc = compile(g, GL_COMPUTE_SHADER, "compute/probe.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_GRAD_BLUR:
-        rc = compile(g, GL_COMPUTE_SHADER, "compute/gradient_blur.comp", NULL, &a);
+    case VXL_PROG_PAGED_BLUR:
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/gradients.comp",
+                     kind == VXL_PROG_PAGED_BLUR ? "#define PAGED 1\n#define BLUR_PASS 1\n" : "#define BLUR_PASS 1\n", &a);
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_GRAD_MAX: /* the dense texture's largest gradient (bricked: found on the CPU) */
-        rc = compile(g, GL_COMPUTE_SHADER, "compute/gradient_sobel.comp", "#define MAX_PASS 1\n", &a);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/gradients.comp", "#define MAX_PASS 1\n", &a);
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_GRAD_STORE:
     case VXL_PROG_PAGED_GRAD_STORE:
-        snprintf(defines, sizeof defines, "#define GRADIENT_FORMAT %s\n", store_formats[flags % 3]);
-        rc = compile(g, GL_COMPUTE_SHADER, kind == VXL_PROG_GRAD_STORE ? "compute/gradient_sobel.comp" : "compute/paged_gradient.comp",
-                     defines, &a);
+        snprintf(defines, sizeof defines, "%s#define GRADIENT_FORMAT %s\n", kind == VXL_PROG_PAGED_GRAD_STORE ? "#define PAGED 1\n" : "",
+                 store_formats[flags % 3]);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/gradients.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_BSPLINE_COPY:
         rc = compile(g, GL_COMPUTE_SHADER, "compute/bspline_prefilter.comp", "#define COPY_PASS 1\n", &a);
@@ -117,9 +119,6 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_CLASSIFY_VOLUME:
         rc = compile(g, GL_COMPUTE_SHADER, "compute/classify_volume.comp", NULL, &a);
-        return rc ? rc : link(g, a, 0, out);
-    case VXL_PROG_PAGED_BLUR:
-        rc = compile(g, GL_COMPUTE_SHADER, "compute/paged_gradient.comp", "#define BLUR_PASS 1\n", &a);
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_DECODE_BRICKS:
         snprintf(defines, sizeof defines, "#define CACHE_FORMAT %s\n", cache_formats[flags & 3]);

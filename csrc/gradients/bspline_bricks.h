@@ -2,7 +2,7 @@
  * derived from the volume (pure, no GL): the cubic filter's B-spline
  * coefficients brick by brick, and the precomputed filter's global maximum
  * gradient magnitude. Both reproduce what the dense compute shaders give for
- * one texture (bspline_prefilter.comp; gradient_blur.comp + gradient_sobel.comp),
+ * one texture (bspline_prefilter.comp; gradients.comp),
  * so bricked and sparse storage render what dense storage renders. */
 #ifndef VXL_BSPLINE_BRICKS_H
 #define VXL_BSPLINE_BRICKS_H

@@ -1,7 +1,7 @@
 /* paged_gradients.c - the precomputed gradient filter with bricked and sparse
  * storage: the same blur + Sobel + global-max scaling as precompute.c,
  * computed per brick into a gradient pool with its own page table (shaders/
- * paged_gradient.comp). A brick needs gradient data unless every voxel
+ * gradients.comp with PAGED). A brick needs gradient data unless every voxel
  * within 2 of it holds one value (then its gradient is exactly zero: the
  * blur and the Sobel reach 2 voxels), and, sparse, only when a visible
  * sample can read it. The maximum that scales the stored gradients is the

@@ -19,7 +19,7 @@
 
 typedef struct vxl_storage_state vxl_storage_state;
 
-/* Volumes derived from the data that bricked storage derives per brick. */
+/* The volumes derived from the data that the storage builds (whole or per brick). */
 enum { VXL_DERIVED_GRADIENTS, VXL_DERIVED_BSPLINE, VXL_DERIVED_COUNT };
 
 /* The derived volume a gradient filter samples (VXL_DERIVED_*), -1 for none. */

@@ -74,7 +74,7 @@ FOLDERS = {
 MOVES = {name: folder for folder, names in FOLDERS.items() for name in names.split()}
 
 SOURCE_EXT = (".c", ".h", ".cpp")
-TEXT_EXT = (".c", ".h", ".cpp", ".py", ".sh", ".md", ".txt", ".mk", ".toml", ".cfg", ".json", ".glsl")
+TEXT_EXT = (".c", ".h", ".cpp", ".py", ".sh", ".md", ".txt", ".mk", ".toml", ".cfg", ".json", ".glsl", ".comp", ".vert", ".frag")
 # never rewritten: this script's table, and the checker's own examples
 KEEP = {"tools/relayout.py", "tests/cli/test_check_includes.py"}
 
@@ -99,7 +99,7 @@ def rewrite_paths(text, moves):
     """csrc/NAME -> csrc/FOLDER/NAME for every moved NAME (not a longer name,
     not one already in a folder)."""
     names = sorted(moves, key=len, reverse=True)
-    pattern = re.compile(r"(?<![\w/.-])csrc/(" + "|".join(re.escape(n) for n in names) + r")(?![\w.])")
+    pattern = re.compile(r"(?<![\w/.-])csrc/(" + "|".join(re.escape(n) for n in names) + r")(?!\w|\.\w)")
     text = pattern.sub(lambda m: f"csrc/{moves[m.group(1)]}/{m.group(1)}", text)
     # globs over the flat folder
     text = text.replace("csrc/helper_*.c", "csrc/*/helper_*.c")

@@ -10,27 +10,36 @@ OPT := -O2 -g
 ifeq ($(SAN),1)
 OPT := -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 endif
-CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include -Icsrc -I$(BUILD)/gen
-CXXFLAGS := -std=c++17 $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include -Icsrc $(shell pkg-config --cflags OpenImageIO)
+# csrc/ holds one folder per pipeline stage (docs/architecture.md); the
+# layer order is checked by tools/check_includes.py. Sources are found by
+# wildcard over the folders, objects stay flat in $(BUILD)/obj/ (file names
+# are unique across csrc/), and each folder is on the include path after
+# csrc/include, so `#include "error.h"` names no folder.
+CSRC_DIRS := $(filter-out csrc/include,$(patsubst %/,%,$(sort $(dir $(wildcard csrc/*/*.c csrc/*/*.cpp csrc/*/*.h)))))
+CSRC_INC := $(addprefix -I,$(CSRC_DIRS))
+vpath %.c $(CSRC_DIRS)
+vpath %.cpp $(CSRC_DIRS)
+CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include $(CSRC_INC) -I$(BUILD)/gen
+CXXFLAGS := -std=c++17 $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include $(CSRC_INC) $(shell pkg-config --cflags OpenImageIO)
 OIIO_LIBS := $(shell pkg-config --libs OpenImageIO)
-# dcmtk (DICOM, csrc/dicom.cpp): Debian 12's dcmtk.pc names sndfile, which is
+# dcmtk (DICOM, csrc/io/dicom.cpp): Debian 12's dcmtk.pc names sndfile, which is
 # not installed, so the three libraries dcmdata needs are named directly.
 DCMTK_LIBS := -ldcmdata -loflog -lofstd
 
 # libvoxlight.so is C and links only the C runtime (issue 13): the readers
 # that need OpenImageIO or dcmtk are built into helper processes next to it
-# (csrc/reader_stream.h), one per library, so a missing library breaks only
+# (csrc/io/reader_stream.h), one per library, so a missing library breaks only
 # its own formats: voxlight-read-oiio (TIFF/PNG stacks, OpenVDB) and
-# voxlight-read-dicom (DICOM). csrc/helper_*.c are the helpers' own files.
-OIIO_CXX := csrc/image_stack.cpp csrc/vdb.cpp
-DICOM_CXX := csrc/dicom.cpp
-HELPER_C := $(wildcard csrc/helper_*.c)
-LIB_C := $(filter-out csrc/cli.c $(HELPER_C),$(wildcard csrc/*.c))
+# voxlight-read-dicom (DICOM). csrc/*/helper_*.c are the helpers' own files.
+OIIO_CXX := csrc/io/image_stack.cpp csrc/io/vdb.cpp
+DICOM_CXX := csrc/io/dicom.cpp
+HELPER_C := $(wildcard csrc/*/helper_*.c)
+LIB_C := $(filter-out csrc/cli/cli.c $(HELPER_C),$(wildcard csrc/*/*.c))
 LIBS := -ldl -lpthread -lz -lm
 # shaders/lib: included code; compute/: compute programs; render/: the ray
-# caster's stages. A shader's name is its path under shaders/ (csrc/shader_source.h).
+# caster's stages. A shader's name is its path under shaders/ (csrc/gl/shader_source.h).
 SHADERS := $(wildcard shaders/lib/*.glsl shaders/compute/*.comp shaders/render/*.vert shaders/render/*.frag)
-OBJ := $(LIB_C:csrc/%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/shaders_embedded.o
+OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_embedded.o
 # What the helpers' readers use of the core (volume building, errors, file
 # helpers), linked into each helper, which needs no libvoxlight.so.
 HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume error loader_util)
@@ -43,10 +52,10 @@ TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
 all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(STUDIES) $(TESTS)
 
-$(BUILD)/obj/%.o: csrc/%.c $(wildcard csrc/*.h csrc/include/*.h) | $(BUILD)/obj
+$(BUILD)/obj/%.o: %.c $(wildcard csrc/*/*.h) | $(BUILD)/obj
 	$(CC) $(CFLAGS) -c $< -o $@
 
-$(BUILD)/obj/%.o: csrc/%.cpp $(wildcard csrc/*.h csrc/include/*.h) | $(BUILD)/obj
+$(BUILD)/obj/%.o: %.cpp $(wildcard csrc/*/*.h) | $(BUILD)/obj
 	$(CXX) $(CXXFLAGS) -c $< -o $@
 
 # Shaders are embedded at build time so an installed library needs no shader path.
@@ -63,7 +72,7 @@ $(BUILD)/libvoxlight.so: $(OBJ)
 	$(CC) -shared $(OPT) -Wl,-soname,libvoxlight.so -Wl,--no-undefined -o $@ $^ $(LIBS)
 
 # Which library file and Debian package each helper needs, for the message a
-# user gets when one is missing (csrc/remote_readers.c): the SONAME of the
+# user gets when one is missing (csrc/io/remote_readers.c): the SONAME of the
 # .so this build links and `dpkg -S` of its real path ("" when dpkg cannot
 # tell; the message then names the file alone).
 %/gen/reader_packages.h: Makefile
@@ -80,15 +89,15 @@ $(BUILD)/libvoxlight.so: $(OBJ)
 
 $(BUILD)/obj/remote_readers.o: $(BUILD)/gen/reader_packages.h
 
-$(BUILD)/voxlight: csrc/cli.c $(BUILD)/libvoxlight.so
+$(BUILD)/voxlight: csrc/cli/cli.c $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
-# The reader helpers (csrc/reader_stream.h): the C++ readers, the core
+# The reader helpers (csrc/io/reader_stream.h): the C++ readers, the core
 # objects they use and their library; started by libvoxlight.so.
-$(BUILD)/voxlight-read-oiio: $(BUILD)/obj/helper_oiio.o $(OIIO_CXX:csrc/%.cpp=$(BUILD)/obj/%.o) $(HELPER_CORE)
+$(BUILD)/voxlight-read-oiio: $(BUILD)/obj/helper_oiio.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(OIIO_CXX))) $(HELPER_CORE)
 	$(CXX) $(OPT) -o $@ $^ $(OIIO_LIBS) -lz -lm
 
-$(BUILD)/voxlight-read-dicom: $(BUILD)/obj/helper_dicom.o $(DICOM_CXX:csrc/%.cpp=$(BUILD)/obj/%.o) $(HELPER_CORE)
+$(BUILD)/voxlight-read-dicom: $(BUILD)/obj/helper_dicom.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(DICOM_CXX))) $(HELPER_CORE)
 	$(CXX) $(OPT) -o $@ $^ $(DCMTK_LIBS) -lz -lm
 
 $(BUILD)/voxlight-bench: bench/bench.c $(BUILD)/libvoxlight.so
@@ -123,9 +132,9 @@ $(BUILD)/obj $(BUILD)/gen $(BUILD)/tests:
 # in directly, plus the seed writer; ./build.sh fuzz / test run them.
 FUZZ_BUILD := build/fuzz
 FUZZ_SAN := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
-FUZZ_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include -Icsrc \
+FUZZ_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include $(CSRC_INC) \
 	-I$(FUZZ_BUILD)/gen
-FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include -Icsrc \
+FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include $(CSRC_INC) \
 	$(shell pkg-config --cflags OpenImageIO)
 # the core's loaders and dispatch (the helper-run readers are called
 # in-process by their targets: libFuzzer sees coverage in its own process only)
@@ -137,15 +146,15 @@ FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard t
 
 fuzz: $(FUZZ_TARGETS) $(FUZZ_BUILD)/make_seeds
 
-$(FUZZ_BUILD)/obj/%.o: csrc/%.c $(wildcard csrc/*.h csrc/include/*.h) | $(FUZZ_BUILD)/obj
+$(FUZZ_BUILD)/obj/%.o: %.c $(wildcard csrc/*/*.h) | $(FUZZ_BUILD)/obj
 	clang $(FUZZ_CFLAGS) -c $< -o $@
 
 $(FUZZ_BUILD)/obj/remote_readers.o: $(FUZZ_BUILD)/gen/reader_packages.h
 
-$(FUZZ_BUILD)/obj/%.o: csrc/%.cpp $(wildcard csrc/*.h csrc/include/*.h) | $(FUZZ_BUILD)/obj
+$(FUZZ_BUILD)/obj/%.o: %.cpp $(wildcard csrc/*/*.h) | $(FUZZ_BUILD)/obj
 	clang++ $(FUZZ_CXXFLAGS) -c $< -o $@
 
-$(FUZZ_BUILD)/obj/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h csrc/include/voxlight.h csrc/helper_main.h | $(FUZZ_BUILD)/obj
+$(FUZZ_BUILD)/obj/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h csrc/include/voxlight.h csrc/io/helper_main.h | $(FUZZ_BUILD)/obj
 	clang $(FUZZ_CFLAGS) -c $< -o $@
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/fuzz_%.o $(FUZZ_OBJ)

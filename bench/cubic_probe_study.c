@@ -4,7 +4,7 @@
  * cubic B-spline derivative evaluated on the CPU in double precision from the
  * stored texels, and with that CPU evaluation when the two-fetch trick's
  * linear-fetch weights are rounded to 1/256 (8-bit fixed point).
- * Build: cc -O2 -std=c11 -D_GNU_SOURCE -Icsrc/include -Icsrc bench/cubic_probe_study.c \
+ * Build: cc -O2 -std=c11 -D_GNU_SOURCE -Icsrc/include -Icsrc/volume -Icsrc/core bench/cubic_probe_study.c \
  *          -Lbuild -lvoxlight -lm -Wl,-rpath,$PWD/build -o build/cubic-probe-study
  * Run:   build/cubic-probe-study /usr/share/mricron/templates/ch2better.nii.gz */
 #include <math.h>

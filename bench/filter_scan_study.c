@@ -11,7 +11,7 @@
  * azimuth; ZOOM=k CX=x CY=y another crop; LATTICE=1 prints the roughness by
  * lattice offset instead of rendering; TIME=1 prints frame-time ratios.
  * docs/filters_on_scans.md has the commands behind its tables.
- * Build: make (build/filter-scan-study); by hand: cc -O2 -std=c11 -D_GNU_SOURCE -Icsrc/include -Icsrc \
+ * Build: make (build/filter-scan-study); by hand: cc -O2 -std=c11 -D_GNU_SOURCE -Icsrc/include -Icsrc/volume -Icsrc/core \
  *          bench/filter_scan_study.c -Lbuild -lvoxlight -lm -Wl,-rpath,$PWD/build -o build/filter-scan-study */
 #include <math.h>
 #include <stdio.h>

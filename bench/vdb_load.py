@@ -1,7 +1,7 @@
 """Load time of an OpenVDB grid against the same floats as raw NIfTI, through
 `build/voxlight info` (load + value range, no GL): what the VDB path adds on
 top of the shared volume build. The library reads .vdb files in a helper
-process (csrc/reader_spawn.c, `voxlight-read-oiio`); the "helper alone" row is that process's
+process (csrc/io/reader_spawn.c, `voxlight-read-oiio`); the "helper alone" row is that process's
 in-process read with its output thrown away, and VOXLIGHT_BASELINE_CLI names
 another `voxlight` build to time too (e.g. one from before the helper, which
 read in-process). Usage: /usr/bin/python3 bench/vdb_load.py [N]"""

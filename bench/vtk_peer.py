@@ -60,7 +60,7 @@ def read_nifti(path):
 
 
 def mri_table():
-    """Mirror of vxl_preset_table(VXL_PRESET_MRI) in csrc/transfer.c, which is
+    """Mirror of vxl_preset_table(VXL_PRESET_MRI) in csrc/frame/transfer.c, which is
     not exported from libvoxlight. Used only when the scene JSON carries no
     "tf_rgba"; keep the two in step."""
     x = np.arange(256) / 255.0

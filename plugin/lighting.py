@@ -35,7 +35,7 @@ SHADOW_QUALITIES = (
 )
 _SIZE_OF = {key: size for key, _n, _d, size in SHADOW_QUALITIES}
 # While a light is dragged in the viewport, a quality finer than this (the
-# library's automatic size, AUTO_SIZE in csrc/illumination.c) drops to it:
+# library's automatic size, AUTO_SIZE in csrc/light/illumination.c) drops to it:
 # each redraw then sweeps 64^3 cells instead of 128^3 or 256^3 (1/8, 1/64),
 # and the switch costs no extinction pass, which the library keeps when only
 # the lights' grid gets coarser (about 0.9 s at 64 cells on ch2better under

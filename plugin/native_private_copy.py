@@ -13,7 +13,7 @@ import tempfile
 import time
 
 # The reader processes the library starts, found next to the library itself
-# (csrc/reader_spawn.c, csrc/reader_stream.h): voxlight-read-oiio (TIFF/PNG
+# (csrc/io/reader_spawn.c, csrc/io/reader_stream.h): voxlight-read-oiio (TIFF/PNG
 # stacks and OpenVDB) and voxlight-read-dicom; every voxlight-read-* file is
 # shipped and copied with the library.
 HELPER_PREFIX = "voxlight-read-"
@@ -27,7 +27,7 @@ OLD_VDB_HELPER_NAME = "voxlight-vdb-read"  # its name in older builds
 # are; if libvoxlight.so were mapped from there, the running Blender would
 # crash at its next call into it. So the library is loaded from a copy in a
 # cache folder named by the content's hash, together with the reader helpers
-# it starts from its own folder (found with dladdr, csrc/reader_spawn.c). An
+# it starts from its own folder (found with dladdr, csrc/io/reader_spawn.c). An
 # updated add-on has another hash, hence a new folder and a fresh dlopen
 # (dlopen of the old path would hand back the old, already loaded library).
 # Each process holds a shared flock on the folder it uses; a folder nobody

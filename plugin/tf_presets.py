@@ -5,7 +5,7 @@ Every preset the panel offers is a piecewise-linear function of "preset
 units" given as stops [(u, (r, g, b, a)), ...], plus how it is placed on
 data (tf_fit.place turns that into a window and ColorRamp stops):
 
-  * the library's built-in tables (Gray, Bone, Hot, MRI, CT; csrc/transfer.c)
+  * the library's built-in tables (Gray, Bone, Hot, MRI, CT; csrc/frame/transfer.c)
     are re-computed here with the same formulas and reduced to at most
     MAX_STOPS stops whose linear interpolation stays within TABLE_TOLERANCE
     of the 256-entry table, so loading one into a ColorRamp reproduces what
@@ -33,7 +33,7 @@ def _smoothstep(a, b, x):
 
 
 def builtin_table(name, size=TABLE_SIZE):
-    """The library's built-in table `name` (csrc/transfer.c,
+    """The library's built-in table `name` (csrc/frame/transfer.c,
     vxl_preset_table), (size, 4) float32 straight RGBA over x in [0, 1]."""
     x = np.linspace(0.0, 1.0, size)
     one, zero = np.ones_like(x), np.zeros_like(x)

@@ -1,5 +1,5 @@
 /* test_budget.c - the renderer's memory budget is one accountant with one
- * formula (csrc/budget.h): a derived volume (precomputed gradients, cubic
+ * formula (csrc/gl/budget.h): a derived volume (precomputed gradients, cubic
  * B-spline coefficients, the pre-classified volume) is charged with the
  * storage and every other derived volume resident beside it, whichever was
  * made first. A dense 32^3 float volume makes the sums exact: the volume,

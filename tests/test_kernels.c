@@ -1,6 +1,6 @@
 /* test_kernels.c - the kernels that derive volumes exist once in GLSL
  * (shaders/lib/, shaders/compute/); the two CPU copies that bricked and
- * sparse storage need (csrc/bspline_bricks.c: the B-spline prefilter of a
+ * sparse storage need (csrc/gradients/bspline_bricks.c: the B-spline prefilter of a
  * brick from the CPU bricks, and the precomputed filter's largest gradient)
  * must give what the GLSL gives on the same data. The volume is small
  * enough that every brick's prefilter window spans whole lines (P = 8, at

@@ -1,7 +1,7 @@
 /* test_nifti.c - the NIfTI reader, through the public API.
  *
  * Files are written by tests/nifti_writer.h (which knows the format
- * independently of csrc/nifti.c) into a mkdtemp directory that is removed at
+ * independently of csrc/io/nifti.c) into a mkdtemp directory that is removed at
  * the end. Voxel values are checked through the volume's texels (layout from
  * volume.h) so byte-order or offset mistakes show up as wrong values, not
  * just as a wrong min/max. */

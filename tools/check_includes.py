@@ -14,8 +14,8 @@ Then it checks:
   files    no cycle between files (a.h includes b.h includes a.h);
   modules  cycles between modules, a module being one stem's .c/.cpp/.h
            (x.h includes y.h while y.c includes x.h is a cycle of modules):
-           listed as notes, failed only with --modules (the hub header
-           renderer_internal.h ties most modules together until it is split);
+           listed as notes, failed only with --modules (there are none
+           since the hub header renderer_internal.h was split by subsystem);
   folders  no cycle between csrc/ folders;
   layers   a folder includes only itself and folders below it in LAYERS;
            every folder is in LAYERS, and no two headers share a name (with
@@ -40,9 +40,9 @@ import tempfile
 LAYERS = [
     ["cli", "helpers"],               # executables: voxlight, voxlight-read-*
     ["render"],                       # frames, the renderer object, the API
-    ["classify", "gradients", "skip"],  # derived volumes the ray caster reads
+    ["classify", "gradients", "skip", "light"],  # derived volumes the ray caster reads
     ["storage"],                      # dense/bricked/sparse/compressed
-    ["gl", "io"],                     # GL context and programs; file readers
+    ["gl", "io", "frame"],            # GL services; file readers; render parameters
     ["volume"],                       # CPU volumes, phantoms
     ["core"],                         # errors, math, names
     ["include"],                      # the public headers
@@ -293,9 +293,9 @@ def main(argv=None):
     for what, edges, label in checks:
         cycles = find_cycles(edges)
         if cycles and what == "modules" and not args.modules:
-            # a hub header (renderer_internal.h) makes every module that
-            # includes it part of a cycle until issue 15 item 4 splits it:
-            # listed, not failed, unless --modules
+            # a hub header makes every module that includes it part of a
+            # cycle (renderer_internal.h did until issue 15 item 4 split
+            # it): listed, not failed, unless --modules
             print(f"check_includes: note: {len(cycles)} cycle(s) between modules (not failed without --modules):")
             for c, members in cycles:
                 print(describe(c, members, edges, label))

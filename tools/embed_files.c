@@ -1,7 +1,7 @@
 /* embed_files.c - build-time tool: writes a C file holding the named files as
  * string constants, so the library carries its shaders. Each is keyed by its
  * path under ROOT ("lib/common.glsl", "compute/probe.comp"): the name
- * csrc/shader_source.c looks up, and the path under VOXLIGHT_SHADER_DIR. */
+ * csrc/gl/shader_source.c looks up, and the path under VOXLIGHT_SHADER_DIR. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -33,8 +33,9 @@ import sys
 FOLDERS = {
     # errors, math, names of enumerations
     "core": """error.c error.h mat4.c mat4.h names.c names.h""",
-    # CPU volumes: limits, scaling, normalised storage; generated phantoms
-    "volume": """volume.c volume.h phantom.c phantom.h phantom_large.c phantom_large.h""",
+    # CPU volumes: limits, scaling, normalised storage; generated phantoms;
+    # the brick min-max grid and occupancy math (CPU only)
+    "volume": """volume.c volume.h phantom.c phantom.h phantom_large.c phantom_large.h bricks.c bricks.h""",
     # every loader, the dispatch, the reader helpers' protocol and the
     # in-process readers the helpers run; image output
     "io": """volume_load.c loaders.h nifti.c nifti.h nrrd.c metaimage.c loader_util.c loader_util.h
@@ -45,24 +46,29 @@ FOLDERS = {
     # accountant
     "gl": """context.c context.h backend_egl.c backend_osmesa.c gl_funcs.c gl_funcs.h gl_thread.c gl_thread.h
              gl_util.c gl_util.h shader_source.c shader_source.h gl_bindings.h gl_bindings.c
-             budget.c budget.h holdings.c holdings.h""",
+             gpu.h budget.c budget.h holdings.c holdings.h""",
+    # render parameters resolved against the volume, transfer-function
+    # tables: plain values every GL-side stage reads (no GL)
+    "frame": """frame.c frame.h frame_lighting.c transfer.c transfer.h""",
     # how the volume is held on the GL side: the storage interface and its
     # modes, paging on the CPU, compression, LOD levels
     "storage": """storage.c storage.h storage_dense.c storage_bricked.c storage_sparse.c storage_compressed.c
                   storage_pool.c storage_pool.h storage_derived.c storage_derived.h
                   paging.c paging.h paged.c paged.h compress.c compress.h compressed_pool.c lod.c lod.h""",
     # empty-space skipping: min-max grid, occupancy, distance map
-    "skip": """bricks.c bricks.h skipping.c skipping.h minmax.c minmax.h""",
+    "skip": """skipping.c skipping.h minmax.c minmax.h""",
     # classification: transfer functions, the classified volume,
     # pre-integration
-    "classify": """classification.c classification.h transfer.c transfer.h preint.c preint.h""",
+    "classify": """classification.c classification.h preint.c preint.h""",
     # derived volumes for filtering: gradients, B-spline coefficients, the
     # shared kernels, the gradient probe
-    "gradients": """precompute.c precompute.h paged_gradients.c gradients.h probe.c bspline.c bspline.h
+    "gradients": """precompute.c precompute.h paged_gradients.c gradients.h bspline.c bspline.h
                     paged_bspline.c bspline_bricks.c bspline_bricks.h kernels.c kernels.h""",
     # one frame: parameters, the renderer object, the reference renderer
-    "render": """frame.c frame.h render.c render.h renderer.c renderer.h renderer_internal.h reference.c
-                 reference.h""",
+    "render": """render.c render.h renderer.c renderer.h renderer_internal.h reference.c reference.h reference_light.c
+                 probe.c slices.c slices.h""",
+    # lighting: the illumination volumes (shadows, occlusion) of issue 17
+    "light": """illumination.c illumination.h""",
     # the command-line tool (an executable, not in the library)
     "cli": """cli.c""",
     # the reader helper executables' own main()s
@@ -71,7 +77,7 @@ FOLDERS = {
 MOVES = {name: folder for folder, names in FOLDERS.items() for name in names.split()}
 
 SOURCE_EXT = (".c", ".h", ".cpp")
-TEXT_EXT = (".c", ".h", ".cpp", ".py", ".sh", ".md", ".txt", ".mk", ".toml", ".cfg", ".json", ".glsl")
+TEXT_EXT = (".c", ".h", ".cpp", ".py", ".sh", ".md", ".txt", ".mk", ".toml", ".cfg", ".json", ".glsl", ".comp", ".vert", ".frag")
 # never rewritten: this script's table, and the checker's own examples
 KEEP = {"tools/relayout.py", "tests/cli/test_check_includes.py"}
 
@@ -96,7 +102,7 @@ def rewrite_paths(text, moves):
     """csrc/NAME -> csrc/FOLDER/NAME for every moved NAME (not a longer name,
     not one already in a folder)."""
     names = sorted(moves, key=len, reverse=True)
-    pattern = re.compile(r"(?<![\w/.-])csrc/(" + "|".join(re.escape(n) for n in names) + r")(?![\w.])")
+    pattern = re.compile(r"(?<![\w/.-])csrc/(" + "|".join(re.escape(n) for n in names) + r")(?!\w|\.\w)")
     text = pattern.sub(lambda m: f"csrc/{moves[m.group(1)]}/{m.group(1)}", text)
     # globs over the flat folder
     text = text.replace("csrc/helper_*.c", "csrc/*/helper_*.c")
@@ -154,7 +160,7 @@ def main(argv=None):
               "(FOLDERS in tools/relayout.py):", file=sys.stderr)
         for f in unknown:
             print(f"    csrc/{f}", file=sys.stderr)
-        print("Add each name to its stage folder's list (core volume io gl storage skip classify gradients "
+        print("Add each name to its stage folder's list (core volume io gl frame storage skip classify gradients "
               "render cli helpers), then run tools/relayout.py again.", file=sys.stderr)
         return 1
     # names must stay unique: flat objects, one -I per folder

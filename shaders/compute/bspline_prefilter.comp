@@ -3,7 +3,7 @@
 // axis per dispatch and one line per invocation, in place. COPY_PASS first
 // copies the normalised volume into the float coefficient image. Bricked
 // storage runs the same recursion on the CPU, brick by brick from the CPU
-// bricks (csrc/bspline_bricks.c), checked against this by tests/test_kernels.c.
+// bricks (csrc/gradients/bspline_bricks.c), checked against this by tests/test_kernels.c.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(r32f, binding = VXL_IMAGE_OUT) uniform coherent image3D u_coeffs;
 #ifdef COPY_PASS

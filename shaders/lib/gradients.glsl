@@ -13,7 +13,7 @@ uniform float u_gradient_scale; // that global max: magnitudes in value per voxe
 #ifdef PAGED
 // Bricked storage: u_gradient is a pool of its own, u_gpage its page table
 // (w < 0 in the pool, else a brick whose whole neighbourhood is one value:
-// zero gradient), see compute/paged_gradient.comp. On a coarser level the gradient
+// zero gradient), see compute/gradients.comp. On a coarser level the gradient
 // is the level's, per level voxel.
 uniform sampler3D u_gpage;
 uniform vec3 u_gpool_dims;

@@ -1,9 +1,9 @@
 // stencils.glsl - the two 3x3x3 stencils of the gradient filters, written
 // once: the [1,2,1]^3 blur and the 26-neighbour Sobel ([-1,0,1] along a
 // component's axis, [1,2,1] across it). Users: the precomputed filter's
-// passes (compute/gradient_blur.comp, gradient_sobel.comp, paged_gradient.comp)
+// passes (compute/gradients.comp, one texture and bricked)
 // and the on-the-fly FILTER_SOBEL26 (lib/gradients.glsl). The CPU's copy of
-// both, for the bricked maximum, is csrc/bspline_bricks.c (tests/test_kernels.c).
+// both, for the bricked maximum, is csrc/gradients/bspline_bricks.c (tests/test_kernels.c).
 //
 // The includer says what a stencil is applied at and how a tap is read:
 // #define STENCIL_POINT as the type of that point (ivec3 for a voxel, vec3 for

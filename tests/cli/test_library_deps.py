@@ -1,7 +1,7 @@
 """libvoxlight.so loads inside Blender's process, on machines without our
 build dependencies (issue 13): it may need only the C runtime. The readers
 that need OpenImageIO or dcmtk live in the helper processes
-(csrc/reader_stream.h)."""
+(csrc/io/reader_stream.h)."""
 import re
 import subprocess
 from pathlib import Path
@@ -9,7 +9,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 LIB = ROOT / "build" / "libvoxlight.so"
 # Not even the dynamic loader: thread-local storage in a shared object would
-# add ld-linux for __tls_get_addr (csrc/error.c keeps its per-thread message
+# add ld-linux for __tls_get_addr (csrc/core/error.c keeps its per-thread message
 # behind a pthread key instead).
 ALLOWED = re.compile(r"^(libc|libm|libz|libdl|libpthread)\.so\.\d+$")
 

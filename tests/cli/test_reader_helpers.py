@@ -1,5 +1,5 @@
 """TIFF/PNG stacks and OpenVDB are read by voxlight-read-oiio, DICOM by
-voxlight-read-dicom (csrc/reader_stream.h). When a helper cannot run - its
+voxlight-read-dicom (csrc/io/reader_stream.h). When a helper cannot run - its
 library missing, the helper itself missing, or crashing - that one format
 fails with a message naming what to install, and every other format still
 loads. VOXLIGHT_READ_OIIO / VOXLIGHT_READ_DICOM point the library at a

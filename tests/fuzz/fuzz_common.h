@@ -72,7 +72,7 @@ static inline int vxl_fuzz_load(const uint8_t *data, size_t size, const char *ex
 }
 
 /* The same through a reader that the library runs in a helper process
- * (csrc/helper_main.h), called in-process here: libFuzzer sees coverage
+ * (csrc/io/helper_main.h), called in-process here: libFuzzer sees coverage
  * only in its own process. */
 typedef int (*vxl_fuzz_reader)(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 

@@ -1,5 +1,5 @@
 /* fuzz_dicom.c - libFuzzer target: arbitrary bytes as a .dcm file through
- * the DICOM reader (csrc/dicom.cpp, which the library runs in the
+ * the DICOM reader (csrc/io/dicom.cpp, which the library runs in the
  * voxlight-read-dicom helper), in-process (dcmtk parses it; the series is
  * the file's own, alone in its folder), under ASan+UBSan (see Makefile
  * 'fuzz', ./build.sh fuzz). */

@@ -1,5 +1,5 @@
 /* fuzz_tiff.c - libFuzzer target: arbitrary bytes as a .tif file through the
- * image stack reader (csrc/image_stack.cpp, which the library runs in the
+ * image stack reader (csrc/io/image_stack.cpp, which the library runs in the
  * voxlight-read-oiio helper), in-process, under ASan+UBSan (see Makefile
  * 'fuzz', ./build.sh fuzz). */
 #include "fuzz_common.h"

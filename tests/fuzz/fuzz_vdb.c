@@ -1,8 +1,8 @@
 /* fuzz_vdb.c - libFuzzer target: arbitrary bytes as a .vdb file through
  * the OpenVDB reader (OpenImageIO's OpenVDB reader and the volume build,
- * csrc/vdb.cpp), in-process, under ASan+UBSan (see Makefile 'fuzz',
+ * csrc/io/vdb.cpp), in-process, under ASan+UBSan (see Makefile 'fuzz',
  * ./build.sh fuzz). The library reads .vdb files in the voxlight-read-oiio
- * helper process (csrc/reader_stream.h); this target calls what the helper
+ * helper process (csrc/io/reader_stream.h); this target calls what the helper
  * runs, because libFuzzer only sees coverage in its own process. So
  * libopenvdb's assertions still abort here, and tests/fuzz/run.sh fuzzes
  * this target in fork mode (tests/fuzz/upstream/README.md). Seeds are

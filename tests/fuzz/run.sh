@@ -65,9 +65,9 @@ crash_is_upstream_openvdb() {
 }
 
 # libopenvdb (inside OpenImageIO's open) aborts on an assertion or asks for
-# absurd allocations on some corrupt files before csrc/vdb.cpp runs; the
+# absurd allocations on some corrupt files before csrc/io/vdb.cpp runs; the
 # library contains that by reading .vdb files in a helper process
-# (voxlight-read-oiio, csrc/reader_spawn.c), but fuzz_vdb runs the read in-process, where libFuzzer
+# (voxlight-read-oiio, csrc/io/reader_spawn.c), but fuzz_vdb runs the read in-process, where libFuzzer
 # sees its coverage. So vdb fuzzes in fork mode, carrying on past crashes,
 # and every crash is replayed afterwards: one that dies inside libopenvdb is
 # the known upstream class (tests/fuzz/upstream/README.md) and is counted,

@@ -53,7 +53,7 @@ def renderer():
 @pytest.mark.parametrize("name", BUILTINS)
 def test_builtin_tables_equal_the_librarys(renderer, name):
     """The library's preset and our copy of its table, as tf_rgba, render
-    the same image: same formulas as csrc/transfer.c."""
+    the same image: same formulas as csrc/frame/transfer.c."""
     lib, r = renderer
     kw = dict(width=48, height=48, jitter=False, window=(-1000.0, 2000.0), azimuth=30.0)
     a, _ = r.render(native.make_params(preset=name, lib=lib, **kw))

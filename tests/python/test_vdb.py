@@ -1,4 +1,4 @@
-"""The OpenVDB loader (csrc/vdb.cpp) against files written by pyopenvdb:
+"""The OpenVDB loader (csrc/io/vdb.cpp) against files written by pyopenvdb:
 dims from the active box, the affine from the grid transform, values and
 their placement (rendered against the same array handed over from memory),
 grid choice and errors."""

@@ -1,5 +1,5 @@
 """OpenVDB files (like TIFF/PNG stacks and DICOM) are read in a helper
-process (csrc/reader_spawn.c, csrc/helper_main.c, voxlight-read-oiio): a
+process (csrc/io/reader_spawn.c, csrc/io/helper_main.c, voxlight-read-oiio): a
 file on which libopenvdb aborts gives a clean error and this process lives
 on; the parent trusts nothing the helper sends (fake helpers below), leaves
 no zombie and no descriptor behind, and never falls back to reading
@@ -20,7 +20,7 @@ from vdb_write import write_vdb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ABORTS = os.path.join(ROOT, "tests", "fuzz", "upstream", "openvdb_delayed_load_mask_assert.vdb")
-# vxl_reader_header in csrc/reader_stream.h: magic; status, msg_len, kind,
+# vxl_reader_header in csrc/io/reader_stream.h: magic; status, msg_len, kind,
 # count, record_size, dims[3], src_dtype, texture_bits, nifti_version,
 # affine_source, frame_count, frame, reserved[2]; tex_lo, tex_hi, value_min,
 # value_max; spacing[3]; affine[16]; nan_count, inf_count, storage_bytes,

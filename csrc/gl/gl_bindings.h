@@ -1,0 +1,53 @@
+/* gl_bindings.h - every texture unit, image unit and shader-storage binding
+ * the library uses, named once. A number with several names has several
+ * jobs that never meet in one program (the comment says which program uses
+ * which name). Samplers get their unit from C (vxl_uniform_i); images and
+ * storage buffers are fixed in GLSL with layout(binding = ...), and GLSL
+ * sees the same numbers through vxl_glsl_binding_defines(), which gl_util.c
+ * puts before every shader's own defines. */
+#ifndef VXL_GL_BINDINGS_H
+#define VXL_GL_BINDINGS_H
+
+/* Texture (sampler) units. */
+#define VXL_VOLUME_UNIT 0         /* the volume texture or brick pool; a compute pass's source texture */
+#define VXL_DERIVED_UNIT 1        /* raycast, probe: precomputed gradients or B-spline coefficients (one filter per program) */
+#define VXL_TF_UNIT 2             /* the transfer-function table (1D) */
+#define VXL_SCENE_DEPTH_UNIT 3    /* raycast: the host scene's depth */
+#define VXL_DISTANCE_UNIT 4       /* raycast: the brick distance map of empty-space skipping */
+#define VXL_CLASSIFIED_UNIT 5     /* raycast: the pre-classified volume (RGBA8) */
+#define VXL_PREINT_UNIT 6         /* raycast: the pre-integration table */
+#define VXL_SCRATCH_UNIT 7        /* used only to create and fill textures, so that never disturbs units 0-6 */
+#define VXL_PAGE_UNIT 8           /* bricked storage: the page table */
+#define VXL_GPAGE_UNIT 9          /* bricked storage: the gradient pool's page table */
+#define VXL_CODE_UNIT 10          /* compressed storage: the code pool while decoding */
+#define VXL_PALETTE_UNIT 11       /* compressed storage: the palettes */
+#define VXL_CPAGE_UNIT 12         /* bricked storage: the coefficient pool's page table */
+#define VXL_ILLUMINATION_UNIT 13  /* raycast, illumination.comp: the lights' transmittance and the occlusion, stacked */
+#define VXL_EXTINCTION_UNIT 14    /* illumination.comp: the optical depth per cell the lights and occlusion read */
+
+/* Image units. */
+#define VXL_IMAGE_OUT 0           /* every compute pass: the texture it writes (the B-spline prefilter also reads it) */
+#define VXL_IMAGE_SLICE_ACCUM 1   /* slices.frag: the colour attachment, read and composited slice by slice */
+#define VXL_IMAGE_SLICE_DEPTH 2   /* slices.frag: the depth attachment, the same way */
+
+/* Shader-storage buffer bindings. */
+#define VXL_SSBO_GRADIENT_MAX 0   /* gradients.comp's max pass: the largest |gradient| as float bits */
+#define VXL_SSBO_PROBE_POINTS 0   /* probe.comp: the points to probe */
+#define VXL_SSBO_PROBE_RESULTS 1  /* probe.comp: what it measured */
+#define VXL_SSBO_STATS 2          /* raycast.frag: the frame's sample counts */
+#define VXL_SSBO_BRICK_LIST 2     /* gradients.comp (bricked), decode_bricks.comp: per slot, the brick (or code slot) to derive */
+
+#define VXL_GLSL_STR_(x) #x
+#define VXL_GLSL_STR(x) VXL_GLSL_STR_(x)
+#define VXL_GLSL_DEFINE(name) "#define " #name " " VXL_GLSL_STR(name) "\n"
+
+/* The image and storage bindings above as GLSL #defines, one a line, for
+ * layout(binding = VXL_...) in shaders. */
+static inline const char *vxl_glsl_binding_defines(void)
+{
+    return VXL_GLSL_DEFINE(VXL_IMAGE_OUT) VXL_GLSL_DEFINE(VXL_SSBO_GRADIENT_MAX) VXL_GLSL_DEFINE(VXL_SSBO_PROBE_POINTS)
+        VXL_GLSL_DEFINE(VXL_SSBO_PROBE_RESULTS) VXL_GLSL_DEFINE(VXL_SSBO_STATS) VXL_GLSL_DEFINE(VXL_SSBO_BRICK_LIST)
+        VXL_GLSL_DEFINE(VXL_IMAGE_SLICE_ACCUM) VXL_GLSL_DEFINE(VXL_IMAGE_SLICE_DEPTH);
+}
+
+#endif

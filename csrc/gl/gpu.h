@@ -1,0 +1,75 @@
+/* gpu.h - the GL services every GL-side stage receives instead of the
+ * renderer: the function table, the error slot, the program cache and its
+ * helpers (gl_util.c), the shader folder, the storage buffers, what the
+ * backend reported, and the memory budget with its holders (holdings.h).
+ * Storage, skipping, classification and the derived volumes each hold a
+ * pointer to the renderer's one vxl_gpu; none of them sees the renderer.
+ * Everything here is used on the renderer's GL thread only. */
+#ifndef VXL_GPU_H
+#define VXL_GPU_H
+
+#include <stdint.h>
+
+#include "budget.h"
+#include "error.h"
+#include "gl_bindings.h"
+#include "gl_funcs.h"
+#include "voxlight.h"
+
+#define VXL_MAX_PROGRAMS 1024 /* every raycast variant (7*4*3*3, dense and paged) plus compute programs */
+
+/* Program kinds in the cache key. */
+#define VXL_PROG_RAYCAST 0
+#define VXL_PROG_PROBE 1
+#define VXL_PROG_GRAD_BLUR 2
+#define VXL_PROG_GRAD_MAX 3
+#define VXL_PROG_GRAD_STORE 4
+#define VXL_PROG_BSPLINE_COPY 5
+#define VXL_PROG_BSPLINE_AXIS 6
+#define VXL_PROG_BRICK_MINMAX 7
+#define VXL_PROG_CLASSIFY_VOLUME 8
+#define VXL_PROG_PAGED_BLUR 9
+/* 10: was the bricked texture's max pass, now on the CPU */
+#define VXL_PROG_PAGED_GRAD_STORE 11
+#define VXL_PROG_DECODE_BRICKS 12 /* flags: the cache's bytes per voxel - 1 */
+#define VXL_PROG_SLICES 13 /* the slicing comparison modes (render/slices.c); flags as RAYCAST */
+#define VXL_PROG_ILLUMINATION 14 /* light/illumination.c: flags & 3 the pass, plus the sample flags */
+
+/* Program flags the storage sets on shaders that sample the volume. */
+#define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
+#define VXL_FLAG_COMPRESSED_DOMAIN 128u /* with PAGED: the pool holds codes, every tap decodes its 8 neighbours */
+
+typedef struct vxl_program_entry {
+    uint32_t key;
+    GLuint program;
+} vxl_program_entry;
+
+/* One holder of GL memory as the budget counts it (budget.h): the subsystem
+ * that holds it registers how to read its bytes (holdings.h), so the
+ * accountant reads no subsystem's struct. */
+typedef struct vxl_holding {
+    uint64_t (*bytes)(const void *state);
+    const void *state;
+} vxl_holding;
+
+typedef struct vxl_gpu {
+    vxl_gl gl;
+    vxl_err err;               /* last failure on this handle */
+    uint64_t budget;           /* GPU storage budget, bytes */
+    char *shader_dir;          /* NULL = embedded shaders */
+    vxl_renderer_info info;
+    vxl_program_entry programs[VXL_MAX_PROGRAMS];
+    int n_programs;
+    GLuint ssbo[3];            /* probe points / the gradient maximum, probe results / brick lists, stats */
+    vxl_holding holdings[VXL_HOLD_COUNT];
+} vxl_gpu;
+
+/* gl_util.c */
+int vxl_program_get(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out);
+void vxl_uniform_i(vxl_gpu *g, GLuint prog, const char *name, int v);
+void vxl_uniform_f(vxl_gpu *g, GLuint prog, const char *name, float v);
+GLuint vxl_texture_new(vxl_gpu *g, GLenum target, GLint filter);
+int vxl_gl_check(vxl_gpu *g, const char *what);
+void vxl_programs_delete(vxl_gpu *g);
+
+#endif

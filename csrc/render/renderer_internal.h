@@ -1,0 +1,47 @@
+/* renderer_internal.h - the renderer's state. Everything GL lives on the
+ * renderer's own thread; API functions package their arguments into a job. */
+#ifndef VXL_RENDERER_INTERNAL_H
+#define VXL_RENDERER_INTERNAL_H
+
+#include <stdint.h>
+
+#include "classification.h"
+#include "context.h"
+#include "error.h"
+#include "frame.h"
+#include "gl_thread.h"
+#include "gpu.h"
+#include "gradients.h"
+#include "illumination.h"
+#include "skipping.h"
+#include "storage.h"
+#include "voxlight.h"
+
+#define VXL_MAX_SAMPLES_PER_RAY 16384 /* bounds every ray, whatever the step */
+#define VXL_MAX_IMAGE_SIDE 16384
+
+/* The renderer composes one struct per subsystem. Each subsystem receives
+ * the GL services (gpu) and the lower stages it reads (the storage), never
+ * the renderer, and releases only its own state; renderer.c wires them
+ * (vxl_*_init) and registers each with the budget and, for the derived
+ * volumes, with the storage. */
+struct vxl_renderer {
+    vxl_gl_thread thread;
+    vxl_context ctx;
+    vxl_gpu gpu;                             /* gpu.h: function table, error, programs, budget */
+    vxl_storage_state storage;               /* storage.h: the volume on the GL side (storage_*.c, paged.c) */
+    vxl_gradient_state gradients;            /* gradients.h */
+    vxl_bspline_state bspline;
+    vxl_skipping_state skipping;             /* skipping.h */
+    vxl_classification_state classification; /* classification.h */
+    vxl_illumination_state illumination;     /* illumination.h: shadows and occlusion (issue 17) */
+
+    GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex;
+    uint32_t fb_w, fb_h;
+    vxl_render_stats stats;    /* of the last successful frame */
+};
+
+/* render.c helpers shared with probe.c */
+int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store);
+
+#endif

@@ -1,0 +1,53 @@
+/* bricks.h - empty-space skipping. The brick min-max grid depends only on
+ * the volume data (built once per volume on the GL side, kept on the CPU);
+ * the occupancy and its Chebyshev distance map depend on the transfer
+ * function, window and opacity scale (re-derived in O(bricks) when those
+ * change, without touching the volume texture). */
+#ifndef VXL_BRICKS_H
+#define VXL_BRICKS_H
+
+#include <stdint.h>
+
+#define VXL_DEFAULT_BRICK 8
+
+typedef struct vxl_bricks {
+    uint32_t size;          /* voxels per brick edge */
+    uint32_t dims[3];       /* bricks per axis */
+    float *minmax;          /* 2 per brick: normalised min, max (apron included) */
+    uint8_t *distance;      /* 0 = occupied; k = Chebyshev distance in bricks to the nearest occupied, max 255 */
+    uint64_t tf_key;        /* hash of what the occupancy was derived from */
+    uint32_t occupied;      /* occupied bricks under that classification */
+    /* Iso-surface opacity only (built on first use): per brick, a bound on
+     * |gradient| of the difference filters over taps reaching gbound_apron
+     * voxels around the brick; NULL = none, every brick counts as occupied. */
+    float *gbound;
+    uint32_t gbound_apron;
+} vxl_bricks;
+
+/* What occupancy depends on, as plain values (the renderer fills it from
+ * its frame: vxl_frame_occupancy_rule in frame.h), so skipping needs no
+ * render parameters. */
+typedef struct vxl_occupancy_rule {
+    uint64_t table_key;     /* hash of the table, window and opacity scale: equal keys, equal occupancy */
+    const float *tf;        /* tf_size straight RGBA entries, alpha per voxel of path */
+    uint32_t tf_size;
+    float window_offset, window_scale, opacity_scale; /* normalised value -> table position in [0,1] */
+    int iso;                /* iso-surface opacity: occupancy follows the surface, not the table */
+    float iso_pos, iso_thickness; /* iso: the surface's normalised value and its thickness */
+    uint32_t filter;        /* VXL_FILTER_* of the gradients (iso: bounds how far taps reach) */
+    float sample_distance;  /* voxels between gradient taps */
+} vxl_occupancy_rule;
+
+/* The skipping grid's brick edge: VXL_DEFAULT_BRICK, or VOXLIGHT_BRICK_SIZE. */
+uint32_t vxl_skip_brick_size(void);
+/* Occupancy + distance map under the rule; returns 1 if it changed (the
+ * caller re-uploads), 0 if the cached one still holds, -1 out of memory. */
+int vxl_bricks_classify(vxl_bricks *b, const vxl_occupancy_rule *c);
+void vxl_bricks_free(vxl_bricks *b);
+/* Voxels around a brick that gradient taps sample_distance apart (filter
+ * VXL_FILTER_*) and their trilinear footprint reach, when the filter's
+ * |gradient| is bounded by the adjacent differences there (central,
+ * forward3, Sobel); 0 = no such bound. */
+uint32_t vxl_bricks_gradient_apron(uint32_t filter, float sample_distance);
+
+#endif

@@ -2,7 +2,7 @@
 """Warm-frame time of the shaded ray caster on ch2better, as issue 16 measured it.
 
 ch2better at 512x512, default camera (azimuth 30, elevation 15), MRI preset,
-through plugin/native.py; per configuration the median of --frames warm
+through plugin/core/native.py; per configuration the median of --frames warm
 frames. Each --shader-dir makes a renderer (A/B: give two) and their frames
 are interleaved in one process, so a busy machine slows all alike: compare
 the ratio columns (k/0: renderer k over renderer 0, same configuration), not
@@ -32,7 +32,7 @@ if "voxlight" not in sys.modules:  # plugin/ without bpy (as tests/python/confte
     pkg.__path__ = [os.path.join(ROOT, "plugin")]
     sys.modules["voxlight"] = pkg
 os.environ.setdefault("VOXLIGHT_LIB", os.path.join(ROOT, "build", "libvoxlight.so"))
-from voxlight import native  # noqa: E402
+from voxlight.core import native  # noqa: E402
 
 VOLUME = "/usr/share/mricron/templates/ch2better.nii.gz"
 

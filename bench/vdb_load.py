@@ -48,7 +48,7 @@ WARM = """
 import sys, time
 sys.path.insert(0, %r)
 import conftest  # the voxlight package stub, as in the tests
-from voxlight import native
+from voxlight.core import native
 lib = native.load_library(sys.argv[1])
 native.Volume.load(sys.argv[2], lib=lib).close()
 runs = []

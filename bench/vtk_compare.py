@@ -2,7 +2,7 @@
 """vtk_compare.py - Voxlight against VTK's GPU ray caster, per covered pixel.
 
 Every (volume, transfer function) pair is rendered on the same frame by
-three renderers: Voxlight (plugin/native.py, central gradients, the step
+three renderers: Voxlight (plugin/core/native.py, central gradients, the step
 given), VTK's vtkOpenGLGPUVolumeRayCastMapper (bench/vtk_peer.py's Peer:
 VTK's defaults except what must match) and the float64 CPU reference of
 bench/ref_render.py. Same camera (Voxlight's default at azimuth 30,
@@ -46,7 +46,7 @@ if "voxlight" not in sys.modules:  # plugin/ without bpy (as bench/frame_time.py
     pkg.__path__ = [os.path.join(ROOT, "plugin")]
     sys.modules["voxlight"] = pkg
 os.environ.setdefault("VOXLIGHT_LIB", os.path.join(ROOT, "build", "libvoxlight.so"))
-from voxlight import native  # noqa: E402
+from voxlight.core import native  # noqa: E402
 
 import ref_render  # noqa: E402
 import vtk_peer  # noqa: E402

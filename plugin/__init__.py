@@ -37,14 +37,15 @@ from . import compat  # noqa: E402
 UNSUPPORTED = compat.unsupported_message(bpy.app.version)
 
 if UNSUPPORTED is None:
-    from . import native  # noqa: E402
+    from .core import native  # noqa: E402
     # The library's private copies (native.private_copy) go to the
     # extension's own folder where Blender gives one; set before any module
     # loads the library.
     native.CACHE_DIR = compat.private_data_dir(__package__)
-    from . import (api, compositor, depth, import_job, importer, lights, native, offline,  # noqa: E402
-                   operators, panels, params, preferences, properties, render_hooks, runtime,
-                   scene_geometry, tf, viewport, volume_object, volume_space, zbuffer)
+    from . import (api, compositor, importer, offline, operators, panels, params,  # noqa: E402
+                   preferences, properties, render_hooks, tf, viewport, volume_object)
+    from .core import (depth, import_job, lights, native, runtime, scene_geometry,  # noqa: E402,F401
+                       volume_space, zbuffer)
     from .api import render_volume  # noqa: E402,F401
 
     # Registration order: properties before the UI that shows them; handlers last.

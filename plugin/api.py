@@ -5,7 +5,8 @@ import os
 import bpy
 import numpy as np
 
-from . import native, offline
+from . import offline
+from .core import native
 
 
 def render_volume(obj, camera=None, resolution=None, filepath=None, occlusion=True,

@@ -18,7 +18,8 @@ from bpy.props import BoolProperty, FloatProperty, FloatVectorProperty, StringPr
 from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix
 
-from . import framing, import_job, orientation, runtime, tf, volume_space
+from . import tf
+from .core import framing, import_job, orientation, runtime, volume_space
 
 
 def _to_matrix(a):

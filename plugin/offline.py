@@ -7,7 +7,8 @@ the scene's meshes in numpy (zbuffer.py) and passing that as scene_depth.
 import bpy
 import numpy as np
 
-from . import native, params, runtime, scene_geometry, volume_space, zbuffer
+from . import params
+from .core import native, runtime, scene_geometry, volume_space, zbuffer
 
 
 def render_size(scene):

@@ -2,7 +2,7 @@
 
 import bpy
 
-from . import native, runtime
+from .core import native, runtime
 
 
 class OnActiveVolume:

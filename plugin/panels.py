@@ -9,13 +9,14 @@ the editor's default width."""
 
 import bpy
 
-from . import histogram_image, runtime, tf
+from . import tf
+from .core import histogram_image, runtime
 from .operators import OnActiveVolume
 from .properties import FIXED_TAP_FILTERS
 
 
 def _draw_library_status(layout):
-    from . import native
+    from .core import native
     ok, msg = native.library_status()
     if not ok:
         box = layout.box()

@@ -4,9 +4,9 @@ scripting API so all three render the same thing."""
 
 import numpy as np
 
-from . import lighting
-from . import lights as _lights
-from . import native
+from .core import lighting
+from .core import lights as _lights
+from .core import native
 from . import tf as _tf
 
 

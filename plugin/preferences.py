@@ -2,7 +2,7 @@
 
 import bpy
 
-from . import native
+from .core import native
 
 
 class VoxlightPreferences(bpy.types.AddonPreferences):

@@ -6,7 +6,8 @@ import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, IntVectorProperty, PointerProperty, StringProperty)
 
-from . import lighting, native, tf
+from . import tf
+from .core import lighting, native
 
 # UI names of the filters this add-on knows. The list itself comes from the
 # library (vxl_filter_name up to VXL_FILTER_COUNT), so a filter added there

@@ -11,7 +11,8 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import compositor, native, offline
+from . import compositor, offline
+from .core import native
 
 last_error = ""
 

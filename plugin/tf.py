@@ -26,7 +26,7 @@ import os
 import bpy
 import numpy as np
 
-from . import lighting, runtime, tf_fit, tf_presets
+from .core import lighting, runtime, tf_fit, tf_presets
 from .operators import OnActiveVolume
 
 TABLE_SIZE = tf_presets.TABLE_SIZE
@@ -75,7 +75,7 @@ def dicom_modality(path, series="", dims=None):
     """The DICOM Modality (0008,0060) of the imported series, "" when the
     input is not DICOM or the library does not say. Without a series
     choice: the only series, or the one of the volume's size `dims`."""
-    from . import native
+    from .core import native
     low = path.lower()
     if not (os.path.isdir(path) or low.endswith(".dcm") or os.path.basename(low) == "dicomdir"):
         return ""

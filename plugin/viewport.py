@@ -53,8 +53,9 @@ import numpy as np
 from bpy.app.handlers import persistent
 from gpu_extras.batch import batch_for_shader
 
-from . import depth as _depth
-from . import native, params, resolution_policy, runtime, volume_space
+from . import params
+from .core import depth as _depth
+from .core import native, resolution_policy, runtime, volume_space
 
 _handle = None
 _shader = None

@@ -19,7 +19,8 @@ import os
 import bpy
 from bpy.props import BoolProperty, PointerProperty, StringProperty
 
-from . import native, runtime, tf
+from . import tf
+from .core import native, runtime
 from .importer import fill_volume_properties
 
 

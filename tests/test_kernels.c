@@ -1,7 +1,8 @@
 /* test_kernels.c - the kernels that derive volumes exist once in GLSL
- * (shaders/lib/, shaders/compute/); the two CPU copies that bricked and
+ * (shaders/lib/, shaders/compute/); the CPU copies that bricked and
  * sparse storage need (csrc/gradients/bspline_bricks.c: the B-spline prefilter of a
- * brick from the CPU bricks, and the precomputed filter's largest gradient)
+ * brick from the CPU bricks, and the precomputed filter's largest gradient;
+ * csrc/storage/paging.c: the skipping grid's min-max, bit for bit)
  * must give what the GLSL gives on the same data. The volume is small
  * enough that every brick's prefilter window spans whole lines (P = 8, at
  * most 16 voxels an axis: a window reaches 12 voxels past the brick and its
@@ -157,6 +158,114 @@ TEST(gradient_max_cpu_equals_glsl_to_rounding)
     vxl_renderer_destroy(rs[1]);
 }
 
+/* ---- the skipping grid: brick_minmax.comp (dense) and paging.c's
+ * vxl_bricks_minmax_cpu (bricked, at set_volume) ---- */
+
+/* odd sizes: every axis ends in a partial brick (skip bricks of 8 voxels) */
+#define GX 21
+#define GY 13
+#define GZ 11
+
+/* The volume of one data type, its raw values from field_noise, with NaN
+ * and infinities sprinkled into the float one (neutralised at load).
+ * norm gets each voxel's normalised value as volume.c defines it. */
+static vxl_volume *make_typed(uint32_t dtype, double *norm)
+{
+    enum { N = GX * GY * GZ };
+    static uint8_t u8[N];
+    static int16_t i16[N];
+    static float f32[N];
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < N; i++) {
+        double u = field_noise(i % GX, i / GX % GY, i / (GX * GY), NULL);
+        u8[i] = (uint8_t)(u * 256);
+        i16[i] = (int16_t)(u * 65536 - 32768);
+        f32[i] = (float)(u * 2000 - 1000);
+        if (i % 97 == 5) f32[i] = NAN;
+        if (i % 211 == 7) f32[i] = i % 2 ? INFINITY : -INFINITY;
+        if (isfinite(f32[i])) lo = fmin(lo, f32[i]), hi = fmax(hi, f32[i]);
+    }
+    for (int i = 0; i < N; i++) { /* volume.c: integers over their type's range; floats over the finite range */
+        double x = f32[i];
+        x = isnan(x) ? lo : fmin(fmax(x, lo), hi);
+        norm[i] = dtype == VXL_DTYPE_U8 ? u8[i] / 255.0
+                  : dtype == VXL_DTYPE_I16 ? (i16[i] + 32768.0) / 65535.0
+                                           : (float)((x - lo) / (hi - lo));
+    }
+    const void *data = dtype == VXL_DTYPE_U8 ? (const void *)u8 : dtype == VXL_DTYPE_I16 ? (const void *)i16 : f32;
+    const vxl_volume_desc d = {.struct_size = sizeof d, .dtype = dtype, .dims = {GX, GY, GZ}, .data = data};
+    vxl_volume *v = NULL;
+    return vxl_volume_create(&d, NULL, &v) == VXL_OK ? v : NULL;
+}
+
+/* The grid of r: n floats into out, the brick edge into *brick; 0 on failure */
+static int read_grid(vxl_renderer *r, float *out, size_t n, uint32_t *brick)
+{
+    uint32_t dims[3];
+    if (vxl_probe_skip_grid(r, dims, brick, out, n) != VXL_OK) return 0;
+    return 2 * (size_t)dims[0] * dims[1] * dims[2] == n;
+}
+
+/* Dense storage builds the skipping grid from the volume texture with
+ * brick_minmax.comp; bricked storage from the CPU voxels with
+ * vxl_bricks_minmax_cpu, before anything is on the GL side. Both must give
+ * the same floats, and both must follow the one rule: a brick's min and max
+ * cover the brick and a one-voxel apron each way, clamped to the volume
+ * (every voxel a trilinear sample inside the brick's box reaches). The
+ * check against that rule, computed here from the source values, is what
+ * fails if both kernels drift together (no apron, a wider one, unclamped). */
+TEST(brick_minmax_cpu_equals_glsl_bit_for_bit)
+{
+    const uint32_t dtypes[3] = {VXL_DTYPE_U8, VXL_DTYPE_I16, VXL_DTYPE_F32};
+    enum { B = 8, BX = (GX + B - 1) / B, BY = (GY + B - 1) / B, BZ = (GZ + B - 1) / B, NG = 2 * BX * BY * BZ };
+    static double norm[GX * GY * GZ];
+    for (int t = 0; t < 3; t++) {
+        vxl_renderer *rs[2] = {make_stored(VXL_STORAGE_DENSE), make_stored(VXL_STORAGE_BRICKED)};
+        vxl_volume *v = make_typed(dtypes[t], norm);
+        REQUIRE(rs[0] && rs[1] && v);
+        float grid[2][NG];
+        uint32_t brick[2] = {0, 0};
+        vxl_render_params p = phantom_scene(16, 16, VXL_FILTER_CENTRAL, VXL_CLASSIFY_POST);
+        for (int i = 0; i < 2; i++) {
+            CHECKF(vxl_renderer_set_volume(rs[i], v) == VXL_OK, "%s", vxl_renderer_error(rs[i]));
+            CHECK(page_brick_of(rs[i], &p) == (i ? 8u : 0u)); /* renders: dense builds its grid on the GPU */
+            CHECKF(read_grid(rs[i], grid[i], NG, &brick[i]), "%s", vxl_renderer_error(rs[i]));
+        }
+        vxl_volume_destroy(v);
+        CHECK(brick[0] == B && brick[1] == B);
+        int differ = 0, first = -1;
+        for (int i = 0; i < NG; i++)
+            if (memcmp(&grid[0][i], &grid[1][i], sizeof(float)) && differ++ == 0) first = i;
+        CHECKF(!differ, "%s: %d of %d floats differ; first %d: GLSL %.9g, CPU %.9g", vxl_dtype_name(dtypes[t]),
+               differ, NG, first, first < 0 ? 0.0 : grid[0][first], first < 0 ? 0.0 : grid[1][first]);
+        double err = 0, spread = 0;
+        for (int i = 0; i < NG / 2; i++) {
+            const int c[3] = {i % BX, i / BX % BY, i / (BX * BY)}, n[3] = {GX, GY, GZ};
+            int lo[3], hi[3];
+            for (int a = 0; a < 3; a++) {
+                lo[a] = c[a] * B - 1 < 0 ? 0 : c[a] * B - 1;
+                hi[a] = c[a] * B + B > n[a] - 1 ? n[a] - 1 : c[a] * B + B;
+            }
+            double mn = INFINITY, mx = -INFINITY;
+            for (int z = lo[2]; z <= hi[2]; z++)
+                for (int y = lo[1]; y <= hi[1]; y++)
+                    for (int x = lo[0]; x <= hi[0]; x++) {
+                        double u = norm[x + GX * (y + GY * z)];
+                        mn = fmin(mn, u);
+                        mx = fmax(mx, u);
+                    }
+            err = fmax(err, fmax(fabs(grid[1][2 * i] - mn), fabs(grid[1][2 * i + 1] - mx)));
+            spread = fmax(spread, mx - mn);
+        }
+        /* one float rounding of a value in [0, 1]; a voxel more or less
+         * in a brick's reach moves its noise min or max by ~1/(voxels) */
+        CHECKF(err <= 1e-7, "%s: the grid is off the brick-plus-apron rule by %.3g", vxl_dtype_name(dtypes[t]), err);
+        CHECK(spread > 0.5);
+        vxl_renderer_destroy(rs[0]);
+        vxl_renderer_destroy(rs[1]);
+    }
+}
+
 /* The source tree's shaders/, from this binary's place (BUILD/tests/):
  * found from any working directory; 0 when not found. */
 static int source_shader_dir(char *out, size_t n)
@@ -207,6 +316,7 @@ int main(void)
 {
     RUN(bspline_prefilter_cpu_equals_glsl_to_rounding);
     RUN(gradient_max_cpu_equals_glsl_to_rounding);
+    RUN(brick_minmax_cpu_equals_glsl_bit_for_bit);
     RUN(shader_dir_reads_the_layout_the_library_embeds);
     return TEST_SUMMARY();
 }

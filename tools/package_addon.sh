@@ -4,9 +4,9 @@
 # reader helper the library starts from its own folder (BUILD_DIR/
 # voxlight-read-*, and voxlight-vdb-read where a build still has it).
 # Blender's zip install drops the helpers' execute bit, which the add-on
-# restores when it loads the library (plugin/native.py).
-# Layout: voxlight/{__init__.py, ..., libvoxlight.so, voxlight-read-*,
-# blender_manifest.toml},
+# restores when it loads the library (plugin/core/native.py).
+# Layout: voxlight/{__init__.py, ..., core/*.py, libvoxlight.so,
+# voxlight-read-*, blender_manifest.toml},
 # which installs both as a Blender 3.x legacy add-on (bl_info) and as a 4.2+
 # extension (manifest in the package's single top-level folder).
 # The zip has directory entries (voxlight/): Blender's legacy "overwrite"
@@ -31,9 +31,13 @@ if [ -z "$HELPERS" ]; then
 fi
 STAGE=$(mktemp -d)
 trap 'rm -rf "$STAGE"' EXIT
-mkdir "$STAGE/voxlight"
+mkdir "$STAGE/voxlight" "$STAGE/voxlight/core"
 for f in "$ROOT"/plugin/*.py "$ROOT"/plugin/*.md; do
     [ -f "$f" ] && cp "$f" "$STAGE/voxlight/"
+done
+# The bpy-free core (plugin/core/, a subpackage).
+for f in "$ROOT"/plugin/core/*.py; do
+    [ -f "$f" ] && cp "$f" "$STAGE/voxlight/core/"
 done
 cp "$ROOT/manifest/blender_manifest.toml" "$STAGE/voxlight/"
 cp "$LIB" "$STAGE/voxlight/libvoxlight.so"

@@ -105,7 +105,7 @@ def orbit(r3d, area, seconds):
 
 def steps():
     vx = u.install_addon()
-    vp, rt = vx.viewport, vx.runtime
+    vp, rt = vx.viewport, vx.core.runtime
     if AA:
         bpy.context.preferences.system.viewport_aa = AA
     u.reset_scene()

@@ -30,7 +30,7 @@ def view3d():
 
 def steps():
     vx = u.install_addon()
-    rt, vp = vx.runtime, vx.viewport
+    rt, vp = vx.core.runtime, vx.viewport
     bpy.types.SpaceView3D.draw_handler_add(pre_view, (), "WINDOW", "PRE_VIEW")
     bpy.types.SpaceView3D.draw_handler_add(post_pixel, (), "WINDOW", "POST_PIXEL")
     scene = u.reset_scene()

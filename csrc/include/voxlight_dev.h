@@ -41,6 +41,15 @@ extern "C" {
 VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, const float *points,
                                 uint32_t n, float *out);
 
+/* The empty-space skipping grid as the renderer holds it: per brick of
+ * *brick voxels, x fastest, the normalised min and max (2 floats) over the
+ * brick and a one-voxel apron (every voxel a trilinear sample in the brick
+ * reaches). Built by brick_minmax.comp at the first skipping frame (one
+ * volume texture), or on the CPU at set_volume (bricked storage). dims gets
+ * the bricks per axis; out (may be NULL) the first max_floats of the
+ * 2*dims[0]*dims[1]*dims[2] floats. VXL_ERR_STATE while there is no grid. */
+VXL_API int vxl_probe_skip_grid(vxl_renderer *r, uint32_t dims[3], uint32_t *brick, float *out, size_t max_floats);
+
 /* ------------------------------------------------- ground truth (issue 4) */
 
 /* Analytic phantoms, generated at any resolution, each with an analytic

@@ -69,3 +69,33 @@ int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, const float
     if (rc) vxl_publish_error(&r->gpu.err);
     return rc;
 }
+
+typedef struct skip_grid_job {
+    vxl_renderer *r;
+    uint32_t *dims, *brick;
+    float *out;
+    size_t max_floats;
+} skip_grid_job;
+
+/* On the GL thread: the grid is the skipping state's, which frames write. */
+static int job_skip_grid(void *arg)
+{
+    skip_grid_job *j = arg;
+    const vxl_bricks *b = &j->r->skipping.bricks;
+    if (!b->minmax)
+        return vxl_fail(&j->r->gpu.err, VXL_ERR_STATE, "no skipping grid yet: set a volume and render with skipping");
+    memcpy(j->dims, b->dims, sizeof b->dims);
+    if (j->brick) *j->brick = b->size;
+    size_t n = 2 * (size_t)b->dims[0] * b->dims[1] * b->dims[2];
+    if (j->out) memcpy(j->out, b->minmax, (n < j->max_floats ? n : j->max_floats) * sizeof(float));
+    return VXL_OK;
+}
+
+int vxl_probe_skip_grid(vxl_renderer *r, uint32_t dims[3], uint32_t *brick, float *out, size_t max_floats)
+{
+    if (!r || !dims) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "renderer or dims is NULL");
+    skip_grid_job j = {r, dims, brick, out, max_floats};
+    int rc = vxl_gl_thread_call(&r->thread, job_skip_grid, &j);
+    if (rc) vxl_publish_error(&r->gpu.err);
+    return rc;
+}

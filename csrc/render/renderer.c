@@ -210,7 +210,7 @@ static int job_set_volume(void *p)
         r->storage.mode = 0;
         return rc;
     }
-    vxl_skipping_adopt(&r->skipping, &plan.bricks); /* the min-max grid the plan computed, if any */
+    vxl_skipping_adopt(&r->skipping, &plan.bricks, v->texture_bits); /* the min-max grid the plan computed, if any */
     memcpy(r->storage.geom.dims, v->dims, sizeof r->storage.geom.dims);
     r->storage.geom.tex_lo = v->tex_lo;
     r->storage.geom.tex_hi = v->tex_hi;

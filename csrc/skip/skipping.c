@@ -1,9 +1,11 @@
 /* skipping.c - the GL side of empty-space skipping: builds the brick min-max
  * grid once per volume, uploads the distance map when the classification
  * changes (the grid's brick edge: vxl_skip_brick_size in bricks.c). */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "paging.h"
 #include "skipping.h"
 
 
@@ -14,9 +16,10 @@ void vxl_skipping_release(vxl_skipping_state *sk)
     vxl_bricks_free(&sk->bricks);
 }
 
-void vxl_skipping_adopt(vxl_skipping_state *sk, vxl_bricks *grid)
+void vxl_skipping_adopt(vxl_skipping_state *sk, vxl_bricks *grid, uint32_t texture_bits)
 {
     vxl_bricks_free(&sk->bricks);
+    sk->texture_bits = texture_bits;
     sk->bricks = *grid;
     memset(grid, 0, sizeof *grid);
 }
@@ -59,7 +62,18 @@ static int build_minmax(vxl_skipping_state *sk)
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     b->minmax = malloc(n * 2 * sizeof(float));
     if (!b->minmax) return vxl_fail(&sk->gpu->err, VXL_ERR_NO_MEMORY, "out of memory for the brick grid");
-    return brick_pass(sk, 0, b->minmax);
+    int rc = brick_pass(sk, 0, b->minmax);
+    if (rc || (sk->texture_bits != 8 && sk->texture_bits != 16)) return rc; /* float texels are exact */
+    /* The pass picks each brick's extreme texels; an integer texel's float is
+     * the driver's rounding of code / (2^bits - 1), which GL lets differ in
+     * the last bit. Recovering the code (off by far under 0.5) and taking
+     * paging.h's value makes this grid bit for bit the CPU's (bricked). The
+     * occupancy rules widen [min, max] by far more than that ulp (bricks.c),
+     * so skipping stays conservative for the samples the driver rounds. */
+    const double top = (double)((1u << sk->texture_bits) - 1);
+    for (size_t i = 0; i < 2 * n; i++)
+        b->minmax[i] = (float)vxl_unorm_value((uint32_t)lrint(b->minmax[i] * top), sk->texture_bits);
+    return VXL_OK;
 }
 
 /* Iso-surface skipping needs a gradient bound over the taps' reach; built on

@@ -17,6 +17,7 @@ typedef struct vxl_skipping_state {
     vxl_gpu *gpu;               /* the GL services */
     vxl_storage_state *storage; /* the volume the grid is derived from */
     vxl_bricks bricks;
+    uint32_t texture_bits;      /* the volume texture's: 8 and 16 are normalised integers */
     GLuint brick_tex;
 } vxl_skipping_state;
 
@@ -25,7 +26,8 @@ void vxl_skipping_init(vxl_skipping_state *sk, vxl_gpu *g, vxl_storage_state *st
 int vxl_skipping_prepare(vxl_skipping_state *sk, const vxl_frame *f);
 void vxl_skipping_release(vxl_skipping_state *sk);
 /* Takes a min-max grid the storage computed (bricked: on the CPU at
- * set_volume); an empty one leaves the grid to be built from the texture. */
-void vxl_skipping_adopt(vxl_skipping_state *sk, vxl_bricks *grid);
+ * set_volume); an empty one leaves the grid to be built from the texture,
+ * whose texels have the volume's texture_bits. */
+void vxl_skipping_adopt(vxl_skipping_state *sk, vxl_bricks *grid, uint32_t texture_bits);
 
 #endif

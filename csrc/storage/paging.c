@@ -16,14 +16,14 @@ static void row_range(const vxl_volume *v, size_t i, uint32_t n, double *lo, dou
         const uint8_t *t = (const uint8_t *)v->texels + i;
         uint8_t a = t[0], b = t[0];
         for (uint32_t k = 1; k < n; k++) { a = t[k] < a ? t[k] : a; b = t[k] > b ? t[k] : b; }
-        mn = a / 255.0 < mn ? a / 255.0 : mn;
-        mx = b / 255.0 > mx ? b / 255.0 : mx;
+        mn = vxl_unorm_value(a, 8) < mn ? vxl_unorm_value(a, 8) : mn;
+        mx = vxl_unorm_value(b, 8) > mx ? vxl_unorm_value(b, 8) : mx;
     } else if (v->texture_bits == 16) {
         const uint16_t *t = (const uint16_t *)v->texels + i;
         uint16_t a = t[0], b = t[0];
         for (uint32_t k = 1; k < n; k++) { a = t[k] < a ? t[k] : a; b = t[k] > b ? t[k] : b; }
-        mn = a / 65535.0 < mn ? a / 65535.0 : mn;
-        mx = b / 65535.0 > mx ? b / 65535.0 : mx;
+        mn = vxl_unorm_value(a, 16) < mn ? vxl_unorm_value(a, 16) : mn;
+        mx = vxl_unorm_value(b, 16) > mx ? vxl_unorm_value(b, 16) : mx;
     } else {
         const float *t = (const float *)v->texels + i;
         float a = t[0], b = t[0];

@@ -39,9 +39,18 @@ static inline uint64_t vxl_page_count(const vxl_pages *pg)
 int vxl_pages_build(vxl_pages *pg, const vxl_volume *v, uint32_t brick, vxl_err *e);
 void vxl_pages_free(vxl_pages *pg);
 
-/* The skipping grid's min-max (bricks of b->size voxels, one-voxel apron),
- * computed from the CPU volume exactly as brick_minmax.comp does on a dense
- * texture; fills b->size, b->dims and b->minmax. */
+/* The value of a normalised integer texel, code / (2^bits - 1), in double
+ * (the grid rounds it to float once). GL leaves the division's last bit to
+ * the driver (llvmpipe's float is 1 ulp off this for some codes), so the
+ * GPU grid is snapped to this one definition (skip/skipping.c). */
+static inline double vxl_unorm_value(uint32_t code, uint32_t bits) { return code / (double)((1u << bits) - 1); }
+
+/* The skipping grid's min-max: per brick of b->size voxels, the min and max
+ * over the brick and a one-voxel apron each way, clamped to the volume
+ * (every voxel a trilinear sample inside the brick's box reaches). The CPU
+ * copy of brick_minmax.comp, bit for bit (tests/test_kernels.c), which
+ * bricked storage needs at set_volume, before anything is on the GL side;
+ * fills b->size, b->dims and b->minmax. */
 int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl_err *e);
 
 /* need[i] = 1 for every candidate brick a frame can read under the

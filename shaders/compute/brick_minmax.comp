@@ -1,6 +1,10 @@
 // brick_minmax.comp - min and max of the normalised value per brick of
 // BRICK^3 voxels, over the brick plus a one-voxel apron: every voxel that a
 // trilinear sample inside the brick's box can touch. Computed once per volume.
+// Its one CPU copy is vxl_bricks_minmax_cpu (csrc/storage/paging.c, for
+// bricked storage); skipping.c snaps integer texels to code / (2^bits - 1)
+// as that copy computes it, and tests/test_kernels.c checks the two grids
+// are the same floats.
 // With GRADIENT_BOUND: instead, a bound on the gradient magnitude of any
 // difference filter (central, forward3, Sobel) at a sample in the brick:
 // the trilinear interpolant is Lipschitz along each axis with the largest

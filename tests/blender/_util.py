@@ -95,7 +95,7 @@ def install_addon(path=None, check_library=True, legacy=False):
         ok, msg = mod.library_status()
         assert ok, msg
         # The library must be the one shipped inside the installed add-on.
-        lib_dir = os.path.dirname(mod.native.load_library().source_path)
+        lib_dir = os.path.dirname(mod.core.native.load_library().source_path)
         assert lib_dir == os.path.dirname(mod.__file__), (lib_dir, mod.__file__)
     return mod
 
@@ -156,7 +156,7 @@ def reopen(objects, filename):
     names = [ob.name for ob in objects]
     path = os.path.join(TMP, filename)
     bpy.ops.wm.save_as_mainfile(filepath=path)
-    installed_module().runtime.release_all()
+    installed_module().core.runtime.release_all()
     bpy.ops.wm.open_mainfile(filepath=path)
     return [bpy.data.objects[n] for n in names]
 

@@ -117,7 +117,7 @@ def import_chooses_a_dicom_series():
         write_dicom(os.path.join(d, "a%d.dcm" % k), "1.2.7.1", px, 2.0 * k)
     for k in range(2):
         write_dicom(os.path.join(d, "b%d.dcm" % k), "1.2.7.2", px, 2.0 * k, modality="MR")
-    assert [s["uid"] for s in vx.native.list_dicom_series(d)] == ["1.2.7.1", "1.2.7.2"]
+    assert [s["uid"] for s in vx.core.native.list_dicom_series(d)] == ["1.2.7.1", "1.2.7.2"]
     ob = u.import_volume(os.path.join(d, "a0.dcm"), series="1.2.7.2")
     assert tuple(ob.voxlight.dims) == (4, 3, 2) and ob.voxlight.series == "1.2.7.2"
     assert vx.render_volume(ob, resolution=(32, 32)).shape == (32, 32, 4)

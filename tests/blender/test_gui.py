@@ -44,7 +44,7 @@ def redraw(types=None):
 def steps():
     """A generator: each yield is the delay (s) before the next step."""
     vx = u.install_addon()
-    rt, vp = vx.runtime, vx.viewport
+    rt, vp = vx.core.runtime, vx.viewport
     capture.install()
     scene = u.reset_scene()
     scene.voxlight.viewport_resolution = 0.5  # llvmpipe: keep each render short
@@ -393,7 +393,7 @@ def volume_object_with_ball(scene):
 
 
 def gui_import_steps(vx, win, area):
-    native = vx.native
+    native = vx.core.native
     made = []
     real_init, real_load = native.Renderer.__init__, native.Volume.load
     gate = {"open": True}
@@ -437,7 +437,7 @@ def gui_import_steps(vx, win, area):
         # released 2 s ago); the worker stops at its next step, so it makes
         # no renderer, or closes the one it made.
         check("esc_cancels_the_import", set(bpy.data.objects) == before
-              and vx.runtime.find_entry(os.path.join(u.TMP, "esc.nii.gz")) is None
+              and vx.core.runtime.find_entry(os.path.join(u.TMP, "esc.nii.gz")) is None
               and all(r._handle is None for r in made[n_made:]),
               "renderers made %d, closed %s" % (len(made) - n_made, [r._handle is None for r in made[n_made:]]))
     finally:

@@ -85,7 +85,7 @@ def steps():
         grab()
         yield 0.5  # a redraw updates perspective_matrix
         model = vx.params.model_matrix(ob)
-        corners = vx.volume_space.world_corners(model, tuple(ob.voxlight.dims))
+        corners = vx.core.volume_space.world_corners(model, tuple(ob.voxlight.dims))
         ndc, w = ndc_of(corners, r3d)
         extent = np.abs(ndc[:, :2]).max()
         check("frame_in_view_%s" % persp.lower(), (w > 0).all() and 0.4 < extent < 1.0,

@@ -90,7 +90,7 @@ def text_width(text):
 
 def steps():
     vx = u.install_addon()
-    rt, vp = vx.runtime, vx.viewport
+    rt, vp = vx.core.runtime, vx.viewport
     scene = u.reset_scene()
     scene.voxlight.viewport_resolution = 0.5
     scene.voxlight.settle_time = 0.3

@@ -36,13 +36,13 @@ def steps():
     s.viewport_resolution, s.settle_time = 0.5, 0.3  # llvmpipe: short renders
 
     sizes = []  # illumination_size of every library call, in order
-    plain_render = vx.native.Renderer.render
+    plain_render = vx.core.native.Renderer.render
 
     def recording_render(self, params=None, *args, **kwargs):
         if params is not None:
             sizes.append(params.illumination_size)
         return plain_render(self, params, *args, **kwargs)
-    vx.native.Renderer.render = recording_render
+    vx.core.native.Renderer.render = recording_render
 
     with bpy.context.temp_override(window=win, area=area):
         ob = u.import_volume(u.ball_file())
@@ -59,9 +59,9 @@ def steps():
             area.tag_redraw()
             yield 0.5
             if capture.img is not None and not vx.viewport.busy() and \
-                    vx.runtime.render_count == last:
+                    vx.core.runtime.render_count == last:
                 return
-            last = vx.runtime.render_count
+            last = vx.core.runtime.render_count
 
     yield from settled()
     before = capture.img
@@ -73,7 +73,7 @@ def steps():
         area.tag_redraw()
         yield 0.08
     dragged = list(sizes)
-    check("dragged_frames_are_coarse", vx.lighting.DRAG_ILLUMINATION_SIZE in dragged
+    check("dragged_frames_are_coarse", vx.core.lighting.DRAG_ILLUMINATION_SIZE in dragged
           and 256 not in dragged[1:], "sizes %s" % sorted(set(dragged)))
     sizes.clear()
     yield from settled()
@@ -83,7 +83,7 @@ def steps():
     check("settled_frame_is_shown_full", st.shown is not None and st.shown.full)
     change = np.abs(after[..., :3] - before[..., :3]).max(axis=2).mean()
     check("moving_the_sun_relights", change > 0.005, "mean change %.4f" % change)
-    vx.native.Renderer.render = plain_render
+    vx.core.native.Renderer.render = plain_render
 
 
 RUN.start(steps())

@@ -127,11 +127,11 @@ def every_panel_property_changes_the_render():
 def filter_choices_come_from_the_library():
     """The panel's filter enum is the library's list (vxl_filter_name), with
     the library's VXL_FILTER_* numbers, so issue 4's 'cubic' (6) is there."""
-    lib = vx.native.load_library()
+    lib = vx.core.native.load_library()
     prop = bpy.types.Object.bl_rna.properties["voxlight"].fixed_type.properties["filter"]
     items = [(i.identifier, i.value) for i in prop.enum_items]
     assert items == [(n, i) for i, n in enumerate(lib.filter_names())], items
-    assert ("cubic", 6) in items and len(items) == len(vx.native.FILTERS)
+    assert ("cubic", 6) in items and len(items) == len(vx.core.native.FILTERS)
     assert ("cubic-smooth", 7) in items  # issue 14: the approximating B-spline
     assert {"cubic", "cubic-smooth"} <= vx.properties.FIXED_TAP_FILTERS  # sampleDistance greyed out
 
@@ -143,7 +143,7 @@ def renders_skip_volumes_nobody_can_see():
     scene, ob = _scene_with_ball()
     ob.voxlight.jitter = False
     w, h = 32, 32
-    rt = vx.runtime
+    rt = vx.core.runtime
 
     def f12_layers():
         dg = bpy.context.evaluated_depsgraph_get()
@@ -269,7 +269,7 @@ def survives_save_and_reload():
     name = ob.name
     path = os.path.join(u.TMP, "scene.blend")
     bpy.ops.wm.save_as_mainfile(filepath=path)
-    vx.runtime.release_all()  # as after a restart: no live renderer
+    vx.core.runtime.release_all()  # as after a restart: no live renderer
     bpy.ops.wm.open_mainfile(filepath=path)
     ob = bpy.data.objects[name]
     assert ob.voxlight.preset == "hot"
@@ -287,7 +287,7 @@ def large_phantom_renders_bricked_within_the_budget():
     assert ob.voxlight.filepath == spec and tuple(ob.voxlight.dims) == (2200, 300, 90)
     img = vx.render_volume(ob, resolution=(96, 48))
     assert img[..., 3].max() > 0.1, img[..., 3].max()
-    frame = vx.runtime.find_entry(spec).last_frame
+    frame = vx.core.runtime.find_entry(spec).last_frame
     assert frame["storage_name"] == "bricked" and 0 < frame["resident_bytes"] < 2 << 30, frame
     assert frame["pages_constant"] > 0 and frame["pages_resident"] < frame["pages_total"]
     text = vx.panels.storage_text(frame)
@@ -297,11 +297,11 @@ def large_phantom_renders_bricked_within_the_budget():
     s = bpy.context.scene.voxlight
     s.storage = "sparse"
     vx.render_volume(ob, resolution=(96, 48))
-    frame = vx.runtime.find_entry(spec).last_frame
+    frame = vx.core.runtime.find_entry(spec).last_frame
     assert frame["storage_name"] == "sparse" and frame["lod_level"] == 0, frame
     s.memory_budget_mib = max(1, int(frame["resident_bytes"] / 2 / 1048576))
     img = vx.render_volume(ob, resolution=(96, 48))
-    frame = vx.runtime.find_entry(spec).last_frame
+    frame = vx.core.runtime.find_entry(spec).last_frame
     assert frame["lod_level"] >= 1 and frame["resident_bytes"] <= s.memory_budget_mib << 20, frame
     assert vx.panels.lod_text(frame).startswith("LOD fallback"), frame
     assert img[..., 3].max() > 0.05

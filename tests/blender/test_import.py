@@ -114,7 +114,7 @@ def openvdb_abort_is_an_error_and_blender_lives_on():
     helper process dies instead of Blender, the import reports it, and the
     next .vdb import still works through the installed helper."""
     u.reset_scene()
-    helper = os.path.join(os.path.dirname(vx.__file__), vx.native.VDB_HELPER_NAME)
+    helper = os.path.join(os.path.dirname(vx.__file__), vx.core.native.VDB_HELPER_NAME)
     assert os.access(helper, os.X_OK), helper  # zip install dropped the bit; the add-on restored it
     repro = os.path.join(u.ROOT, "tests", "fuzz", "upstream", "openvdb_delayed_load_mask_assert.vdb")
     _expect_failure("the OpenVDB reader crashed (signal 6: SIGABRT)", filepath=repro)
@@ -156,7 +156,7 @@ def failure_while_creating_the_object_removes_it():
         _expect_failure("simulated failure", filepath=path)
     finally:
         vx.tf.ensure_texture = real
-    assert vx.runtime.find_entry(path) is None
+    assert vx.core.runtime.find_entry(path) is None
 
 
 u.run("test_import")

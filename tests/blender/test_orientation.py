@@ -129,8 +129,8 @@ def option_off_keeps_scanner_placement_and_on_turns_it():
     on = u.import_volume(path, center=False)
     info = {"affine": np.diag([SPACING, SPACING, SPACING, 1.0])}
     info["affine"][:3, 3] = -(N - 1) / 2.0 * SPACING
-    s_from_v = vx.volume_space.scene_from_voxel(info["affine"], (N, N, N), 0.01)
-    want = vx.volume_space.object_matrix(s_from_v, (N, N, N))
+    s_from_v = vx.core.volume_space.scene_from_voxel(info["affine"], (N, N, N), 0.01)
+    want = vx.core.volume_space.object_matrix(s_from_v, (N, N, N))
     assert np.allclose(np.array(off.matrix_world), want, atol=1e-6)
     turn = np.diag([-1.0, -1.0, 1.0, 1.0])
     assert np.allclose(np.array(on.matrix_world), turn @ want, atol=1e-6)

@@ -42,7 +42,7 @@ def _nothing_mapped_from_the_addon(mod):
     folder = os.path.realpath(os.path.dirname(mod.__file__))
     mapped = [p for p in _mapped_files() if os.path.realpath(p).startswith(folder + os.sep)]
     assert not mapped, mapped
-    lib = mod.native.load_library()
+    lib = mod.core.native.load_library()
     assert os.path.realpath(lib.path) in {os.path.realpath(p) for p in _mapped_files()}, lib.path
 
 
@@ -74,13 +74,13 @@ def zip_has_directory_entries():
 
 @test
 def library_is_a_private_copy_with_its_helpers():
-    lib = vx.native.load_library()
+    lib = vx.core.native.load_library()
     assert lib.path != lib.source_path
     private = os.environ.get("BLENDER_USER_EXTENSIONS")
     if u.uses_extensions() and private:  # the extension's own user folder
         assert os.path.realpath(lib.path).startswith(os.path.realpath(private) + os.sep), lib.path
     src, copy = os.path.dirname(lib.source_path), os.path.dirname(lib.path)
-    for name in vx.native.helper_names(src):
+    for name in vx.core.native.helper_names(src):
         assert os.access(os.path.join(copy, name), os.X_OK), name
         assert os.access(os.path.join(src, name), os.X_OK), name  # execute bit restored
     _nothing_mapped_from_the_addon(vx)
@@ -90,12 +90,12 @@ def library_is_a_private_copy_with_its_helpers():
 def reinstall_same_zip_then_reenable_and_render():
     global vx
     _render_ball(vx)
-    before = vx.native.load_library().path
+    before = vx.core.native.load_library().path
     vx = u.install_addon()  # over the enabled add-on
     u.disable()
     vx = u.enable()
     _render_ball(vx)
-    assert vx.native.load_library().path == before  # same content, same copy
+    assert vx.core.native.load_library().path == before  # same content, same copy
     _nothing_mapped_from_the_addon(vx)
     # And again, the way a user may click it twice.
     vx = u.install_addon()
@@ -106,11 +106,11 @@ def reinstall_same_zip_then_reenable_and_render():
 @test
 def updated_library_is_loaded_after_reinstall():
     global vx
-    before = vx.native.load_library().path
+    before = vx.core.native.load_library().path
     # Bytes after the end of an ELF file change its hash, not its meaning.
     z = _variant_zip("updated.zip", lambda data: data + b"\0voxlight update test\0")
     vx = u.install_addon(z)
-    lib = vx.native.load_library()
+    lib = vx.core.native.load_library()
     assert lib.path != before, "the old library is still in use"
     with open(lib.path, "rb") as a, open(lib.source_path, "rb") as b:
         assert a.read() == b.read()
@@ -147,11 +147,11 @@ def library_of_another_abi_is_refused_with_a_message():
 
 @test
 def private_copies_are_cleaned_when_unused():
-    lib = vx.native.load_library()
+    lib = vx.core.native.load_library()
     root = os.path.dirname(os.path.dirname(lib.path))
     stale = os.path.join(root, "0" * 24)
     shutil.copytree(os.path.dirname(lib.path), stale)
-    vx.native.clean_stale_copies(root)
+    vx.core.native.clean_stale_copies(root)
     assert not os.path.exists(stale)
     assert os.path.isfile(lib.path)  # the copy in use stays
     _render_ball(vx)

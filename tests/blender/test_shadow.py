@@ -227,7 +227,7 @@ def defaults_choices_and_animatable():
     assert rna["anisotropy"].default == 0.0
     assert rna["shadow_quality"].default == "AUTO"
     # The models and their numbers are the library's (VXL_SHADING_*).
-    lib = vx.native.load_library()
+    lib = vx.core.native.load_library()
     items = [(i.identifier, i.value) for i in rna["shading_model"].enum_items]
     assert items == [(n, i) for i, n in enumerate(lib.names("shading_model"))], items
     assert [(i.identifier, i.value) for i in rna["shadow_quality"].enum_items] == \
@@ -291,7 +291,7 @@ def dragging_a_light_coarsens_only_the_illumination_volume():
     bpy.context.view_layer.update()
     dragged, left = frame(100.2)
     assert left is not None and 0 < left <= 0.3
-    assert dragged.illumination_size == vx.lighting.DRAG_ILLUMINATION_SIZE
+    assert dragged.illumination_size == vx.core.lighting.DRAG_ILLUMINATION_SIZE
     assert dragged.shading_model == still.shading_model and dragged.step == still.step
     settled, left = frame(100.6)
     assert left is None and settled.illumination_size == 256

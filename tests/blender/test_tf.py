@@ -70,7 +70,7 @@ def ct_range_imports_as_ct_with_hounsfield_window():
     ob = _volume("ct.nii.gz", -1024.0, 2000.0)
     p = ob.voxlight
     assert p.data_kind == "ct" and p.tf_preset == "CT"
-    lo, hi, _stops = vx.tf_fit.place("CT", "ct", vx.tf.stats_of(ob))
+    lo, hi, _stops = vx.core.tf_fit.place("CT", "ct", vx.tf.stats_of(ob))
     assert abs(p.window_low - lo) < 1e-3 and p.window_high == 2000.0
 
 
@@ -82,21 +82,21 @@ def every_preset_round_trips_through_the_colorramp():
         ob = _volume(name, lo, hi)
         p = ob.voxlight
         stats = vx.tf.stats_of(ob)
-        for key in vx.tf_presets.PRESETS:
+        for key in vx.core.tf_presets.PRESETS:
             _load(ob, key)
-            wlo, whi, stops = vx.tf_fit.place(key, p.data_kind, stats)
+            wlo, whi, stops = vx.core.tf_fit.place(key, p.data_kind, stats)
             assert abs(p.window_low - wlo) < 1e-3 * max(1.0, abs(wlo)), (key, p.window_low, wlo)
             assert abs(p.window_high - whi) < 1e-3 * max(1.0, abs(whi)), (key, p.window_high, whi)
-            want = vx.tf_presets.stops_table(stops)
+            want = vx.core.tf_presets.stops_table(stops)
             got = vx.tf.table(p)
             err = float(np.abs(got - want).max())
             assert err < 0.01, (key, err)
             assert len(p.tf_texture.color_ramp.elements) == len(stops), key
-            assert vx.tf.preset_state(p) == (vx.tf_presets.PRESETS[key].name, False), key
+            assert vx.tf.preset_state(p) == (vx.core.tf_presets.PRESETS[key].name, False), key
         # built-in presets on CT reproduce the library's own table over its window
         if p.data_kind == "ct":
             _load(ob, "BONE")
-            lib_ct = vx.tf_presets.builtin_table("ct")
+            lib_ct = vx.core.tf_presets.builtin_table("ct")
             _load(ob, "CT")
             wlo, whi = p.window_low, p.window_high
             hu = np.linspace(-1000.0, 2000.0, 301)
@@ -130,10 +130,10 @@ def editing_the_ramp_marks_the_preset_modified_and_rerenders():
     assert img[..., 0].max() > 0.2  # red stop: red where the ball is
     # The sampled table is part of the viewport's frame key.
     view, proj = np.eye(4), np.eye(4)
-    k1 = vx.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
+    k1 = vx.core.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
     ramp.elements[0].color = (0, 1, 0, 0.5)
-    k2 = vx.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
-    k3 = vx.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
+    k2 = vx.core.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
+    k3 = vx.core.native.params_digest(vx.params.build(ob, 8, 8, view, proj), "id")
     assert k1 != k2 and k2 == k3
     # Fit Window on an edited ramp keeps the stops and spans the foreground.
     before = vx.tf.table(p)
@@ -182,7 +182,7 @@ def old_files_open_looking_the_same():
         name = ob.name
         path = os.path.join(u.TMP, "legacy_%s.blend" % preset)
         bpy.ops.wm.save_as_mainfile(filepath=path)
-        vx.runtime.release_all()
+        vx.core.runtime.release_all()
         bpy.ops.wm.open_mainfile(filepath=path)
         ob = bpy.data.objects[name]
         p = ob.voxlight
@@ -231,7 +231,7 @@ def dicom_modality_decides_the_kind_of_data():
     mr = u.import_volume(os.path.join(d, "m0.dcm"), series="1.2.9.2")
     assert (ct.voxlight.data_kind, ct.voxlight.tf_preset) == ("ct", "CT")
     assert (mr.voxlight.data_kind, mr.voxlight.tf_preset) == ("mr", "MRI")
-    assert vx.tf_fit.guess_kind(76.0, 87.0) == "mr"  # what the range alone would say
+    assert vx.core.tf_fit.guess_kind(76.0, 87.0) == "mr"  # what the range alone would say
 
 
 # Each Slicer preset on a volume whose values lie where the preset shows something.
@@ -297,7 +297,7 @@ def _box_pixels(ob, camera, w, h):
     depsgraph = bpy.context.evaluated_depsgraph_get()
     view, proj = vx.offline.camera_matrices(camera, depsgraph, w, h, bpy.context.scene)
     model = vx.params.model_matrix(ob)
-    c = np.c_[vx.native.voxel_box_corners(tuple(ob.voxlight.dims)), np.ones(8)]
+    c = np.c_[vx.core.native.voxel_box_corners(tuple(ob.voxlight.dims)), np.ones(8)]
     clip = (proj @ view @ model @ c.T).T
     pts = (clip[:, :2] / clip[:, 3:4] * 0.5 + 0.5) * [w, h]
     pts = sorted(map(tuple, pts))

@@ -60,7 +60,7 @@ def test_reference_follows_the_library_equations():
         pkg.__path__ = [str(ROOT / "plugin")]
         sys.modules["voxlight"] = pkg
     os.environ.setdefault("VOXLIGHT_LIB", str(ROOT / "build" / "libvoxlight.so"))
-    from voxlight import native
+    from voxlight.core import native
     import ref_render
     from vtk_compare import MATERIAL, TABLES
     from vtk_peer import read_nifti

@@ -1,4 +1,4 @@
-"""The ctypes structs (plugin/native_abi.py) against the C headers: every
+"""The ctypes structs (plugin/core/native_abi.py) against the C headers: every
 public struct's size, alignment and field offsets as the C compiler lays
 them out, so a field added, moved or resized on one side only fails here.
 
@@ -15,7 +15,7 @@ import subprocess
 import pytest
 
 import conftest
-from voxlight import native
+from voxlight.core import native
 
 INCLUDE = os.path.join(conftest.ROOT, "csrc", "include")
 HEADERS = ("voxlight.h", "voxlight_dev.h")

@@ -9,7 +9,7 @@ import pytest
 
 from dicom_write import write_dicom
 from nifti_write import nifti1_bytes
-from voxlight import frames, native, runtime
+from voxlight.core import frames, native, runtime
 
 
 def write_4d(path, frames_n=8, n=12):

@@ -1,4 +1,4 @@
-"""Framing a volume in the viewport after import (plugin/framing.py):
+"""Framing a volume in the viewport after import (plugin/core/framing.py):
 the bounding sphere and the view distance that fits it, checked by
 projecting with a projection built like Blender's viewport camera."""
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from voxlight import framing, volume_space
+from voxlight.core import framing, volume_space
 
 
 def viewport_proj(lens, w, h, perspective, distance, near=0.01, far=1000.0):

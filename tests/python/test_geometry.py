@@ -4,7 +4,7 @@ volume placement and the light mapping."""
 import numpy as np
 import pytest
 
-from voxlight import depth, lights, volume_space, zbuffer
+from voxlight.core import depth, lights, volume_space, zbuffer
 
 
 def perspective(fov_y=1.0, aspect=1.0, near=0.1, far=100.0):

@@ -1,4 +1,4 @@
-"""The importer's worker (plugin/import_job.py) and runtime.open_volume
+"""The importer's worker (plugin/core/import_job.py) and runtime.open_volume
 without Blender: a load on a thread, errors as messages, and cancelling
 before, during and after the load keeps nothing alive or registered."""
 
@@ -9,7 +9,7 @@ import threading
 import numpy as np
 import pytest
 
-from voxlight import import_job, native, runtime
+from voxlight.core import import_job, native, runtime
 from nifti_write import phantom, write_nifti
 
 

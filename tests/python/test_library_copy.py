@@ -1,4 +1,4 @@
-"""The library is loaded from a private copy (plugin/native.py), so that
+"""The library is loaded from a private copy (plugin/core/native.py), so that
 installing the add-on over itself never writes over a mapped file, and an
 updated library is really loaded. Without Blender: each scenario runs in a
 child Python, because writing over a mapped library crashes its process."""
@@ -11,7 +11,7 @@ import textwrap
 
 import pytest
 
-from voxlight import native
+from voxlight.core import native
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -32,7 +32,7 @@ def addon_dir(tmp_path):
 def _child(code, cache, **env):
     e = dict(os.environ, VOXLIGHT_CACHE_DIR=str(cache), **env)
     e.pop("VOXLIGHT_LIB", None)
-    prelude = "import sys; sys.path.insert(0, %r); import conftest; from voxlight import native\n" % HERE
+    prelude = "import sys; sys.path.insert(0, %r); import conftest; from voxlight.core import native\n" % HERE
     return subprocess.run([sys.executable, "-c", prelude + textwrap.dedent(code)], env=e,
                           capture_output=True, text=True, timeout=120)
 
@@ -85,7 +85,7 @@ def test_stale_copies_go_and_held_ones_stay(addon_dir, tmp_path):
     lib = str(addon_dir / "libvoxlight.so")
     holder = subprocess.Popen(
         [sys.executable, "-c", "import sys; sys.path.insert(0, %r); import conftest\n"
-         "from voxlight import native\nprint(native.load_library(%r).path, flush=True)\n"
+         "from voxlight.core import native\nprint(native.load_library(%r).path, flush=True)\n"
          "sys.stdin.read()" % (HERE, lib)],
         env=dict(os.environ, VOXLIGHT_CACHE_DIR=str(cache)), stdin=subprocess.PIPE,
         stdout=subprocess.PIPE, text=True)

@@ -1,4 +1,4 @@
-"""The volume's lighting settings without Blender (plugin/lighting.py and
+"""The volume's lighting settings without Blender (plugin/core/lighting.py and
 params' light watch), and their way into vxl_render_params
 (native.make_params, tile_params, params_digest)."""
 
@@ -9,7 +9,7 @@ import re
 import numpy as np
 import pytest
 
-from voxlight import lighting, lights, native
+from voxlight.core import lighting, lights, native
 
 from conftest import ROOT
 

@@ -1,4 +1,4 @@
-"""The ctypes binding (plugin/native.py) against the real library, without
+"""The ctypes binding (plugin/core/native.py) against the real library, without
 Blender."""
 
 import ctypes
@@ -8,7 +8,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from voxlight import native
+from voxlight.core import native
 from nifti_write import phantom, write_nifti
 
 
@@ -88,7 +88,10 @@ def test_candidate_order(monkeypatch):
     monkeypatch.setenv("VOXLIGHT_LIB", "/env/libvoxlight.so")
     paths = native.candidate_paths("/explicit/libvoxlight.so")
     assert paths[0] == "/explicit/libvoxlight.so" and paths[1] == "/env/libvoxlight.so"
-    assert paths[2] == os.path.join(os.path.dirname(native.__file__), "libvoxlight.so")
+    # The add-on ships the library in its top folder, above core/.
+    addon = os.path.dirname(os.path.dirname(native.__file__))
+    assert paths[2] == os.path.join(addon, "libvoxlight.so")
+    assert paths[3] == os.path.join(os.path.dirname(addon), "build", "libvoxlight.so")
 
 
 def test_volume_load_info(lib, ball_file):

@@ -1,11 +1,11 @@
 """The import option that turns a scan so Blender's named views match its
-anatomy (plugin/orientation.py), checked against the views' real
+anatomy (plugin/core/orientation.py), checked against the views' real
 directions and through the same placement maths the importer uses."""
 
 import numpy as np
 import pytest
 
-from voxlight import orientation, volume_space
+from voxlight.core import orientation, volume_space
 
 # Blender's named views as bpy.ops.view3d.view_axis sets them (measured in
 # Blender 3.4 with view_rotation; tests/blender/test_gui_orientation.py

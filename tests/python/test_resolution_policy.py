@@ -1,4 +1,4 @@
-"""The viewport's adaptive interactive resolution (plugin/resolution_policy.py):
+"""The viewport's adaptive interactive resolution (plugin/core/resolution_policy.py):
 given measured frame times and pixel counts, the next scale aims at the
 frame budget, is clamped, moves smoothly, and the still view refines in
 visible steps."""
@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from voxlight.resolution_policy import TARGET_SECONDS, ScalePolicy, refine_scales
+from voxlight.core.resolution_policy import TARGET_SECONDS, ScalePolicy, refine_scales
 
 FULL = 1321 * 852  # the viewport of the report, at scale 1
 

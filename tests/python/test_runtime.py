@@ -1,4 +1,4 @@
-"""The viewport's background worker (plugin/runtime.py) against the real
+"""The viewport's background worker (plugin/core/runtime.py) against the real
 library: newest frame wins, stale frames are dropped between bands, the
 renderer is free again within one band, close() joins the thread."""
 
@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from voxlight import native, runtime
+from voxlight.core import native, runtime
 from nifti_write import phantom, write_nifti
 
 

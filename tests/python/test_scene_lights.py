@@ -1,4 +1,4 @@
-"""Blender lights -> library lights and shapes (plugin/lights.py), without
+"""Blender lights -> library lights and shapes (plugin/core/lights.py), without
 Blender: light data, objects and depsgraph instances are stand-ins read by
 attribute, the way the add-on reads Blender's."""
 
@@ -8,7 +8,7 @@ from types import SimpleNamespace as NS
 import numpy as np
 import pytest
 
-from voxlight import lights
+from voxlight.core import lights
 
 
 def _matrix(location=(0.0, 0.0, 0.0), rotation=np.eye(3), scale=(1.0, 1.0, 1.0)):

@@ -1,11 +1,11 @@
-"""Transfer-function presets and their fit to the data (plugin/tf_presets.py,
+"""Transfer-function presets and their fit to the data (plugin/core/tf_presets.py,
 tf_fit.py, histogram_image.py) without Blender; the built-in tables are
 checked against the library's own."""
 
 import numpy as np
 import pytest
 
-from voxlight import histogram_image, native, tf_fit, tf_presets
+from voxlight.core import histogram_image, native, tf_fit, tf_presets
 from nifti_write import phantom
 
 BUILTINS = ("gray", "bone", "hot", "mri", "ct")

@@ -6,7 +6,7 @@ grid choice and errors."""
 import numpy as np
 import pytest
 
-from voxlight import native
+from voxlight.core import native
 from vdb_write import write_vdb
 
 # a rotation about z, anisotropic voxels and a translation: catches any

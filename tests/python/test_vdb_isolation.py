@@ -15,7 +15,7 @@ import time
 import numpy as np
 import pytest
 
-from voxlight import native
+from voxlight.core import native
 from vdb_write import write_vdb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

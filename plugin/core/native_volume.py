@@ -2,7 +2,7 @@
 or generated (phantoms), with their information and histogram; the series
 of a DICOM folder.
 
-Part of the ctypes binding; plugin/native.py re-exports it."""
+Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
 import ctypes
 import os

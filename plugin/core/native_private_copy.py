@@ -2,7 +2,7 @@
 never mapped from the add-on's own folder (see below), and the execute bit
 Blender's zip install drops from the helpers.
 
-Part of the ctypes binding; plugin/native.py re-exports it."""
+Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
 import errno
 import fcntl

@@ -2,7 +2,7 @@
 part of the binding calls through, with the argument types of each entry
 point and the names of the library's enumerations.
 
-Part of the ctypes binding; plugin/native.py re-exports it."""
+Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
 import ctypes
 import os
@@ -19,9 +19,10 @@ LIBRARY_NAME = "libvoxlight.so"
 
 def candidate_paths(explicit=None):
     """Where the library is looked for, in order. The add-on ships the .so
-    next to this file; the source-tree fallback (../build) serves developers
-    running from a checkout."""
-    here = os.path.dirname(os.path.abspath(__file__))
+    in its top folder, the parent of this core/ folder; the source-tree
+    fallback (../build from there) serves developers running from a
+    checkout."""
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     paths = []
     if explicit:
         paths.append(explicit)

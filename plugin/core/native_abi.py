@@ -4,7 +4,7 @@ the pointer and matrix conversions every call uses. No library is loaded
 here. tests/python/test_abi.py checks every struct's size and field offsets
 against the C compiler's.
 
-Part of the ctypes binding; plugin/native.py re-exports it."""
+Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
 import ctypes
 

@@ -2,7 +2,7 @@
 (same camera, same jitter), the digest that says two frames are the same,
 and the statistics of a tiled frame.
 
-Part of the ctypes binding; plugin/native.py re-exports it."""
+Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
 import hashlib
 

@@ -1,7 +1,7 @@
 """libvoxlight renderers: the render params built from the add-on's
 settings (make_params), and the Renderer, whole-frame or tiled.
 
-Part of the ctypes binding; plugin/native.py re-exports it."""
+Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
 import ctypes
 import os

@@ -265,6 +265,8 @@ TEST(every_enumeration_has_names)
         {"gradient opacity", vxl_gradient_opacity_name, vxl_gradient_opacity_from_name, VXL_GOPACITY_COUNT},
         {"gradient store", vxl_gradient_store_name, vxl_gradient_store_from_name, VXL_GRADIENT_STORE_COUNT},
         {"backend", vxl_backend_name, vxl_backend_from_name, VXL_BACKEND_COUNT},
+        {"shading model", vxl_shading_model_name, vxl_shading_model_from_name, VXL_SHADING_COUNT},
+        {"technique", vxl_technique_name, vxl_technique_from_name, VXL_TECHNIQUE_COUNT},
     };
     for (size_t e = 0; e < sizeof all / sizeof *all; e++) {
         const enum_names *E = &all[e];

@@ -150,17 +150,6 @@ static int enum_option(const char *what, const char *val, name_fn name, int (*fr
     return die("unknown %s '%s' (%s)", what, val, name_list(name, 0, ", ", names, sizeof names));
 }
 
-/* The library has no reverse lookup for techniques: the names are few. */
-static int technique_from_name(const char *val, uint32_t *out)
-{
-    for (uint32_t i = 0; vxl_technique_name(i); i++)
-        if (!strcasecmp(vxl_technique_name(i), val)) {
-            *out = i;
-            return VXL_OK;
-        }
-    return VXL_ERR_INVALID_ARGUMENT;
-}
-
 /* "dir:X,Y,Z[,INTENSITY]" or "point:X,Y,Z[,INTENSITY]" -> a light in world
  * space. */
 static int light_option(const char *val, vxl_render_params *p)
@@ -403,7 +392,7 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (enum_option("--classify", val, vxl_classify_name, vxl_classify_from_name, &p->classify)) return 1;
         } else if (!strcmp(o, "--renderer")) {
             NEED_VALUE();
-            if (enum_option("--renderer", val, vxl_technique_name, technique_from_name, &p->technique)) return 1;
+            if (enum_option("--renderer", val, vxl_technique_name, vxl_technique_from_name, &p->technique)) return 1;
         }
         else if (!strcmp(o, "--gradient-store")) {
             NEED_VALUE();

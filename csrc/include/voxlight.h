@@ -336,6 +336,7 @@ VXL_API int vxl_shading_model_from_name(const char *name, uint32_t *out);
 #define VXL_TECHNIQUE_SLICES3D 2 /* view-aligned slices, proxy polygons clipped to the box */
 #define VXL_TECHNIQUE_COUNT 3
 VXL_API const char *vxl_technique_name(uint32_t technique); /* "raycast", "slices2d", "slices3d" */
+VXL_API int vxl_technique_from_name(const char *name, uint32_t *out);
 
 /* 9 words of room: the struct then ends on its 8-byte alignment, with no padding. */
 #define VXL_RENDER_PARAMS_RESERVED 9

@@ -32,7 +32,7 @@ import sys
 # in a plausible place; a missing file is skipped.
 FOLDERS = {
     # errors, math, names of enumerations
-    "core": """error.c error.h mat4.c mat4.h names.c names.h""",
+    "core": """error.c error.h hash.h mat4.c mat4.h names.c names.h""",
     # CPU volumes: limits, scaling, normalised storage; generated phantoms;
     # the brick min-max grid and occupancy math (CPU only)
     "volume": """volume.c volume.h phantom.c phantom.h phantom_large.c phantom_large.h bricks.c bricks.h""",

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hash.h"
 #include "mat4.h"
 
 #define DEFAULT_STEP 0.5f
@@ -315,20 +316,13 @@ void vxl_frame_free(vxl_frame *f)
     f->tf_copy = NULL;
 }
 
-static uint64_t fnv(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *c = p;
-    for (size_t i = 0; i < n; i++) h = (h ^ c[i]) * 1099511628211ull;
-    return h;
-}
-
 uint64_t vxl_classification_key(const vxl_frame *f)
 {
     uint64_t h = 1469598103934665603ull;
-    h = fnv(h, f->tf, (size_t)f->tf_size * 4 * sizeof(float));
-    h = fnv(h, &f->tf_size, sizeof f->tf_size);
-    h = fnv(h, &f->window_offset, sizeof f->window_offset);
-    h = fnv(h, &f->window_scale, sizeof f->window_scale);
-    h = fnv(h, &f->opacity_scale, sizeof f->opacity_scale);
+    h = vxl_fnv(h, f->tf, (size_t)f->tf_size * 4 * sizeof(float));
+    h = vxl_fnv(h, &f->tf_size, sizeof f->tf_size);
+    h = vxl_fnv(h, &f->window_offset, sizeof f->window_offset);
+    h = vxl_fnv(h, &f->window_scale, sizeof f->window_scale);
+    h = vxl_fnv(h, &f->opacity_scale, sizeof f->opacity_scale);
     return h;
 }

@@ -9,6 +9,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "hash.h"
 #include "holdings.h"
 #include "mat4.h"
 #include "storage.h"
@@ -35,13 +36,6 @@ void vxl_illumination_init(vxl_illumination_state *s, vxl_gpu *g, vxl_storage_st
     s->gpu = g;
     s->storage = st;
     vxl_holding_register(g, VXL_HOLD_ILLUMINATION, vxl_holding_counter, &s->bytes);
-}
-
-static uint64_t fnv(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *c = p;
-    for (size_t i = 0; i < n; i++) h = (h ^ c[i]) * 1099511628211ull;
-    return h;
 }
 
 /* Light i in voxel space: w = 0 the unit direction towards it, w = 1 its
@@ -317,11 +311,11 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
     int rc = choose_grid(s, f, blocks, &size, cells);
     if (rc) return rc;
     uint64_t key = vxl_classification_key(f);
-    key = fnv(key, &s->storage->pool_generation, sizeof s->storage->pool_generation);
+    key = vxl_fnv(key, &s->storage->pool_generation, sizeof s->storage->pool_generation);
     if (f->gopacity) { /* the opacity follows the gradient too */
         const float g[4] = {(float)f->gopacity, f->gopacity == VXL_GOPACITY_ISO ? f->iso_pos : f->gradient_ref,
                             f->gopacity == VXL_GOPACITY_ISO ? f->iso_thickness : f->gradient_exp, f->sample_distance};
-        key = fnv(key, g, sizeof g);
+        key = vxl_fnv(key, g, sizeof g);
     }
     const int keep = keeps_extinction(s, key, cells, blocks);
     if ((rc = allocate(s, keep ? s->extinction_cells : cells, cells, blocks))) return rc;
@@ -332,14 +326,14 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
         s->extinction_key = key;
     }
     /* the lights and the occlusion follow the extinction and their own grid */
-    key = fnv(key, s->extinction_cells, sizeof s->extinction_cells);
-    key = fnv(key, s->cells, sizeof s->cells);
+    key = vxl_fnv(key, s->extinction_cells, sizeof s->extinction_cells);
+    key = vxl_fnv(key, s->cells, sizeof s->cells);
     for (int i = 0; i < f->light_count; i++) {
         float lv[4], radius;
         light_voxel(f, i, lv, &radius);
-        uint64_t k = fnv(key, lv, sizeof lv);
-        k = fnv(k, &f->light_size[i], sizeof f->light_size[i]);
-        k = fnv(k, &i, sizeof i);
+        uint64_t k = vxl_fnv(key, lv, sizeof lv);
+        k = vxl_fnv(k, &f->light_size[i], sizeof f->light_size[i]);
+        k = vxl_fnv(k, &i, sizeof i);
         if (s->light_key[i] == k) continue;
         s->light_key[i] = 0;
         if ((rc = build_light(s, i, lv, radius, f->light_size[i]))) return rc;
@@ -348,7 +342,7 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
         s->builds++;
     }
     if (f->ao_radius > 0) {
-        uint64_t k = fnv(key, &f->ao_radius, sizeof f->ao_radius);
+        uint64_t k = vxl_fnv(key, &f->ao_radius, sizeof f->ao_radius);
         if (s->occlusion_key != k) {
             s->occlusion_key = 0;
             if ((rc = build_occlusion(s, f, f->light_count))) return rc;

@@ -14,6 +14,8 @@ static const char *const gopacity_names[VXL_GOPACITY_COUNT] = {"off", "boundary"
 static const char *const gradient_store_names[VXL_GRADIENT_STORE_COUNT] = {"8bit", "16f", "32f"};
 static const char *const shading_model_names[VXL_SHADING_COUNT] = {"phong", "shadowed", "scatter"};
 static const char *const technique_names[VXL_TECHNIQUE_COUNT] = {"raycast", "slices2d", "slices3d"};
+static const char *const mode_names[VXL_MODE_COUNT] = {"dvr", "mip", "minip", "average", "iso"};
+static const char *const interpolation_names[VXL_INTERP_COUNT] = {"nearest", "linear", "cubic"};
 static const char *const backend_names[VXL_BACKEND_COUNT] = {"auto", "osmesa", "egl"};
 static const char *const dtype_names[VXL_DTYPE_COUNT] = {NULL,    "uint8", "int8",    "uint16", "int16",
                                                          "uint32", "int32", "float32", "float64"};
@@ -43,6 +45,8 @@ VXL_NAMES(gradient_store, gradient_store_names, VXL_GRADIENT_STORE_COUNT, "gradi
 VXL_NAMES(backend, backend_names, VXL_BACKEND_COUNT, "backend")
 VXL_NAMES(shading_model, shading_model_names, VXL_SHADING_COUNT, "shading model")
 VXL_NAMES(technique, technique_names, VXL_TECHNIQUE_COUNT, "technique")
+VXL_NAMES(mode, mode_names, VXL_MODE_COUNT, "render mode")
+VXL_NAMES(interpolation, interpolation_names, VXL_INTERP_COUNT, "interpolation")
 
 
 const char *vxl_dtype_name(uint32_t dtype) { return dtype < VXL_DTYPE_COUNT ? dtype_names[dtype] : NULL; }

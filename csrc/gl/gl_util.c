@@ -14,7 +14,9 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
 /* flags bits for RAYCAST: 1 shading, 2 reuse gradients, bits 2-3 the
  * classify mode, bits 4-5 the gradient-opacity mode, bit 6 (also PROBE)
  * bricked storage, bit 7 compressed storage filtered in the compressed
- * domain, bits 8-9 the shading model (issue 17); for GRAD_STORE: the store format; for DECODE_BRICKS: the cache's
+ * domain, bits 8-9 the shading model (issue 17), bits 10-12 the render
+ * mode, bit 13 a MatCap, bit 14 convex cutaways (clip planes, crop box),
+ * bit 15 cutter meshes (issue 19: VXL_FLAG_* in gpu.h); for GRAD_STORE: the store format; for DECODE_BRICKS: the cache's
  * bytes per voxel - 1 */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
 static const char *const cache_formats[] = {"r8", "r16", "r32f", "r32f"};
@@ -23,7 +25,7 @@ static int compile(vxl_gpu *g, GLenum type, const char *file, const char *define
 {
     vxl_gl *gl = &g->gl;
     /* the binding numbers first, so layout(binding = VXL_...) reads gl_bindings.h */
-    char all[1024];
+    char all[2048];
     snprintf(all, sizeof all, "%s%s", vxl_glsl_binding_defines(), defines ? defines : "");
     char *src = NULL;
     int rc = vxl_shader_source(g->shader_dir, file, all, &src, &g->err);
@@ -70,7 +72,7 @@ static int link(vxl_gpu *g, GLuint a, GLuint b, GLuint *out)
 
 static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
 {
-    char defines[256] = "";
+    char defines[512] = "";
     const char *fdef = filter < VXL_FILTER_COUNT ? filter_defines[filter] : filter_defines[0];
     const char *paged = (flags & VXL_FLAG_COMPRESSED_DOMAIN) ? "#define PAGED 1\n#define COMPRESSED_DOMAIN 1\n"
                         : (flags & VXL_FLAG_PAGED)            ? "#define PAGED 1\n"
@@ -89,6 +91,11 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         if ((flags >> 8) & 3) /* issue 17: shadowed / scatter; PHONG compiles as before */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define SHADING_MODEL %u\n",
                      (flags >> 8) & 3);
+        if (kind == VXL_PROG_RAYCAST) /* issue 19: the mode, the MatCap and the cutaways */
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define MODE %u\n%s%s%s",
+                     (flags >> VXL_FLAG_MODE_SHIFT) & 7, (flags & VXL_FLAG_MATCAP) ? "#define MATCAP 1\n" : "",
+                     (flags & VXL_FLAG_CUT_CONVEX) ? "#define CUT_CONVEX 1\n" : "",
+                     (flags & VXL_FLAG_CUT_CUTTERS) ? "#define CUT_CUTTERS 1\n" : "");
         rc = compile(g, GL_VERTEX_SHADER, kind == VXL_PROG_SLICES ? "render/slices.vert" : "render/raycast.vert", NULL, &a);
         if (rc) return rc;
         rc = compile(g, GL_FRAGMENT_SHADER, kind == VXL_PROG_SLICES ? "render/slices.frag" : "render/raycast.frag", defines, &b);

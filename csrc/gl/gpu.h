@@ -38,6 +38,11 @@
 /* Program flags the storage sets on shaders that sample the volume. */
 #define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
 #define VXL_FLAG_COMPRESSED_DOMAIN 128u /* with PAGED: the pool holds codes, every tap decodes its 8 neighbours */
+/* Ray caster program flags of issue 19 (gl_util.c turns them into defines). */
+#define VXL_FLAG_MODE_SHIFT 10u        /* bits 10-12: VXL_MODE_* (MODE) */
+#define VXL_FLAG_MATCAP (1u << 13)     /* MATCAP: shading reads the MatCap */
+#define VXL_FLAG_CUT_CONVEX (1u << 14) /* CUT_CONVEX: clip planes and the crop box narrow the ray */
+#define VXL_FLAG_CUT_CUTTERS (1u << 15) /* CUT_CUTTERS: cutter meshes remove depth intervals */
 
 typedef struct vxl_program_entry {
     uint32_t key;

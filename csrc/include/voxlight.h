@@ -338,8 +338,107 @@ VXL_API int vxl_shading_model_from_name(const char *name, uint32_t *out);
 VXL_API const char *vxl_technique_name(uint32_t technique); /* "raycast", "slices2d", "slices3d" */
 VXL_API int vxl_technique_from_name(const char *name, uint32_t *out);
 
-/* 9 words of room: the struct then ends on its 8-byte alignment, with no padding. */
-#define VXL_RENDER_PARAMS_RESERVED 9
+/* Render modes (issue 19), params.mode. The projections classify the value
+ * they project: colour = the transfer function's colour at it (after the
+ * window), opacity = its opacity (times opacity_scale, clamped to 1) as one
+ * opaque-or-not layer, not per voxel of path; depth = where the projected
+ * sample lies (MIP, MinIP), where the ray enters the kept volume (AVERAGE).
+ *   DVR      emission-absorption ray casting (today's)
+ *   MIP      the largest value along the ray inside the kept volume
+ *   MINIP    the smallest
+ *   AVERAGE  the mean of the samples
+ *   ISO      the first crossing of iso_value (data units) along the ray,
+ *            refined below the step by bisection on the filter's
+ *            reconstruction, shaded as a surface (the material, lights,
+ *            shading model or MatCap) with the transfer function's colour at
+ *            iso_value, opacity 1; depth = the exact hit. */
+#define VXL_MODE_DVR 0
+#define VXL_MODE_MIP 1
+#define VXL_MODE_MINIP 2
+#define VXL_MODE_AVERAGE 3
+#define VXL_MODE_ISO 4
+#define VXL_MODE_COUNT 5
+VXL_API const char *vxl_mode_name(uint32_t mode); /* "dvr", "mip", "minip", "average", "iso" */
+VXL_API int vxl_mode_from_name(const char *name, uint32_t *out);
+
+/* Cutaways (issue 19), params.cutaway. A sample is kept when it is inside
+ * every clip plane's kept region, inside the crop box (when there is one)
+ * and not removed by any cutter; the ray caster, every mode, skipping and
+ * early termination see only kept samples. */
+#define VXL_MAX_CLIP_PLANES 6
+#define VXL_MAX_CUTTERS 4
+
+typedef struct vxl_clip_plane {
+    float plane[4];   /* world space a, b, c, d: keeps a x + b y + c z + d >= 0 ((a, b, c) need
+                         not be unit length; it must not be zero) */
+    float thickness;  /* 0: the half-space; > 0: only the slab of that thickness (world units)
+                         on the kept side, 0 <= signed distance <= thickness */
+    uint32_t reserved; /* must be 0 */
+} vxl_clip_plane;
+
+/* A closed triangle mesh that removes its inside (or, with remove_outside,
+ * everything but its inside). Depth-peeled from the camera each frame: the
+ * ray skips the removed depth intervals. The array's stride is
+ * cutters[0].struct_size. */
+typedef struct vxl_cutter {
+    uint32_t struct_size;
+    uint32_t remove_outside;   /* 0: remove the inside; 1: keep only the inside */
+    const float *vertices;     /* world xyz, 3 floats per vertex */
+    const uint32_t *indices;   /* 3 per triangle, < vertex_count */
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+} vxl_cutter;
+
+typedef struct vxl_cutaway {
+    uint32_t struct_size;
+    uint32_t clip_plane_count;  /* <= VXL_MAX_CLIP_PLANES */
+    vxl_clip_plane clip_planes[VXL_MAX_CLIP_PLANES];
+    uint32_t has_crop;          /* 1: keep only the inside of the crop box */
+    float crop_box[16];         /* box -> world, column-major: the box is the cube [-1, 1]^3 of this
+                                   (non-singular) matrix, e.g. a Blender cube Empty's matrix_world
+                                   times its display size */
+    uint32_t cutter_count;      /* <= VXL_MAX_CUTTERS */
+    const vxl_cutter *cutters;
+    uint32_t caps_off;          /* 0: caps on: the first kept sample behind a cut surface is
+                                   shaded with the cut's normal (facing the eye) instead of the
+                                   data gradient; 1: the data gradient everywhere */
+    uint32_t reserved;          /* must be 0 */
+} vxl_cutaway;
+
+/* A MatCap (issue 19), params.matcap: a picture of a lit sphere that fills
+ * the image. With one, the shaded colour of a sample (DVR with shading on,
+ * ISO) is its classified colour times the MatCap's colour at the view-space
+ * normal: texel (0.5 + 0.5 n.x, 0.5 + 0.5 n.y) of the image (linear, row 0
+ * = bottom), instead of the material and lights. */
+typedef struct vxl_matcap {
+    uint32_t struct_size;
+    uint32_t width, height;     /* >= 1 each, <= 4096 */
+    uint32_t reserved;          /* must be 0 */
+    const float *rgba;          /* width*height*4 floats (alpha unused) */
+    uint64_t key;               /* nonzero: the caller's name for this image, so the same key is
+                                   not uploaded again; 0: the library hashes the pixels */
+} vxl_matcap;
+
+/* Scene shadows (issue 18), params.scene_shadows: the scene's opaque meshes
+ * as occluders between the lights and the volume. For each light the
+ * library rasterises them as seen from the light into a shadow map and
+ * multiplies the light's transmittance T_i (see the shading models) by the
+ * map's visibility, so meshes shadow the volume in the SHADOWED and SCATTER
+ * models (PHONG has no T_i). Shadow maps are rebuilt only when the
+ * occluders (their key), a light or the volume's placement change. */
+typedef struct vxl_scene_shadows {
+    uint32_t struct_size;
+    uint32_t occluder_vertex_count;
+    const float *occluder_vertices;  /* world xyz, 3 floats per vertex */
+    const uint32_t *occluder_indices; /* 3 per triangle, < occluder_vertex_count */
+    uint32_t occluder_triangle_count;
+    uint32_t shadow_map_size;        /* texels per side; 0 = 1024 */
+    uint64_t occluder_key;           /* nonzero: the caller's version of the occluders (same key =
+                                        unchanged, no rebuild); 0: the library hashes them */
+} vxl_scene_shadows;
+
+/* 2 words of room: the struct then ends on its 8-byte alignment, with no padding. */
+#define VXL_RENDER_PARAMS_RESERVED 2
 
 typedef struct vxl_render_params {
     uint32_t struct_size;
@@ -395,7 +494,7 @@ typedef struct vxl_render_params {
     uint32_t gradient_opacity;
     float gradient_ref;              /* normalised value per voxel; 0 = 0.05 */
     float gradient_exp;              /* 0 = 1 */
-    float iso_value;                 /* data units (ISO) */
+    float iso_value;                 /* data units (gradient_opacity ISO, mode ISO) */
     float iso_thickness;             /* voxels; 0 = 1 (ISO) */
     /* lighting (issue 17): see VXL_SHADING_* */
     uint32_t shading_model;          /* VXL_SHADING_* */
@@ -406,6 +505,12 @@ typedef struct vxl_render_params {
     uint32_t illumination_size;      /* cells along the illumination volumes' longest side; 0 = automatic */
     /* technique (issue 16): VXL_TECHNIQUE_* */
     uint32_t technique;
+    /* issue 19: VXL_MODE_* (ISO reads iso_value) */
+    uint32_t mode;
+    const vxl_cutaway *cutaway;      /* NULL: nothing cut away */
+    /* issue 18: NULL: no scene meshes shadow the volume */
+    const vxl_scene_shadows *scene_shadows;
+    const vxl_matcap *matcap;        /* issue 19: NULL: the material and lights */
     /* Room for the next features (fields taken from here keep the struct's
      * size and offsets). Must be zero: vxl_render fails with
      * VXL_ERR_INVALID_ARGUMENT naming the word otherwise. */
@@ -461,6 +566,43 @@ typedef struct vxl_render_stats {
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);
+
+/* Scene shadows (issue 18): for every pixel of p->scene_depth (required;
+ * seen through p's camera), the transmittance through the volume from that
+ * scene point to light `light` (an index into p->lights; with light_count 0
+ * the headlight), from the same illumination volume the SHADOWED model
+ * reads (built for this light when the frame has none), and cut by
+ * p->scene_shadows' occluders as the volume's own shadows are. 1 where the
+ * path to the light misses the volume or the depth is +inf. out:
+ * width*height floats, row 0 = bottom. A compositor multiplies the light's
+ * direct contribution by it. */
+VXL_API int vxl_scene_transmittance(vxl_renderer *r, const vxl_render_params *p, uint32_t light,
+                                    float *out);
+
+/* Slice planes (issue 19): the volume resampled on a plane. */
+#define VXL_INTERP_NEAREST 0
+#define VXL_INTERP_LINEAR 1
+#define VXL_INTERP_CUBIC 2   /* the interpolating cubic B-spline (as VXL_FILTER_CUBIC) */
+#define VXL_INTERP_COUNT 3
+VXL_API const char *vxl_interpolation_name(uint32_t interp); /* "nearest", "linear", "cubic" */
+VXL_API int vxl_interpolation_from_name(const char *name, uint32_t *out);
+
+typedef struct vxl_slice_params {
+    uint32_t struct_size;
+    uint32_t interpolation;      /* VXL_INTERP_* */
+    float plane_to_world[16];    /* column-major: the slice is the square [-1, 1]^2 at z = 0 of this
+                                    matrix (a Blender plane's matrix_world); pixel (x, y) of the output
+                                    lies at ((x + 0.5) / width * 2 - 1, (y + 0.5) / height * 2 - 1, 0) */
+} vxl_slice_params;
+
+/* Resamples the volume on the slice: p gives the output size (width,
+ * height), the volume's placement (has_model / model), the window and the
+ * colour map (preset or tf_rgba); its camera, shading and mode are not
+ * used. rgba (width*height*4 floats, premultiplied): the transfer
+ * function's colour at the value with alpha 1 inside the volume's box, 0
+ * outside it. */
+VXL_API int vxl_render_slice(vxl_renderer *r, const vxl_render_params *p, const vxl_slice_params *s,
+                             float *rgba);
 
 /* The camera vxl_render uses when has_camera is 0, for callers that want to
  * start from it. */

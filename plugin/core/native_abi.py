@@ -26,12 +26,18 @@ STORAGES = ("auto", "dense", "bricked", "sparse", "compressed")  # VXL_STORAGE_*
 CLASSIFY_MODES = ("post", "pre", "preint")  # VXL_CLASSIFY_*
 GRADIENT_OPACITY_MODES = ("off", "boundary", "iso")  # VXL_GOPACITY_*
 SHADING_MODELS = ("phong", "shadowed", "scatter")  # VXL_SHADING_*
+MODES = ("dvr", "mip", "minip", "average", "iso")  # VXL_MODE_*
+INTERPOLATIONS = ("nearest", "linear", "cubic")  # VXL_INTERP_*
 # The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
 ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "storage": STORAGES,
                   "classify": CLASSIFY_MODES, "gradient_opacity": GRADIENT_OPACITY_MODES,
-                  "gradient_store": ("8bit", "16f", "32f"), "shading_model": SHADING_MODELS}
+                  "gradient_store": ("8bit", "16f", "32f"), "shading_model": SHADING_MODELS,
+                  "technique": ("raycast", "slices2d", "slices3d"), "mode": MODES,
+                  "interpolation": INTERPOLATIONS}
 MAX_LIGHTS = 8
-RENDER_PARAMS_RESERVED = 9  # VXL_RENDER_PARAMS_RESERVED
+RENDER_PARAMS_RESERVED = 2  # VXL_RENDER_PARAMS_RESERVED
+MAX_CLIP_PLANES = 6  # VXL_MAX_CLIP_PLANES
+MAX_CUTTERS = 4  # VXL_MAX_CUTTERS
 
 _DTYPES = {
     np.dtype(np.uint8): 1, np.dtype(np.int8): 2,
@@ -143,6 +149,58 @@ class LightShape(ctypes.Structure):
                 ("size", ctypes.c_float)]
 
 
+class ClipPlane(ctypes.Structure):
+    _fields_ = [("plane", ctypes.c_float * 4),
+                ("thickness", ctypes.c_float),
+                ("reserved", ctypes.c_uint32)]
+
+
+class Cutter(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("remove_outside", ctypes.c_uint32),
+                ("vertices", ctypes.POINTER(ctypes.c_float)),
+                ("indices", ctypes.POINTER(ctypes.c_uint32)),
+                ("vertex_count", ctypes.c_uint32),
+                ("triangle_count", ctypes.c_uint32)]
+
+
+class Cutaway(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("clip_plane_count", ctypes.c_uint32),
+                ("clip_planes", ClipPlane * MAX_CLIP_PLANES),
+                ("has_crop", ctypes.c_uint32),
+                ("crop_box", c_float4x4),
+                ("cutter_count", ctypes.c_uint32),
+                ("cutters", ctypes.POINTER(Cutter)),
+                ("caps_off", ctypes.c_uint32),
+                ("reserved", ctypes.c_uint32)]
+
+
+class Matcap(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("width", ctypes.c_uint32),
+                ("height", ctypes.c_uint32),
+                ("reserved", ctypes.c_uint32),
+                ("rgba", ctypes.POINTER(ctypes.c_float)),
+                ("key", ctypes.c_uint64)]
+
+
+class SceneShadows(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("occluder_vertex_count", ctypes.c_uint32),
+                ("occluder_vertices", ctypes.POINTER(ctypes.c_float)),
+                ("occluder_indices", ctypes.POINTER(ctypes.c_uint32)),
+                ("occluder_triangle_count", ctypes.c_uint32),
+                ("shadow_map_size", ctypes.c_uint32),
+                ("occluder_key", ctypes.c_uint64)]
+
+
+class SliceParams(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("interpolation", ctypes.c_uint32),
+                ("plane_to_world", c_float4x4)]
+
+
 class RenderParams(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("width", ctypes.c_uint32),
@@ -194,6 +252,10 @@ class RenderParams(ctypes.Structure):
                 ("anisotropy", ctypes.c_float),
                 ("illumination_size", ctypes.c_uint32),
                 ("technique", ctypes.c_uint32),
+                ("mode", ctypes.c_uint32),
+                ("cutaway", ctypes.POINTER(Cutaway)),
+                ("scene_shadows", ctypes.POINTER(SceneShadows)),
+                ("matcap", ctypes.POINTER(Matcap)),
                 ("reserved", ctypes.c_uint32 * RENDER_PARAMS_RESERVED)]  # must stay 0
 
 

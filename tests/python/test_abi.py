@@ -31,6 +31,12 @@ BINDINGS = {
     "vxl_light": native.Light,
     "vxl_light_shape": native.LightShape,
     "vxl_render_params": native.RenderParams,
+    "vxl_clip_plane": native.ClipPlane,
+    "vxl_cutter": native.Cutter,
+    "vxl_cutaway": native.Cutaway,
+    "vxl_matcap": native.Matcap,
+    "vxl_scene_shadows": native.SceneShadows,
+    "vxl_slice_params": native.SliceParams,
     "vxl_render_stats": native.RenderStats,
     "vxl_phantom_desc": native.PhantomDesc,
 }

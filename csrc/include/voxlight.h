@@ -237,6 +237,27 @@ typedef struct vxl_dicom_series {
  * max 0 to count. */
 VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint32_t max, uint32_t *count);
 
+/* ------------------------------------------------------- label tables */
+
+/* One entry of a label lookup table (issue 20): what a label id of a
+ * segmentation is called and how it looks. */
+typedef struct vxl_label_entry {
+    uint32_t struct_size;
+    int32_t id;                 /* the label's value in the label volume */
+    float color[4];             /* straight RGBA in [0, 1]; alpha 1 unless the file gives one */
+    uint32_t visible;           /* 1 unless the file hides it (ITK-SNAP's VIS column) */
+    char name[64];              /* UTF-8, NUL-terminated, cut to fit; "" when the file names none */
+} vxl_label_entry;
+
+/* Reads a label lookup table: FreeSurfer's LUT.txt, ITK-SNAP label
+ * descriptions, 3D Slicer colour tables (.ctbl), and MRIcron's .lut
+ * (binary 256-entry palette; the names come from the .txt of the same
+ * stem beside it when there is one). The format is detected from the
+ * content. Entries are sorted by id, ids unique. Up to max entries go to
+ * out (stride out[0].struct_size, 0 = sizeof); *count receives how many
+ * the file has. out may be NULL with max 0 to count. */
+VXL_API int vxl_label_table_load(const char *path, vxl_label_entry *out, uint32_t max, uint32_t *count);
+
 /* -------------------------------------------------------------- renderer */
 
 typedef struct vxl_renderer_options {

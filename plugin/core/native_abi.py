@@ -149,6 +149,14 @@ class LightShape(ctypes.Structure):
                 ("size", ctypes.c_float)]
 
 
+class LabelEntry(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("id", ctypes.c_int32),
+                ("color", ctypes.c_float * 4),
+                ("visible", ctypes.c_uint32),
+                ("name", ctypes.c_char * 64)]
+
+
 class ClipPlane(ctypes.Structure):
     _fields_ = [("plane", ctypes.c_float * 4),
                 ("thickness", ctypes.c_float),

@@ -32,6 +32,7 @@ BINDINGS = {
     "vxl_light_shape": native.LightShape,
     "vxl_render_params": native.RenderParams,
     "vxl_clip_plane": native.ClipPlane,
+    "vxl_label_entry": native.LabelEntry,
     "vxl_cutter": native.Cutter,
     "vxl_cutaway": native.Cutaway,
     "vxl_matcap": native.Matcap,

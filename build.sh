@@ -9,7 +9,8 @@ ROOT=$(pwd)
 
 # Debian packages the project needs: compilers, GL headers (we never link GL),
 # Mesa's EGL and OSMesa for the offscreen context, OpenImageIO for image files,
-# dcmtk for DICOM series,
+# dcmtk for DICOM series, libzstd and libblosc for OME-Zarr chunks (the helper
+# voxlight-read-zarr; tests/zarr_write.py also compresses through them),
 # the demo brain (mricron-data), Blender and Xvfb for the add-on and its tests,
 # numpy and pytest for the Python tests, clang with its sanitizer/libFuzzer
 # runtime for the loader fuzz targets (tests/fuzz/) and llvm for llvm-symbolizer
@@ -24,7 +25,7 @@ ROOT=$(pwd)
 # library (and every test) renders through Mesa's surfaceless EGL. "clang-rt"
 # stands for the sanitizer/libFuzzer runtime of clang's major version.
 NEEDS=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
-       libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev mricron-data blender
+       libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev libzstd-dev libblosc-dev mricron-data blender
        xvfb xauth python3 python3-numpy python3-pytest zip unzip clang clang-rt llvm
        python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv")
 
@@ -284,7 +285,7 @@ case "$cmd" in
         [ "$TOTAL_FAIL" -eq 0 ] ;;
     fuzz)
         # ./build.sh fuzz [SECONDS [TARGET...]]: each loader's libFuzzer target
-        # (nifti nrrd metaimage tiff png dicom vdb) for SECONDS (default 300);
+        # (nifti nrrd metaimage tiff png dicom vdb label_table zarr) for SECONDS (default 300);
         # crashes are kept in tests/crashers/<target>/. SECONDS "replay":
         # replay tests/crashers/ only
         install_deps; build
@@ -310,6 +311,9 @@ case "$cmd" in
         # Issue 17: shadows, occlusion and scattering (docs/lighting.md pastes bench/out/lighting_tables.md).
         light_csv=$([ "$mode" = --quick ] && echo bench/out/lighting.csv || echo bench/lighting.csv)
         ./build/voxlight-lightbench $([ "$mode" = --quick ] && echo --quick) --out "$light_csv"
+        # Issue 18: scene shadows on against off (docs/scene_shadows.md).
+        ./build/voxlight-sceneshadowbench $([ "$mode" = --quick ] && echo --quick || echo --frames 9) \
+            --out "$([ "$mode" = --quick ] && echo bench/out/scene_shadows.csv || echo bench/scene_shadows.csv)"
         /usr/bin/python3 bench/plot_lighting.py "$light_csv" \
             --png "$([ "$mode" = --quick ] && echo bench/out/lighting.png || echo docs/lighting.png)" \
             --md bench/out/lighting_tables.md --command "./build.sh bench $mode"
@@ -322,8 +326,14 @@ case "$cmd" in
             --size "$([ "$mode" = --quick ] && echo 64 || echo 512)" --frames "$([ "$mode" = --quick ] && echo 3 || echo 5)" \
             --out "$cmp_csv" --md bench/out/vtk_compare.md --command "./build.sh bench $mode"
         if [ "$mode" = --quick ]; then dest=bench/out/benchmark; else dest=docs/benchmark; fi
+        # Issue 19: the render modes' run time against error (docs/modes.md).
+        ./build/voxlight-modesbench $([ "$mode" = --quick ] && echo --quick) \
+            --out "$([ "$mode" = --quick ] && echo bench/out/modes.csv || echo bench/modes.csv)" --md bench/out/modes.md
         /usr/bin/python3 bench/plot.py bench/results.csv --png "$dest.png" --md "$dest.md" --command "./build.sh bench $mode"
-        { echo; cat bench/out/vtk_compare.md; } >> "$dest.md" ;;
+        { echo; cat bench/out/vtk_compare.md; } >> "$dest.md"
+        { echo; echo "## Render modes: run time against error (issue 19)"; echo;
+          echo "\`build/voxlight-modesbench\` (bench/modes_study.c, docs/modes.md), from \`./build.sh bench $mode\`:";
+          echo; cat bench/out/modes.md; } >> "$dest.md" ;;
     bpy)
         bpy_venvs ;;
     clean)

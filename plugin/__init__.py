@@ -43,14 +43,16 @@ if UNSUPPORTED is None:
     # loads the library.
     native.CACHE_DIR = compat.private_data_dir(__package__)
     from . import (api, compositor, importer, offline, operators, panels, params,  # noqa: E402
-                   preferences, properties, render_hooks, tf, viewport, volume_object)
+                   preferences, properties, render_hooks, scene_shadows, tf, viewport,
+                   volume_object)
+    from . import cutaway_ui, slice_planes  # noqa: E402  (issue 19)
     from .core import (depth, import_job, lights, native, runtime, scene_geometry,  # noqa: E402,F401
                        volume_space, zbuffer)
     from .api import render_volume  # noqa: E402,F401
 
     # Registration order: properties before the UI that shows them; handlers last.
     _modules = (preferences, properties, tf, operators, importer, volume_object, panels,
-                render_hooks, viewport)
+                slice_planes, cutaway_ui, render_hooks, scene_shadows, viewport)
 else:
     _modules = ()
 

@@ -11,6 +11,8 @@ Differences handled here:
     inputs were Fac, Image (background), Image (foreground) with
     use_premultiply/premul properties ("Straight Alpha" exists as a socket
     from 4.5 as well);
+  * 5.0 removed the compositor's Mix node (CompositorNodeMixRGB): the
+    shared Mix node (ShaderNodeMix, colour mode) takes its place;
   * 4.2 made add-ons extensions: the package is then bl_ext.<repo>.voxlight,
     so code uses __package__, never a hard-coded module name; an extension
     keeps its files in its own user folder (private_data_dir).
@@ -110,6 +112,38 @@ def alpha_over_premultiplied(node):
     if hasattr(node, "use_premultiply"):  # up to 4.5
         node.use_premultiply = False
         node.premul = 0.0
+
+
+def mix_color_node(tree, blend_type):
+    """A compositor node mixing two colours with `blend_type` (MULTIPLY,
+    ADD, SUBTRACT, ...) at factor 1, unclamped: the Mix node up to 4.5
+    (CompositorNodeMixRGB), the shared Mix node in colour mode from 5.0,
+    which removed the compositor's own."""
+    if hasattr(_bpy().types, "CompositorNodeMixRGB"):
+        node = tree.nodes.new("CompositorNodeMixRGB")
+        node.use_clamp = False
+        node.inputs[0].default_value = 1.0
+    else:
+        node = tree.nodes.new("ShaderNodeMix")
+        node.data_type = "RGBA"
+        node.clamp_result = False
+        node.clamp_factor = True
+        _socket(node.inputs, "Factor_Float").default_value = 1.0
+    node.blend_type = blend_type
+    return node
+
+
+def _socket(sockets, identifier):
+    return next(s for s in sockets if s.identifier == identifier)
+
+
+def mix_sockets(node):
+    """(first colour input, second colour input, output) of a node made by
+    mix_color_node."""
+    if node.bl_idname == "ShaderNodeMix":
+        return (_socket(node.inputs, "A_Color"), _socket(node.inputs, "B_Color"),
+                _socket(node.outputs, "Result_Color"))
+    return node.inputs[1], node.inputs[2], node.outputs[0]
 
 
 def wrap(text, width):

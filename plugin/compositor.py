@@ -29,6 +29,7 @@ import bpy
 import numpy as np
 
 from . import compat
+from .core import shadow_plan
 
 IMAGE_NAME = "Voxlight Render"
 NODE_IMAGE = "Voxlight Volume"
@@ -85,13 +86,11 @@ def _route_through(tree, over):
     """Every link leaving the Render Layers node that feeds the Alpha Over's
     background (other than that one) is moved to leave the Alpha Over."""
     background, _foreground = compat.alpha_over_sockets(over)
-    if not background.is_linked:
-        return
-    src = background.links[0].from_socket
-    if src.node.bl_idname != "CompositorNodeRLayers":
+    src = _chain_origin(background)
+    if src is None or src.node.bl_idname != "CompositorNodeRLayers":
         return  # the user fed the background from elsewhere: theirs to keep
     for link in list(src.links):
-        if link.to_node == over:
+        if link.to_node == over or _is_shadow_node(link.to_node):
             continue
         to = link.to_socket
         tree.links.remove(link)
@@ -133,6 +132,7 @@ def remove_nodes(scene):
     tree = compat.compositor_tree(scene, create=False)
     if tree is None:
         return
+    remove_shadow_chain(scene)
     over = tree.nodes.get(NODE_OVER)
     if over is not None:
         background, _foreground = compat.alpha_over_sockets(over)
@@ -196,3 +196,122 @@ def mute(scene):
         over = tree.nodes.get(NODE_OVER)
         if over is not None:
             over.mute = True
+
+
+# ------------------------------------------------- the volume's shadows
+# Issue 18: between Render Layers' Image and the Alpha Over's background, a
+# chain of nodes (planned by core/shadow_plan.py) multiplies each light
+# group's light, or the direct light, by the volume's transmittance:
+#
+#   Render Layers [Image] --> Voxlight Shadow ... Out --> Alpha Over [bg]
+#   Render Layers [Combined_<g>] x Image "Voxlight Shadow <g>" -----^
+#
+# The volume is then laid over the shadowed render, so it never shadows
+# itself. Every node of the chain is named shadow_plan.NODE_PREFIX ...
+
+def _is_shadow_node(node):
+    return node.name.startswith(shadow_plan.NODE_PREFIX)
+
+
+def _chain_origin(socket_in):
+    """The output socket that feeds `socket_in`, looking through the shadow
+    chain (its first colour input, the running result): what the chain is
+    applied to. None when nothing feeds it."""
+    seen = 0
+    while socket_in.is_linked and seen < 1000:
+        src = socket_in.links[0].from_socket
+        if not _is_shadow_node(src.node) or src.node.type == "IMAGE":
+            return src
+        socket_in = compat.mix_sockets(src.node)[0]
+        seen += 1
+    return None
+
+
+def _pass_socket(rl, source):
+    """The Render Layers output of a plan source ("pass", key): a light
+    group's Combined_<g>, or a pass by its names in each version."""
+    names = shadow_plan.PASS_SOCKETS.get(source[1], (source[1],))
+    for name in names:
+        out = rl.outputs.get(name)
+        if out is not None and out.enabled:
+            return out
+    return None
+
+
+def ensure_shadow_chain(scene, nodes):
+    """Build the chain of plan `nodes` (shadow_plan.node_plan) between what
+    feeds the Alpha Over's background (Render Layers' Image) and it,
+    replacing an older chain. Returns "" when built, else why not (the
+    chain is then gone and the render untouched)."""
+    tree = compat.compositor_tree(scene)
+    remove_shadow_chain(scene)
+    over = tree.nodes.get(NODE_OVER)
+    if over is None or not nodes:
+        return "no Voxlight nodes in the compositor" if over is None else ""
+    background, _foreground = compat.alpha_over_sockets(over)
+    origin = _chain_origin(background)
+    if origin is None or origin.node.bl_idname != "CompositorNodeRLayers":
+        return "the Alpha Over's background is not fed by Render Layers"
+    rl = origin.node
+    # Light groups and passes just added reach the node's outputs only when
+    # it is updated (4.x, 5.x): setting its view layer again does that.
+    view_layer = scene.view_layers.get(rl.layer)
+    if view_layer is not None:
+        view_layer.update_render_passes()
+    rl.layer = rl.layer
+    built = {}
+    for spec in nodes:
+        if spec.kind == "image":
+            img = bpy.data.images.get(spec.inputs[0])
+            node = tree.nodes.new("CompositorNodeImage")
+            node.image = img
+        else:
+            node = compat.mix_color_node(tree, spec.kind)
+        node.name = node.label = spec.name
+        node.location = (rl.location.x + spec.location[0], rl.location.y + spec.location[1])
+        built[spec.name] = node
+        if spec.kind == "image":
+            continue
+        for sock, source in zip(compat.mix_sockets(node)[:2], spec.inputs):
+            if source[0] == "origin":
+                out = origin
+            elif source[0] == "pass":
+                out = _pass_socket(rl, source)
+            else:
+                out = built[source[1]].outputs[0] if built[source[1]].type == "IMAGE" \
+                    else compat.mix_sockets(built[source[1]])[2]
+            if out is None:
+                remove_shadow_chain(scene)
+                return "Render Layers has no %s output" % source[1]
+            tree.links.new(out, sock)
+    tree.links.new(compat.mix_sockets(built[shadow_plan.NODE_OUT])[2], background)
+    return ""
+
+
+def remove_shadow_chain(scene):
+    """Take the shadow chain out, giving what it fed back to its origin."""
+    tree = compat.compositor_tree(scene, create=False)
+    if tree is None:
+        return
+    out = tree.nodes.get(shadow_plan.NODE_OUT)
+    if out is not None:
+        origin = _chain_origin(compat.mix_sockets(out)[0])
+        targets = [link.to_socket for link in compat.mix_sockets(out)[2].links]
+    for node in [n for n in tree.nodes if _is_shadow_node(n)]:
+        tree.nodes.remove(node)
+    if out is not None and origin is not None:
+        for to in targets:
+            tree.links.new(origin, to)
+
+
+def write_shadow_image(name, width, height, shadow):
+    """Image `name` (grey, data) holding `shadow` = 1 - transmittance,
+    (height, width) float32 row 0 = bottom, or 0 everywhere when None."""
+    img = ensure_image(width, height, name)
+    img.alpha_mode = "STRAIGHT"
+    img.colorspace_settings.is_data = True
+    s = np.zeros((height, width), np.float32) if shadow is None else np.asarray(shadow, np.float32)
+    one = np.ones_like(s)
+    img.pixels.foreach_set(np.ascontiguousarray(np.stack([s, s, s, one], -1), np.float32).ravel())
+    img.update()
+    return img

@@ -7,7 +7,7 @@ the scene's meshes in numpy (zbuffer.py) and passing that as scene_depth.
 import bpy
 import numpy as np
 
-from . import params
+from . import params, scene_shadows
 from .core import native, runtime, scene_geometry, volume_space, zbuffer
 
 
@@ -68,14 +68,22 @@ def composite_layers(layers):
 
 
 def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
-           for_render=True, backend="auto"):
+           for_render=True, backend="auto", frame_info=None):
     """Premultiplied RGBA (height, width, 4) and depth of the scene's
     volumes (or of the objects in `only`). camera None = the library's
-    default camera framing the volume. Returns None when there is nothing."""
+    default camera framing the volume. Returns None when there is nothing.
+    frame_info (a dict, F12's scene shadows): filled with the scene's
+    z-buffer ("depth"), its lights with their names ("named_lights") and,
+    per volume that casts shadows (in the frame or not), its entry and
+    make_params keyword arguments ("casters")."""
     vols = volume_instances(depsgraph, only, for_render)
     if not vols:
         return None
     view = proj = None
+    named = scene_shadows.named_lights(depsgraph, for_render) \
+        if scene.voxlight.use_scene_lights else []
+    lights = [l for _n, _g, l in named]
+    casters = [(ob, mw) for ob, mw in vols if ob.voxlight.cast_shadows]
     if camera is not None:
         view, proj = camera_matrices(camera, depsgraph, width, height, scene)
         # Volumes outside the camera's frustum cost nothing: no library call
@@ -83,22 +91,37 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
         vols = [(ob, mw) for ob, mw in vols if not volume_space.outside_frustum(
             mw @ np.array(ob.voxlight.voxel_to_local, np.float64).reshape(4, 4).T,
             tuple(ob.voxlight.dims), view, proj)]
-        if not vols:
-            return (np.zeros((height, width, 4), np.float32),
-                    np.full((height, width), np.inf, np.float32))
+    # A volume outside the frame may still shadow what is in it.
+    want_shadows = bool(frame_info is not None and camera is not None and casters and lights)
     zbuf = None
-    if occlusion and camera is not None:
+    if camera is not None and (occlusion and vols or want_shadows):
         zbuf = zbuffer.rasterize(scene_geometry.triangles(depsgraph, for_render),
                                  view, proj, width, height)
-    lights = params.scene_lights(scene, depsgraph, for_render)
-    layers = []
-    for ob, mw in vols:
-        opts = dict(runtime.options_of(scene.voxlight), backend=backend)
+    opts = dict(runtime.options_of(scene.voxlight), backend=backend)
+
+    def volume_kwargs(ob, mw):
         entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
                                   scene.frame_current, **opts)
         v2l = np.array(ob.voxlight.voxel_to_local, np.float64).reshape(4, 4).T
-        p = native.make_params(width=width, height=height, view=view, proj=proj,
-                               model=mw @ v2l, scene_depth=zbuf, lights=lights,
-                               **params.look_kwargs(ob.voxlight))
+        return entry, dict(view=view, proj=proj, model=mw @ v2l, lights=lights,
+                           **params.look_kwargs(ob.voxlight))
+
+    if frame_info is not None:
+        frame_info.update(depth=zbuf, named_lights=named if want_shadows else [],
+                          casters=[volume_kwargs(ob, mw) for ob, mw in casters]
+                          if want_shadows else [])
+    if not vols:
+        return (np.zeros((height, width, 4), np.float32),
+                np.full((height, width), np.inf, np.float32))
+    shadows = None
+    if any(scene_shadows.receives(ob.voxlight) for ob, _mw in vols):
+        shadows = scene_shadows.occluders(depsgraph, for_render)
+    layers = []
+    for ob, mw in vols:
+        entry, kw = volume_kwargs(ob, mw)
+        if shadows is not None and scene_shadows.receives(ob.voxlight):
+            kw["scene_shadows"] = shadows
+        p = native.make_params(width=width, height=height,
+                               scene_depth=zbuf if occlusion else None, **kw)
         layers.append(runtime.render(entry, p))
     return composite_layers(layers)

@@ -182,6 +182,12 @@ class VOXLIGHT_PT_volume_lighting(_VolumePanel, bpy.types.Panel):
         sub = layout.column()
         sub.active = p.shading_model == "scatter"
         sub.prop(p, "anisotropy", slider=True)
+        # Scene shadows (issue 18): the volume and the scene's meshes.
+        col = layout.column(heading="Scene", align=True)
+        col.prop(p, "cast_shadows")
+        sub = col.column(align=True)
+        sub.active = p.shading_model != "phong"  # Phong has no shadows to cut
+        sub.prop(p, "receive_shadows")
 
 
 class VOXLIGHT_PT_volume_advanced(_VolumePanel, bpy.types.Panel):
@@ -302,6 +308,10 @@ class VOXLIGHT_PT_scene(bpy.types.Panel):
         col.prop(s, "render_enabled", text="Composite")
         col.prop(s, "render_occlusion", text="Mesh Occlusion")
         col.prop(s, "render_separate_layer", text="Separate Layer")
+        from . import compat, scene_shadows
+        if scene_shadows.note:  # how the last render applied the volume's shadows (issue 18)
+            for i, line in enumerate(compat.wrap(scene_shadows.note, 40)):
+                col.label(text=line, icon="INFO" if i == 0 else "BLANK1")
         layout.prop(s, "use_scene_lights")
         layout.prop(s, "backend")
         layout.prop(s, "storage")

@@ -7,6 +7,7 @@ import numpy as np
 from .core import lighting
 from .core import lights as _lights
 from .core import native
+from . import cutaway
 from . import tf as _tf
 
 
@@ -52,6 +53,7 @@ def look_kwargs(props, fast=False, dragging=False):
         iso_value=props.iso_value,
         iso_thickness=props.iso_thickness,
         **lighting.look_kwargs(props, dragging),
+        **cutaway.look_kwargs(props),  # issue 19: mode, MatCap, cutaway
     )
 
 
@@ -86,8 +88,13 @@ def while_lights_move(lights, now, settle_time):
     return out, left
 
 
-def build(obj, width, height, view, proj, scene_depth=None, lights=(), fast=False, lib=None):
+def build(obj, width, height, view, proj, scene_depth=None, lights=(), fast=False, lib=None,
+          scene_shadows=None):
+    """scene_shadows: the occluders (vertices, triangles, key) that shadow
+    the volume (issue 18), or None."""
     kw = look_kwargs(obj.voxlight, fast, dragging=getattr(lights, "dragged", False))
+    if scene_shadows is not None:
+        kw["scene_shadows"] = scene_shadows
     return native.make_params(width=width, height=height, view=view, proj=proj,
                               model=model_matrix(obj), scene_depth=scene_depth,
                               lights=lights, lib=lib, **kw)

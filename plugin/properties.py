@@ -3,10 +3,11 @@
 (Blender's default for PropertyGroup members) and redraws the viewports."""
 
 import bpy
-from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
-                       IntProperty, IntVectorProperty, PointerProperty, StringProperty)
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
+                       FloatVectorProperty, IntProperty, IntVectorProperty, PointerProperty,
+                       StringProperty)
 
-from . import tf
+from . import cutaway_props, tf
 from .core import lighting, native
 
 # UI names of the filters this add-on knows. The list itself comes from the
@@ -110,6 +111,9 @@ SHADING_MODEL_ITEMS = _items(_library_names("shading_model"), _SHADING_MODEL_UI,
                              "Shading model")
 BACKEND_ITEMS = _items(_library_names("backend"), _BACKEND_UI, "Backend")
 STORAGE_ITEMS = _items(_library_names("storage"), _STORAGE_UI, "Storage")
+MODE_ITEMS = _items(_library_names("mode"), cutaway_props.MODE_UI, "Render mode")
+INTERPOLATION_ITEMS = _items(_library_names("interpolation"), cutaway_props.INTERPOLATION_UI,
+                             "Interpolation")
 
 
 def tag_redraw(self=None, context=None):
@@ -303,6 +307,34 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                                  description="Resolution of the volumes that hold each light's "
                                              "shadows: higher is crisper and slower to update "
                                              "when a light moves")
+    # --- scene shadows (issue 18; scene_shadows.py, compositor.py)
+    cast_shadows: BoolProperty(name="Cast Shadows", default=True, update=tag_redraw,
+                               description="The volume darkens the meshes behind it as seen "
+                                           "from each light (F12: each light's direct light; "
+                                           "viewport: a preview)")
+    receive_shadows: BoolProperty(name="Receive Shadows", default=True, update=tag_redraw,
+                                  description="Meshes between a light and the volume shadow it "
+                                              "(meshes whose Shadow visibility is on; Shadowed "
+                                              "and Scatter models)")
+    # --- render mode, MatCap and cutaways (issue 19; cutaway_props.py, cutaway.py)
+    render_mode: EnumProperty(name="Render Mode", items=MODE_ITEMS, default="dvr",
+                              update=tag_redraw,
+                              description="How each ray's samples become a pixel: volume "
+                                          "rendering, a projection, or an iso-surface")
+    matcap: EnumProperty(name="MatCap", items=cutaway_props.matcap_items, update=tag_redraw,
+                         description="Shade surfaces with one of Blender's MatCaps (a picture "
+                                     "of a lit sphere, as in Solid mode) instead of the "
+                                     "material and lights")
+    clip_planes: CollectionProperty(type=cutaway_props.VoxlightClipPlane, name="Clip Planes",
+                                    description="Planes that cut the volume (at most 6)")
+    crop_box: PointerProperty(type=bpy.types.Object, name="Crop Box", update=tag_redraw,
+                              description="A cube Empty: only the volume inside its cube "
+                                          "(its Size, scaled by its transform) is kept")
+    cutters: CollectionProperty(type=cutaway_props.VoxlightCutter, name="Cutters",
+                                description="Closed meshes that cut the volume (at most 4)")
+    caps: BoolProperty(name="Caps", default=True, update=tag_redraw,
+                       description="Shade a cut face with the cut's own direction, so it "
+                                   "looks like a clean cut surface instead of noisy tissue")
 
 
 class VoxlightSceneProperties(bpy.types.PropertyGroup):
@@ -346,7 +378,7 @@ class VoxlightSceneProperties(bpy.types.PropertyGroup):
                                                "when this changes)")
 
 
-_classes = (VoxlightVolumeProperties, VoxlightSceneProperties)
+_classes = cutaway_props.CLASSES + (VoxlightVolumeProperties, VoxlightSceneProperties)
 
 
 def register():

@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import compositor, offline
+from . import compositor, offline, scene_shadows
 from .core import native
 
 last_error = ""
@@ -44,11 +44,18 @@ def _prepare_nodes(scene):
         compositor.ensure_pass_nodes(scene, w, h)
     else:
         compositor.ensure_nodes(scene, compositor.ensure_image(w, h))
+    # The volume's shadows on the scene: light groups and the chain before
+    # the Alpha Over (issue 18, scene_shadows.py).
+    scene_shadows.prepare_render(scene, w, h)
 
 
-def _show_nothing(scene):
+def _show_nothing(scene, shadows=False):
+    """No volume to lay over the render; shadows=False: no volume shadows
+    either (a failed frame), else the shadow images written stay."""
     compositor.mute(scene)
     compositor.clear_passes(scene)
+    if not shadows:
+        scene_shadows.clear_render(scene)
 
 
 @persistent
@@ -64,6 +71,7 @@ def on_render_pre(scene, *args):
     s = scene.voxlight
     if not s.render_enabled or not _volumes_present(scene) or scene.camera is None:
         _show_nothing(scene)
+        scene_shadows.revert(scene)
         _pending = False
         return
     _prepare_nodes(scene)
@@ -84,9 +92,12 @@ def on_frame_change_post(scene, depsgraph=None, *args):
     s = scene.voxlight
     w, h = offline.render_size(scene)
     camera = scene.camera
+    frame = {}
     try:
         result = offline.render(scene, depsgraph, camera, w, h,
-                                occlusion=s.render_occlusion, backend=s.backend)
+                                occlusion=s.render_occlusion, backend=s.backend, frame_info=frame)
+        if frame:
+            scene_shadows.write_render(scene, frame, w, h)
     except native.VoxlightError as e:
         last_error = str(e)
         print("Voxlight: render failed: %s" % e)
@@ -94,7 +105,7 @@ def on_frame_change_post(scene, depsgraph=None, *args):
         return
     last_error = ""
     if result is None or not result[0][..., 3].any():  # nothing, or all outside the frame
-        _show_nothing(scene)
+        _show_nothing(scene, shadows=bool(frame))
         return
     rgba, depth = result
     if s.render_separate_layer:

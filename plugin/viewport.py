@@ -51,9 +51,8 @@ import bpy
 import gpu
 import numpy as np
 from bpy.app.handlers import persistent
-from gpu_extras.batch import batch_for_shader
 
-from . import params
+from . import gpu_quad, params, scene_shadows, scene_shadows_viewport
 from .core import depth as _depth
 from .core import native, resolution_policy, runtime, volume_space
 
@@ -216,7 +215,6 @@ class _State:
         _ensure_poll()
 
 
-_VERT = "void main() { uv = pos * 0.5 + 0.5; gl_Position = vec4(pos, 0.0, 1.0); }"
 _FRAG = ("void main() { fragColor = texture(color_tex, uv);"
          " gl_FragDepth = texture(depth_tex, uv).r; }")
 
@@ -224,19 +222,7 @@ _FRAG = ("void main() { fragColor = texture(color_tex, uv);"
 def _get_shader():
     global _shader, _batch
     if _shader is None:
-        iface = gpu.types.GPUStageInterfaceInfo("voxlight_iface")
-        iface.smooth("VEC2", "uv")
-        info = gpu.types.GPUShaderCreateInfo()
-        info.vertex_in(0, "VEC2", "pos")
-        info.vertex_out(iface)
-        info.sampler(0, "FLOAT_2D", "color_tex")
-        info.sampler(1, "FLOAT_2D", "depth_tex")
-        info.fragment_out(0, "VEC4", "fragColor")
-        info.vertex_source(_VERT)
-        info.fragment_source(_FRAG)
-        _shader = gpu.shader.create_from_info(info)
-        _batch = batch_for_shader(_shader, "TRI_FAN",
-                                  {"pos": ((-1, -1), (1, -1), (1, 1), (-1, 1))})
+        _shader, _batch = gpu_quad.quad_shader("voxlight", ("color_tex", "depth_tex"), _FRAG)
     return _shader, _batch
 
 
@@ -473,7 +459,8 @@ class _Frame:
                                                        quantum, self.rect)
         _profile.mark("scene_depth")
         self.params = params.build(ob, w, h, view, proj, scene_depth=scene_depth,
-                                   lights=lights, fast=fast)
+                                   lights=lights, fast=fast,
+                                   scene_shadows=scene_shadows.for_viewport(ob))
         _profile.mark("params")
         self.key = native.params_digest(self.params, entry.identity)
         _profile.mark("digest")
@@ -594,6 +581,12 @@ def _draw():
                 if light_settles_in is not None:
                     _schedule_refine(light_settles_in + 0.01)
                 _profile.mark("lights")
+                # Issue 18: the meshes that shadow the volumes, and the
+                # volumes' shadow on the meshes (drawn under the volumes).
+                scene_shadows.refresh_viewport(depsgraph, objs)
+                scene_shadows_viewport.draw_layer(scene, depsgraph, objs, window_depth, W, H,
+                                                  view, proj, lights, region_ptr)
+                _profile.mark("scene_shadows")
             try:
                 shown = _update(st, ob, entry, W, H, view, proj, model, window_depth, lights,
                                 moving, key)
@@ -788,6 +781,7 @@ def _forget_all():
     for st in _states.values():
         st.cancel_job()
     _states.clear()
+    scene_shadows_viewport.forget()
     _depth_cache.clear()
 
 

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "axis_view.h" /* vxl_axis_view_ortho: GL's orthographic projection, as the CLI builds it */
 #include "voxlight_dev.h"
 
 /* ------------------------------------------------------------ environment */
@@ -339,18 +340,6 @@ static inline void sm_persp(float m[16], double fovy_deg, double aspect, double 
     sm_frustum(m, -t * aspect, t * aspect, -t, t, n, f);
 }
 
-static inline void sm_ortho(float m[16], double l, double r, double b, double t, double n, double f)
-{
-    memset(m, 0, 16 * sizeof *m);
-    m[0] = (float)(2 / (r - l));
-    m[5] = (float)(2 / (t - b));
-    m[10] = (float)(-2 / (f - n));
-    m[12] = (float)(-(r + l) / (r - l));
-    m[13] = (float)(-(t + b) / (t - b));
-    m[14] = (float)(-(f + n) / (f - n));
-    m[15] = 1;
-}
-
 /* F_NEAR_INVARIANT: the near plane sv_camera uses instead of the case's
  * (thread-local: the backends render concurrently). */
 static _Thread_local double vc_near_override;
@@ -460,7 +449,7 @@ static inline void sv_axis_ortho(vxl_render_params *p, stress_view_ctx *vc, int 
     at[a] = eye[a] + sgn;
     sm_look_at(p->view, eye, at, a == 2 ? UP_Y : UP_Z);
     double half = w / 2.0;
-    sm_ortho(p->proj, -half, half, -half, half, 1, 3 * dist);
+    vxl_axis_view_ortho(p->proj, -half, half, -half, half, 1, 3 * dist);
 }
 VIEW(axis_ortho_minus_x) { sv_axis_ortho(p, vc, 0); }
 VIEW(axis_ortho_plus_x) { sv_axis_ortho(p, vc, 1); }
@@ -514,7 +503,7 @@ VIEW(proj_near_eq_far_ortho)
     p->has_camera = 1;
     sm_look_at(p->view, eye, at, UP_Y);
     double f = 3 * vc->n, h = vc->n;
-    sm_ortho(p->proj, -h, h, -h, h, f * 0.999999, f);
+    vxl_axis_view_ortho(p->proj, -h, h, -h, h, f * 0.999999, f);
 }
 VIEW(proj_infinite_far) /* the classic infinite projection: m10 = -1, m14 = -2n */
 {
@@ -537,7 +526,7 @@ VIEW(proj_ortho_oblique)
     p->has_camera = 1;
     sm_look_at(p->view, eye, vc->c, UP_Z);
     double h = vc->n;
-    sm_ortho(p->proj, -h, h, -h, h, 0.5, 10 * vc->n);
+    vxl_axis_view_ortho(p->proj, -h, h, -h, h, 0.5, 10 * vc->n);
 }
 VIEW(proj_ortho_inside) /* the near plane cuts through the volume */
 {
@@ -546,7 +535,7 @@ VIEW(proj_ortho_inside) /* the near plane cuts through the volume */
     p->has_camera = 1;
     sm_look_at(p->view, eye, at, UP_Y);
     double h = vc->n;
-    sm_ortho(p->proj, -h, h, -h, h, 0.01, 10 * vc->n);
+    vxl_axis_view_ortho(p->proj, -h, h, -h, h, 0.01, 10 * vc->n);
 }
 VIEW(proj_ortho_huge_extent) /* the volume is far below a pixel */
 {
@@ -554,7 +543,7 @@ VIEW(proj_ortho_huge_extent) /* the volume is far below a pixel */
     double eye[3] = {vc->c[0], vc->c[1], vc->c[2] + 2 * vc->n}, at[3] = {vc->c[0], vc->c[1], 0};
     p->has_camera = 1;
     sm_look_at(p->view, eye, at, UP_Y);
-    sm_ortho(p->proj, -1e7, 1e7, -1e7, 1e7, 0.5, 1e7);
+    vxl_axis_view_ortho(p->proj, -1e7, 1e7, -1e7, 1e7, 0.5, 1e7);
 }
 VIEW(proj_fov_tiny)
 {
@@ -1168,6 +1157,54 @@ static inline int stress_apply_variant(vxl_render_params *p, const stress_view_c
     case 10: if (p->jitter_off) return 0; p->jitter_off = 1; return 1;
     case 11: p->jitter_seed = 0xFFFFFFFFu; return 1;
     default: return 0;
+    }
+}
+
+/* ------------------------------------------------------ issue 19: modes */
+
+/* The issue 19 renders each case gets beside the DVR matrix: every render
+ * mode but DVR, ISO shaded by a MatCap, and a cutaway (a clip plane through
+ * the volume's centre, half-space and slab) on DVR and MIP. */
+enum { SM_MIP, SM_MINIP, SM_AVERAGE, SM_ISO, SM_ISO_MATCAP, SM_DVR_CUT, SM_MIP_SLAB, SM_COUNT };
+
+static inline const char *stress_mode_render_name(int m)
+{
+    static const char *const names[SM_COUNT] = {"mip", "minip", "average", "iso", "iso+matcap", "dvr+clip", "mip+slab"};
+    return m >= 0 && m < SM_COUNT ? names[m] : "?";
+}
+
+/* Sets p (after the case's view) for issue 19 render m, with mc and cut as
+ * the MatCap and cutaway it may point to. For a valid case the classify,
+ * gradient-opacity and technique settings the modes refuse are reset (the
+ * DVR matrix covers those); an invalid case keeps what makes it invalid. */
+static inline void stress_mode_params(vxl_render_params *p, int m, int valid, const stress_view_ctx *vc, vxl_matcap *mc,
+                                      vxl_cutaway *cut)
+{
+    static const float cap[2 * 2 * 4] = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1};
+    const uint32_t modes[SM_COUNT] = {VXL_MODE_MIP, VXL_MODE_MINIP, VXL_MODE_AVERAGE, VXL_MODE_ISO, VXL_MODE_ISO,
+                                      VXL_MODE_DVR, VXL_MODE_MIP};
+    p->mode = modes[m];
+    if (valid && m != SM_DVR_CUT) {
+        p->classify = VXL_CLASSIFY_POST;
+        p->gradient_opacity = VXL_GOPACITY_OFF;
+        p->technique = VXL_TECHNIQUE_RAYCAST;
+    }
+    if (m == SM_ISO_MATCAP) {
+        *mc = (vxl_matcap){.struct_size = sizeof *mc, .width = 2, .height = 2, .rgba = cap, .key = 19};
+        p->matcap = mc;
+    }
+    if (m == SM_DVR_CUT || m == SM_MIP_SLAB) {
+        memset(cut, 0, sizeof *cut);
+        cut->struct_size = sizeof *cut;
+        cut->clip_plane_count = 1;
+        /* keeps x + 0.3 y - 0.2 z >= that of the centre (voxel = world for the identity-affine cases) */
+        const float n[3] = {1.0f, 0.3f, -0.2f};
+        cut->clip_planes[0].plane[0] = n[0];
+        cut->clip_planes[0].plane[1] = n[1];
+        cut->clip_planes[0].plane[2] = n[2];
+        cut->clip_planes[0].plane[3] = -(float)(n[0] * vc->c[0] + n[1] * vc->c[1] + n[2] * vc->c[2]);
+        cut->clip_planes[0].thickness = m == SM_MIP_SLAB ? (float)(0.25 * vc->n) : 0.0f;
+        p->cutaway = cut;
     }
 }
 

@@ -368,6 +368,36 @@ static void mode_label(const vxl_render_params *p, char *out, size_t n)
              p->gradient_opacity < VXL_GOPACITY_COUNT ? gop[p->gradient_opacity] : "+gop_invalid");
 }
 
+/* Issue 19 (stress_mode_params): each render mode, a MatCap and a cutaway,
+ * with one filter per case in rotation. A projection or an iso-surface may
+ * rightly show nothing, or something, where DVR does the opposite (a
+ * transparent maximum, a surface of opacity 1 in a transparent table), so
+ * only the invariants every render keeps are asked, and the scene-depth
+ * invariance. Returns the number of failed renders. */
+static int render_issue19_modes(case_run *cr, int b, stress_view_ctx *vc, buffers *bu)
+{
+    stress_case c = *cr->c;
+    c.flags &= F_SAME_AS_NO_DEPTH;
+    case_run run = *cr;
+    run.c = &c;
+    int errors = 0;
+    char label[320];
+    for (int m = 0; m < SM_COUNT; m++) {
+        vxl_render_params p = stress_base_params(&ENV);
+        p.filter = (uint32_t)((cr->idx + (size_t)m) % VXL_FILTER_COUNT);
+        p.iso_value = (float)(0.5 * vc->value_min + 0.5 * vc->value_max);
+        cr->c->view(&p, vc);
+        vxl_matcap mc;
+        vxl_cutaway cut;
+        stress_mode_params(&p, m, cr->c->expect_rc == VXL_OK, vc, &mc, &cut);
+        const char *fname = vxl_filter_name(p.filter);
+        snprintf(label, sizeof label, "[%s] filter=%s mode=%s backend=%s", c.name, fname ? fname : "?",
+                 stress_mode_render_name(m), backend_names[b]);
+        errors += render_one(&run, b, &p, 0, label, bu, vc);
+    }
+    return errors;
+}
+
 typedef struct backend_job {
     case_run cr;
     int b;
@@ -425,6 +455,7 @@ static void *run_backend(void *arg)
                     errors += render_one(cr, b, &p, var, label, &bu, &vc);
                 }
             }
+    errors += render_issue19_modes(cr, b, &vc, &bu);
     if (errors) { /* after any failed render the renderer must still work */
         snprintf(label, sizeof label, "[%s] backend=%s (a plain render after %d failed ones)", c->name,
                  backend_names[b], errors);

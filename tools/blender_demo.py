@@ -48,6 +48,10 @@ def main():
     bpy.ops.voxlight.import_volume(filepath=BRAIN)  # 1 mm = 0.01 units: ~1.7 units long
     brain = bpy.context.view_layer.objects.active
     brain.voxlight.preset = "mri"
+    # The brain shadows the floor and the sphere (issue 18; on by default):
+    # each light's direct light in the render times the volume's
+    # transmittance, through Cycles light groups and the compositor.
+    brain.voxlight.cast_shadows = True
 
     # A mesh beside the brain (and a floor) so the compositing is visible.
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.45, location=(1.35, 0.2, -0.3))

@@ -40,7 +40,8 @@ FOLDERS = {
     # in-process readers the helpers run; image output
     "io": """volume_load.c loaders.h nifti.c nifti.h nrrd.c metaimage.c loader_util.c loader_util.h
              dicom_detect.c reader_stream.h reader_spawn.c reader_spawn.h remote_readers.c
-             helper_main.c helper_main.h image_stack.cpp vdb.cpp dicom.cpp image_write.c image_write.h""",
+             helper_main.c helper_main.h image_stack.cpp vdb.cpp dicom.cpp image_write.c image_write.h
+             json.c json.h zarr.h zarr_store.c zarr_chunk.c zarr_read.c zarr_detect.c""",
     # the GL context and its backends, the function table, the GL thread,
     # programs and shader source, texture units and bindings, the GL memory
     # accountant
@@ -49,7 +50,7 @@ FOLDERS = {
              gpu.h budget.c budget.h holdings.c holdings.h""",
     # render parameters resolved against the volume, transfer-function
     # tables: plain values every GL-side stage reads (no GL)
-    "frame": """frame.c frame.h frame_lighting.c transfer.c transfer.h""",
+    "frame": """frame.c frame.h frame_lighting.c transfer.c transfer.h frame_cut.c frame_cut.h""",
     # how the volume is held on the GL side: the storage interface and its
     # modes, paging on the CPU, compression, LOD levels
     "storage": """storage.c storage.h storage_dense.c storage_bricked.c storage_sparse.c storage_compressed.c
@@ -66,13 +67,15 @@ FOLDERS = {
                     paged_bspline.c bspline_bricks.c bspline_bricks.h kernels.c kernels.h""",
     # one frame: parameters, the renderer object, the reference renderer
     "render": """render.c render.h renderer.c renderer.h renderer_internal.h reference.c reference.h reference_light.c
-                 probe.c slices.c slices.h""",
+                 probe.c slices.c slices.h slice_plane.c""",
     # lighting: the illumination volumes (shadows, occlusion) of issue 17
     "light": """illumination.c illumination.h""",
+    # cutaways (issue 19): clip planes' and crop box's uniforms, cutter meshes peeled per pixel
+    "cut": """cutaway.c cutaway.h""",
     # the command-line tool (an executable, not in the library)
-    "cli": """cli.c""",
+    "cli": """cli.c cli_cut.c cli_cut.h""",
     # the reader helper executables' own main()s
-    "helpers": """helper_oiio.c helper_dicom.c""",
+    "helpers": """helper_oiio.c helper_dicom.c helper_zarr.c""",
 }
 MOVES = {name: folder for folder, names in FOLDERS.items() for name in names.split()}
 

@@ -1,4 +1,4 @@
-/* cli.c - the `voxlight` command-line tool: `render` and `info`. Every
+/* cli.c - the `voxlight` command-line tool: `render`, `info` and `labels`. Every
  * failure ends with one line "voxlight: error: ..." and exit status 1. */
 #include <math.h>
 #include <stdarg.h>
@@ -8,6 +8,9 @@
 #include <strings.h>
 #include <time.h>
 
+#include "cli_cut.h"   /* --clip-plane, --crop, --no-caps (issue 19) */
+#include "cli_modes.h" /* --mode, --iso-value, --matcap, --ortho, --view (issue 19) */
+#include "cli_labels.h" /* the labels command (issue 20) */
 #include "voxlight_dev.h" /* phantoms (phantom:NAME inputs) and --no-skip */
 
 /* The option values come from the library's name functions (vxl_*_name),
@@ -23,7 +26,11 @@ static const char usage_format[] =
     "                  [--storage %s] [--page-brick 8|16|32|64] [--renderer %s]\n"
     "                  [--light dir:X,Y,Z[,INTENSITY] | point:X,Y,Z[,INTENSITY]]... [--shading %s]\n"
     "                  [--ambient-occlusion RADIUS] [--anisotropy G]\n"
+    "                  [--mode %s] [--iso-value V] [--matcap FILE.png] [--ortho]\n"
+    "                  [--view x|-x|y|-y|z|-z]\n"
+    "                  [--clip-plane A,B,C,D[,T]]... [--crop X0:X1,Y0:Y1,Z0:Z1] [--no-caps]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
+    "  voxlight labels FILE   (a label lookup table: FreeSurfer LUT, ITK-SNAP, Slicer .ctbl, MRIcron .lut/.txt)\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
     "--voxel-size (mm) is for inputs without geometry (TIFF/PNG stacks); one value sets all three\n"
@@ -37,6 +44,9 @@ static const char usage_format[] =
     "         directional light, point: a point light's world position; INTENSITY > 0, default 1.\n"
     "         --shading phong: local lighting; shadowed: with shadows and --ambient-occlusion (voxels,\n"
     "         0 = off); scatter: also single scattering, forward for --anisotropy G > 0 (-0.99..0.99)\n"
+    "cutaways: --clip-plane (repeatable, up to 6) keeps A x + B y + C z + D >= 0 (world mm), only the slab\n"
+    "         up to T mm from the plane when T > 0; --crop keeps voxels X0..X1, Y0..Y1, Z0..Z1 (indices from 0,\n"
+    "         inclusive); cut faces are shaded as surfaces (caps) unless --no-caps (docs/cutaways.md)\n"
     "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of\n"
     "         %s\n"
     "         (large-sparse: default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
@@ -60,7 +70,7 @@ static const char *name_list(name_fn name, uint32_t first, const char *sep, char
 static void print_usage(FILE *out)
 {
     char backends[64], stores[64], classify[64], gopacity[64], storage[128], filters[256], presets[128], phantoms[256],
-        techniques[64], shading[64];
+        techniques[64], shading[64], modes[64];
     fprintf(out, usage_format, name_list(vxl_backend_name, 0, "|", backends, sizeof backends),
             name_list(vxl_gradient_store_name, 0, "|", stores, sizeof stores),
             name_list(vxl_classify_name, 0, "|", classify, sizeof classify),
@@ -68,6 +78,7 @@ static void print_usage(FILE *out)
             name_list(vxl_storage_name, 0, "|", storage, sizeof storage),
             name_list(vxl_technique_name, 0, "|", techniques, sizeof techniques),
             name_list(vxl_shading_model_name, 0, "|", shading, sizeof shading),
+            name_list(vxl_mode_name, 0, "|", modes, sizeof modes),
             name_list(vxl_filter_name, 0, " ", filters, sizeof filters),
             name_list(vxl_preset_name, 0, " ", presets, sizeof presets),
             name_list(vxl_phantom_name, 1, " ", phantoms, sizeof phantoms));
@@ -328,12 +339,15 @@ typedef struct render_args {
     vxl_render_params p;
     vxl_renderer_options ro;
     vxl_load_options lo;
+    vxl_cli_modes modes; /* issue 19 */
+    vxl_cli_cut cut;     /* issue 19 cutaways */
 } render_args;
 
 static int parse_render(int argc, char **argv, render_args *a)
 {
     vxl_render_params *p = &a->p;
     int r;
+    char err[512];
     for (int i = 0; i < argc; i++) {
         const char *o = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -419,6 +433,10 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (r < 0) return 1;
         } else if ((r = parse_lighting_option(argc, argv, &i, p)) != 0) {
             if (r < 0) return 1;
+        } else if ((r = vxl_cli_modes_option(argc, argv, &i, &a->modes, p, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err);
+        } else if ((r = vxl_cli_cut_option(argc, argv, &i, &a->cut, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err);
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);
@@ -436,6 +454,8 @@ static int cmd_render(int argc, char **argv)
     a.p.struct_size = sizeof a.p;
     a.ro.struct_size = sizeof a.ro;
     a.lo.struct_size = sizeof a.lo;
+    vxl_cli_modes_init(&a.modes);
+    vxl_cli_cut_init(&a.cut);
     if (parse_render(argc, argv, &a)) return 1;
     uint32_t w = a.p.width ? a.p.width : 512, h = a.p.height ? a.p.height : 512;
     vxl_volume *v = NULL;
@@ -448,6 +468,9 @@ static int cmd_render(int argc, char **argv)
     }
     if (vxl_renderer_create(&a.ro, &r)) { die("%s", vxl_last_error()); goto done; }
     if (vxl_renderer_set_volume(r, v)) { die("%s", vxl_renderer_error(r)); goto done; }
+    char merr[512];
+    if (vxl_cli_modes_apply(&a.modes, r, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
+    if (vxl_cli_cut_apply(&a.cut, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     vxl_volume_destroy(v);
     v = NULL;
     rgba = malloc((size_t)w * h * 4 * sizeof *rgba);
@@ -482,9 +505,18 @@ static int cmd_render(int argc, char **argv)
 done:
     free(rgba);
     free(depth);
+    vxl_cli_modes_free(&a.modes);
     vxl_renderer_destroy(r);
     vxl_volume_destroy(v);
     return status;
+}
+
+/* `labels FILE`: the lookup table as the library reads it (cli_labels.c). */
+static int cmd_labels(int argc, char **argv)
+{
+    if (argc != 1 || argv[0][0] == '-') return die("labels takes one FILE (see voxlight --help)");
+    char err[600];
+    return vxl_cli_labels_print(argv[0], stdout, err, sizeof err) ? die("%s", err) : 0;
 }
 
 int main(int argc, char **argv)
@@ -496,5 +528,6 @@ int main(int argc, char **argv)
     if (vxl_abi_version() != VXL_ABI_VERSION) return die("libvoxlight ABI %u, expected %u", vxl_abi_version(), VXL_ABI_VERSION);
     if (!strcmp(argv[1], "render")) return cmd_render(argc - 2, argv + 2);
     if (!strcmp(argv[1], "info")) return cmd_info(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "labels")) return cmd_labels(argc - 2, argv + 2);
     return die("unknown command '%s' (see voxlight --help)", argv[1]);
 }

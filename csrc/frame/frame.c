@@ -261,6 +261,8 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown technique %u (0 raycast, 1 slices2d, 2 slices3d)",
                         p->technique);
     f->technique = p->technique;
+    rc = vxl_frame_resolve_mode(f, p, e); /* issue 19: mode, iso_value, MatCap */
+    if (rc) return rc;
     f->gradient_ref = p->gradient_ref == 0 ? 0.05f : p->gradient_ref;
     f->gradient_exp = p->gradient_exp == 0 ? 1.0f : p->gradient_exp;
     f->iso_thickness = p->iso_thickness == 0 ? 1.0f : p->iso_thickness;
@@ -275,7 +277,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     if (f->preint_size < 16 || f->preint_size > 4096)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "preint_size %u must be in [16, 4096]", f->preint_size);
     f->store = p->gradient_store;
-    f->shading = !p->shading_off;
+    f->shading = !p->shading_off && vxl_mode_shades(f->mode); /* issue 19: projections have no surface */
     f->reuse = p->reuse_gradients != 0;
     f->jitter = !p->jitter_off;
     f->seed = p->jitter_seed;
@@ -305,6 +307,8 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     rc = resolve_matrices(f, p, g, e);
     if (!rc) rc = resolve_lights(f, p, e);
     if (!rc) rc = vxl_frame_resolve_lighting(f, p, e);
+    if (!rc) rc = vxl_frame_resolve_scene_shadows(f, p, e); /* issue 18 */
+    if (!rc) rc = vxl_frame_cut_resolve(&f->cut, p, f->model, f->technique, e); /* issue 19 cutaways */
     if (!rc) rc = resolve_tf(f, p, g, e);
     if (rc) vxl_frame_free(f);
     return rc;

@@ -8,6 +8,7 @@
 
 #include "bricks.h"
 #include "error.h"
+#include "frame_cut.h"
 #include "transfer.h"
 #include "voxlight.h"
 
@@ -53,11 +54,28 @@ typedef struct vxl_frame {
     float light_spot_blend[VXL_MAX_LIGHTS];   /* spot_blend, 0..1 (0 = hard edge) */
     float light_size[VXL_MAX_LIGHTS];         /* directional: angular diameter (radians); point:
                                                  radius (world units); 0 = hard shadows */
+    /* issue 18 scene shadows (frame_scene.c): the scene's occluder meshes,
+     * validated (indices in range, vertices finite); none when
+     * occluder_triangle_count is 0. The arrays are the caller's. */
+    const float *occluder_vertices;      /* world xyz per vertex */
+    const uint32_t *occluder_indices;    /* 3 per triangle */
+    uint32_t occluder_vertex_count, occluder_triangle_count;
+    uint32_t shadow_map_size;            /* texels per side, 0 resolved to the default */
+    uint64_t occluder_key;               /* the caller's version, or the arrays' hash; never 0 with occluders */
     float early_termination, depth_threshold;
     int skip;                   /* empty-space skipping and the screen-space bound */
     const float *scene_depth;
     float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
     float *tf_copy;             /* owned when the caller gave a table */
+    /* issue 19 modes (frame_mode.c): the projection or iso-surface, and the
+     * MatCap when one is given and shading reads it (DVR with shading, ISO). */
+    uint32_t mode;              /* VXL_MODE_* */
+    const float *matcap_rgba;   /* NULL: the material and lights */
+    uint32_t matcap_width, matcap_height;
+    uint64_t matcap_key;        /* the caller's key; 0: the GL side hashes the pixels */
+    /* issue 19 cutaways (frame_cut.c): clip planes and crop box in voxel
+     * space, the cutters checked; cut.any is 0 without params.cutaway. */
+    vxl_frame_cut cut;
 } vxl_frame;
 
 /* The gradient filter a frame evaluates: rays that never evaluate gradients
@@ -103,6 +121,19 @@ void vxl_frame_free(vxl_frame *f);
  * ambient_occlusion, occlusion_strength, anisotropy, illumination_size) into
  * f; needs f->view and the lights resolved. Part of vxl_frame_resolve. */
 int vxl_frame_resolve_lighting(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+
+/* Whether mode (VXL_MODE_*) shades: DVR and ISO do, the projections have no surface. */
+static inline int vxl_mode_shades(uint32_t mode) { return mode == VXL_MODE_DVR || mode == VXL_MODE_ISO; }
+
+/* Validates the issue 19 mode fields of p (mode, iso_value, matcap) and how
+ * the mode combines with classify, gradient_opacity and technique, into f.
+ * Part of vxl_frame_resolve (frame_mode.c). */
+int vxl_frame_resolve_mode(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+
+/* Validates p->scene_shadows (issue 18) into f's occluder fields: NULL
+ * arrays with counts, indices out of range, vertices not finite and map
+ * sizes out of range fail naming the field. Part of vxl_frame_resolve. */
+int vxl_frame_resolve_scene_shadows(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
 
 /* Blender's spot mask (voxlight.h, vxl_light_shape.spot_blend) of light i
  * for a sample whose direction from the light makes cos_a with the spot's

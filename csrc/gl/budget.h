@@ -26,6 +26,10 @@ typedef enum vxl_holder {
     VXL_HOLD_BSPLINE,    /* cubic B-spline coefficients (texture, or pool + page table) */
     VXL_HOLD_CLASSIFIED, /* the pre-classified volume (RGBA8) */
     VXL_HOLD_ILLUMINATION, /* the illumination volumes: extinction, the lights' transmittance, occlusion */
+    VXL_HOLD_SCENE_SHADOWS, /* issue 18: the lights' shadow maps of the scene's occluders, transmittance images */
+    VXL_HOLD_MATCAP,     /* issue 19: the MatCap image */
+    VXL_HOLD_MODE_BRICKS, /* issue 19: the brick min-max grid as a texture (MIP, MinIP, ISO skipping) */
+    VXL_HOLD_CUTAWAY,    /* issue 19: the cutters' per-pixel crossing layers and their vertex buffer */
     VXL_HOLD_COUNT
 } vxl_holder;
 

@@ -24,6 +24,9 @@
 #define VXL_CPAGE_UNIT 12         /* bricked storage: the coefficient pool's page table */
 #define VXL_ILLUMINATION_UNIT 13  /* raycast, illumination.comp: the lights' transmittance and the occlusion, stacked */
 #define VXL_EXTINCTION_UNIT 14    /* illumination.comp: the optical depth per cell the lights and occlusion read */
+#define VXL_SHADOW_MAP_UNIT 15    /* illumination.comp (pass 3), scene_transmittance.comp: the lights' shadow maps (issue 18) */
+#define VXL_MATCAP_UNIT 16        /* raycast: the MatCap image (issue 19, render/matcap.c) */
+#define VXL_BRICK_MINMAX_UNIT 17  /* raycast: the brick min-max grid the modes skip by (issue 19, render/mode_bricks.c) */
 
 /* Image units. */
 #define VXL_IMAGE_OUT 0           /* every compute pass: the texture it writes (the B-spline prefilter also reads it) */
@@ -35,6 +38,7 @@
 #define VXL_SSBO_PROBE_POINTS 0   /* probe.comp: the points to probe */
 #define VXL_SSBO_PROBE_RESULTS 1  /* probe.comp: what it measured */
 #define VXL_SSBO_STATS 2          /* raycast.frag: the frame's sample counts */
+#define VXL_SSBO_CUT_LAYERS 3     /* raycast, cut_peel.frag: the cutter crossings per pixel (issue 19, cut/cutaway.c) */
 #define VXL_SSBO_BRICK_LIST 2     /* gradients.comp (bricked), decode_bricks.comp: per slot, the brick (or code slot) to derive */
 
 #define VXL_GLSL_STR_(x) #x
@@ -46,7 +50,7 @@
 static inline const char *vxl_glsl_binding_defines(void)
 {
     return VXL_GLSL_DEFINE(VXL_IMAGE_OUT) VXL_GLSL_DEFINE(VXL_SSBO_GRADIENT_MAX) VXL_GLSL_DEFINE(VXL_SSBO_PROBE_POINTS)
-        VXL_GLSL_DEFINE(VXL_SSBO_PROBE_RESULTS) VXL_GLSL_DEFINE(VXL_SSBO_STATS) VXL_GLSL_DEFINE(VXL_SSBO_BRICK_LIST)
+        VXL_GLSL_DEFINE(VXL_SSBO_PROBE_RESULTS) VXL_GLSL_DEFINE(VXL_SSBO_STATS) VXL_GLSL_DEFINE(VXL_SSBO_BRICK_LIST) VXL_GLSL_DEFINE(VXL_SSBO_CUT_LAYERS)
         VXL_GLSL_DEFINE(VXL_IMAGE_SLICE_ACCUM) VXL_GLSL_DEFINE(VXL_IMAGE_SLICE_DEPTH);
 }
 

@@ -71,7 +71,16 @@
     X(PFNGLUNIFORMMATRIX3FVPROC, UniformMatrix3fv)                            \
     X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                            \
     X(PFNGLDISPATCHCOMPUTEPROC, DispatchCompute)                              \
-    X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)
+    X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                  \
+    X(PFNGLCLEARBUFFERSUBDATAPROC, ClearBufferSubData) /* issue 19: cut/cutaway.c */ \
+    /* issue 18: occluder meshes rasterised into shadow maps (light/shadow_maps.c) */ \
+    X(PFNGLDRAWELEMENTSPROC, DrawElements)                                    \
+    X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)                      \
+    X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)              \
+    X(PFNGLFRAMEBUFFERTEXTURELAYERPROC, FramebufferTextureLayer)              \
+    X(PFNGLDEPTHFUNCPROC, DepthFunc)                                          \
+    X(PFNGLDEPTHMASKPROC, DepthMask)                                          \
+    X(PFNGLUNIFORM1FVPROC, Uniform1fv)
 
 typedef struct vxl_gl {
 #define VXL_GL_MEMBER(type, name) type name;

@@ -139,6 +139,27 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         snprintf(defines, sizeof defines, "%s#define PASS %u\n#define GOPACITY %u\n", paged, flags & 3, (flags >> 2) & 3);
         rc = compile(g, GL_COMPUTE_SHADER, "compute/illumination.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
+    case VXL_PROG_SLICE_PLANE: /* slice_plane.c: flags & 3 the interpolation (VXL_INTERP_*), plus the sample flags */
+        snprintf(defines, sizeof defines, "%s%s#define INTERP %u\n", paged, fdef, flags & 3);
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/slice_plane.comp", defines, &a);
+        return rc ? rc : link(g, a, 0, out);
+    case VXL_PROG_SHADOW_MAP: /* issue 18: depth only */
+        rc = compile(g, GL_VERTEX_SHADER, "render/shadow_map.vert", NULL, &a);
+        if (rc) return rc;
+        rc = compile(g, GL_FRAGMENT_SHADER, "render/shadow_map.frag", NULL, &b);
+        if (rc) {
+            g->gl.DeleteShader(a);
+            return rc;
+        }
+        return link(g, a, b, out);
+    case VXL_PROG_SCENE_TRANSMITTANCE: /* issue 18 */
+        rc = compile(g, GL_COMPUTE_SHADER, "compute/scene_transmittance.comp", NULL, &a);
+        return rc ? rc : link(g, a, 0, out);
+    case VXL_PROG_CUT_PEEL: /* issue 19: cut/cutaway.c */
+        rc = compile(g, GL_VERTEX_SHADER, "render/cut_peel.vert", NULL, &a);
+        if (!rc && (rc = compile(g, GL_FRAGMENT_SHADER, "render/cut_peel.frag", "#define CUT_PEEL 1\n", &b)))
+            g->gl.DeleteShader(a);
+        return rc ? rc : link(g, a, b, out);
     case VXL_PROG_BRICK_MINMAX:
         rc = compile(g, GL_COMPUTE_SHADER, "compute/brick_minmax.comp", flags & 1 ? "#define GRADIENT_BOUND 1\n" : NULL, &a);
         return rc ? rc : link(g, a, 0, out);
@@ -149,7 +170,7 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
 
 int vxl_program_get(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
 {
-    uint32_t key = kind | (filter << 4) | (flags << 12);
+    uint32_t key = kind | (filter << 5) | (flags << 12); /* kind < 32, filter < 8 */
     for (int i = 0; i < g->n_programs; i++)
         if (g->programs[i].key == key) {
             *out = g->programs[i].program;

@@ -34,6 +34,11 @@
 #define VXL_PROG_DECODE_BRICKS 12 /* flags: the cache's bytes per voxel - 1 */
 #define VXL_PROG_SLICES 13 /* the slicing comparison modes (render/slices.c); flags as RAYCAST */
 #define VXL_PROG_ILLUMINATION 14 /* light/illumination.c: flags & 3 the pass, plus the sample flags */
+#define VXL_PROG_CUT_PEEL 24 /* cut/cutaway.c (issue 19): cutter meshes peeled into per-pixel crossings */
+/* kinds take 5 bits of the program cache's key (gl_util.c): at most 31 */
+#define VXL_PROG_SHADOW_MAP 20 /* light/shadow_maps.c (issue 18): occluders rasterised from a light (depth only) */
+#define VXL_PROG_SCENE_TRANSMITTANCE 21 /* light/transmittance.c (issue 18): scene points' transmittance to a light */
+#define VXL_PROG_SLICE_PLANE 16 /* render/slice_plane.c (issue 19): flags & 3 the interpolation, plus the sample flags */
 
 /* Program flags the storage sets on shaders that sample the volume. */
 #define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */

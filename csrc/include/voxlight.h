@@ -369,10 +369,13 @@ VXL_API int vxl_technique_from_name(const char *name, uint32_t *out);
  *   MINIP    the smallest
  *   AVERAGE  the mean of the samples
  *   ISO      the first crossing of iso_value (data units) along the ray,
- *            refined below the step by bisection on the filter's
- *            reconstruction, shaded as a surface (the material, lights,
- *            shading model or MatCap) with the transfer function's colour at
- *            iso_value, opacity 1; depth = the exact hit. */
+ *            refined below the step by bisection (and a last secant step) on
+ *            the reconstruction every sample reads, the trilinear one (the
+ *            filter gives the surface's normal), shaded as a surface (the
+ *            material, lights, shading model or MatCap) with the transfer
+ *            function's colour at iso_value, opacity 1; depth = the exact hit.
+ * A projection's depth, like DVR's, is written where its opacity reaches
+ * depth_threshold (+inf elsewhere). docs/modes.md. */
 #define VXL_MODE_DVR 0
 #define VXL_MODE_MIP 1
 #define VXL_MODE_MINIP 2
@@ -399,8 +402,10 @@ typedef struct vxl_clip_plane {
 
 /* A closed triangle mesh that removes its inside (or, with remove_outside,
  * everything but its inside). Depth-peeled from the camera each frame: the
- * ray skips the removed depth intervals. The array's stride is
- * cutters[0].struct_size. */
+ * ray skips the removed depth intervals. Faces wind counter-clockwise seen
+ * from outside (a mesh wound inward throughout is turned round); at most 8
+ * surface crossings per pixel, a pixel crossed more often is drawn empty
+ * (docs/cutaways.md). The array's stride is cutters[0].struct_size. */
 typedef struct vxl_cutter {
     uint32_t struct_size;
     uint32_t remove_outside;   /* 0: remove the inside; 1: keep only the inside */
@@ -420,7 +425,7 @@ typedef struct vxl_cutaway {
                                    times its display size */
     uint32_t cutter_count;      /* <= VXL_MAX_CUTTERS */
     const vxl_cutter *cutters;
-    uint32_t caps_off;          /* 0: caps on: the first kept sample behind a cut surface is
+    uint32_t caps_off;          /* 0: caps on: the first kept sample (within one step) behind a cut surface is
                                    shaded with the cut's normal (facing the eye) instead of the
                                    data gradient; 1: the data gradient everywhere */
     uint32_t reserved;          /* must be 0 */
@@ -453,7 +458,8 @@ typedef struct vxl_scene_shadows {
     const float *occluder_vertices;  /* world xyz, 3 floats per vertex */
     const uint32_t *occluder_indices; /* 3 per triangle, < occluder_vertex_count */
     uint32_t occluder_triangle_count;
-    uint32_t shadow_map_size;        /* texels per side; 0 = 1024 */
+    uint32_t shadow_map_size;        /* texels per side, 16..8192; 0 = 1024 (a point light inside or
+                                        beside the volume's box gets a cube of six such maps) */
     uint64_t occluder_key;           /* nonzero: the caller's version of the occluders (same key =
                                         unchanged, no rebuild); 0: the library hashes them */
 } vxl_scene_shadows;
@@ -594,7 +600,8 @@ VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);
  * the headlight), from the same illumination volume the SHADOWED model
  * reads (built for this light when the frame has none), and cut by
  * p->scene_shadows' occluders as the volume's own shadows are. 1 where the
- * path to the light misses the volume or the depth is +inf. out:
+ * path to the light misses the volume or the depth is +inf (or NaN, or not
+ * positive). Exact and approximate parts: docs/scene_shadows.md. out:
  * width*height floats, row 0 = bottom. A compositor multiplies the light's
  * direct contribution by it. */
 VXL_API int vxl_scene_transmittance(vxl_renderer *r, const vxl_render_params *p, uint32_t light,
@@ -621,7 +628,11 @@ typedef struct vxl_slice_params {
  * colour map (preset or tf_rgba); its camera, shading and mode are not
  * used. rgba (width*height*4 floats, premultiplied): the transfer
  * function's colour at the value with alpha 1 inside the volume's box, 0
- * outside it. */
+ * outside it. plane_to_world must be finite and affine (last row 0 0 0 1)
+ * with x and y axes that span an area (its z axis is not used);
+ * VXL_ERR_INVALID_ARGUMENT otherwise. Compressed storage has no cubic
+ * coefficients (as VXL_FILTER_CUBIC): a cubic slice of it is
+ * VXL_ERR_STATE. docs/slicing-planes.md. */
 VXL_API int vxl_render_slice(vxl_renderer *r, const vxl_render_params *p, const vxl_slice_params *s,
                              float *rgba);
 

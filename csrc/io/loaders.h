@@ -31,6 +31,15 @@ int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out
 /* DICOM: a folder, a DICOMDIR or one file of a series (dicom.cpp in
  * voxlight-read-dicom). */
 int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* OME-Zarr (v2 and v3): the image's folder, optionally "#level=N&c=N"
+ * (zarr_read.c in voxlight-read-zarr; docs/zarr.md). */
+int vxl_zarr_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* Whether path (a folder, maybe followed by "#options") is a Zarr store:
+ * it holds .zattrs, .zgroup or zarr.json; in zarr_detect.c. The path may
+ * also name one of those files (the store is its folder). */
+int vxl_zarr_path_is_zarr(const char *path);
+/* 1 for "zarr.json", ".zattrs" and ".zgroup". */
+int vxl_zarr_metadata_name(const char *name);
 /* Whether a folder holds DICOM (a DICOMDIR, or "DICM" files) or a file is
  * DICOM, for the dispatch; in dicom_detect.c. */
 int vxl_dicom_path_is_dicom(const char *path, int is_dir);

@@ -4,6 +4,7 @@
  * library is missing cannot take the host (Blender) down:
  *   voxlight-read-oiio   TIFF/PNG stacks and OpenVDB, through OpenImageIO
  *   voxlight-read-dicom  DICOM, through dcmtk
+ *   voxlight-read-zarr   OME-Zarr, through libzstd and libblosc (zarr.h)
  * One helper per library, so a missing library breaks only its formats.
  * reader_spawn.c starts a helper next to libvoxlight.so and checks what it
  * sends; helper_main.c is the helpers' side. This is the pipe protocol both
@@ -21,6 +22,8 @@
 #define VXL_HELPER_OIIO_ENV "VOXLIGHT_READ_OIIO"
 #define VXL_HELPER_DICOM "voxlight-read-dicom"
 #define VXL_HELPER_DICOM_ENV "VOXLIGHT_READ_DICOM"
+#define VXL_HELPER_ZARR "voxlight-read-zarr" /* OME-Zarr: libzstd, libblosc (zarr.h) */
+#define VXL_HELPER_ZARR_ENV "VOXLIGHT_READ_ZARR"
 /* Overrides every helper's time limit in seconds (tests). */
 #define VXL_READER_TIMEOUT_ENV "VOXLIGHT_READER_TIMEOUT"
 
@@ -29,6 +32,7 @@
 #define VXL_CMD_VDB "vdb"                  /* OpenVDB grid -> a volume */
 #define VXL_CMD_DICOM "dicom"              /* DICOM series -> a volume */
 #define VXL_CMD_DICOM_SERIES "dicom-series" /* DICOM folder -> vxl_dicom_series[] */
+#define VXL_CMD_ZARR "zarr"                /* OME-Zarr level -> a volume */
 
 /* argv: HELPER COMMAND PATH MAX_DIM BUDGET_BYTES VOXEL_X VOXEL_Y VOXEL_Z
  * FRAME SERIES (SERIES may be ""): the load options, defaults resolved. */

@@ -24,6 +24,10 @@ static const vxl_reader dicom_reader = {
     VXL_HELPER_DICOM, VXL_HELPER_DICOM_ENV, "the DICOM reader", "DICOM series", "dcmtk",
     VXL_DCMTK_SONAME, VXL_DCMTK_PACKAGE};
 
+static const vxl_reader zarr_reader = {
+    VXL_HELPER_ZARR, VXL_HELPER_ZARR_ENV, "the OME-Zarr reader", "OME-Zarr stores", "libblosc and libzstd",
+    VXL_BLOSC_SONAME " and " VXL_ZSTD_SONAME, VXL_BLOSC_PACKAGE " " VXL_ZSTD_PACKAGE};
+
 #define MAX_ENTRIES 100000u /* files counted for the time limit */
 
 /* Bytes of the regular files under dir (to depth levels below it), for the
@@ -123,6 +127,30 @@ int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out
 int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     return load_remote(&dicom_reader, VXL_CMD_DICOM, 1, DICOM_DEPTH, path, opt, out, e);
+}
+
+/* A store's chunks sit up to a level, t, c, z, y and x folder deep. */
+#define ZARR_DEPTH 8
+
+/* path may carry "#level=N&c=N" after the folder (zarr_read.c), so the
+ * folder alone is checked here and sized for the time limit. */
+int vxl_zarr_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+{
+    if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
+    *out = NULL;
+    char folder[4096];
+    const char *hash = strrchr(path, '#');
+    int n = hash ? (int)(hash - path) : (int)strlen(path);
+    if (n >= (int)sizeof folder) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': path too long", path);
+    snprintf(folder, sizeof folder, "%.*s", n, path);
+    struct stat st;
+    if (stat(folder, &st)) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", folder, strerror(errno));
+    vxl_reader_header h;
+    void *body = NULL;
+    int rc = vxl_reader_run(&zarr_reader, VXL_CMD_ZARR, path, opt, VXL_REPLY_VOLUME,
+                            input_bytes(folder, &st, 0, ZARR_DEPTH), &h, &body, e);
+    if (rc) return rc;
+    return volume_from(&h, body, out, e);
 }
 
 VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint32_t max, uint32_t *count)

@@ -22,6 +22,7 @@ typedef int (*vxl_loader_fn)(const char *path, const vxl_load_options *opt, vxl_
 static vxl_loader_fn vxl_loader_for(const char *path)
 {
     struct stat st;
+    if (vxl_zarr_path_is_zarr(path)) return vxl_zarr_load; /* before the folder test: "store.zarr#level=1" */
     if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
         return vxl_dicom_path_is_dicom(path, 1) ? vxl_dicom_load : vxl_image_stack_load;
     static const struct { const char *ext; vxl_loader_fn fn; } by_ext[] = {

@@ -21,14 +21,24 @@
 #define AUTO_SIZE 64u
 #define MIN_SIZE 8u
 
-enum { PASS_EXTINCTION, PASS_SWEEP, PASS_OCCLUSION };
+enum { PASS_EXTINCTION, PASS_SWEEP, PASS_OCCLUSION, PASS_SCENE_SHADOWS };
 
 void vxl_illumination_release(vxl_illumination_state *s)
 {
     if (s->extinction_tex) s->gpu->gl.DeleteTextures(1, &s->extinction_tex);
     if (s->tex) s->gpu->gl.DeleteTextures(1, &s->tex);
-    vxl_illumination_state kept = {.gpu = s->gpu, .storage = s->storage, .builds = s->builds};
+    if (s->scene_depth_tex) s->gpu->gl.DeleteTextures(1, &s->scene_depth_tex);
+    if (s->transmittance_tex) s->gpu->gl.DeleteTextures(1, &s->transmittance_tex);
+    vxl_shadow_maps_release(&s->shadows);
+    vxl_illumination_state kept = {.gpu = s->gpu, .storage = s->storage, .builds = s->builds, .shadows = s->shadows};
     *s = kept;
+}
+
+/* Issue 18's GL memory: the shadow maps, the occluders, the transmittance images. */
+static uint64_t scene_shadow_bytes(const void *state)
+{
+    const vxl_illumination_state *s = state;
+    return vxl_shadow_maps_bytes(&s->shadows) + s->image_bytes;
 }
 
 void vxl_illumination_init(vxl_illumination_state *s, vxl_gpu *g, vxl_storage_state *st)
@@ -36,6 +46,8 @@ void vxl_illumination_init(vxl_illumination_state *s, vxl_gpu *g, vxl_storage_st
     s->gpu = g;
     s->storage = st;
     vxl_holding_register(g, VXL_HOLD_ILLUMINATION, vxl_holding_counter, &s->bytes);
+    vxl_shadow_maps_init(&s->shadows, g);
+    vxl_holding_register(g, VXL_HOLD_SCENE_SHADOWS, scene_shadow_bytes, s);
 }
 
 /* Light i in voxel space: w = 0 the unit direction towards it, w = 1 its
@@ -299,6 +311,41 @@ static int build_occlusion(vxl_illumination_state *s, const vxl_frame *f, int bl
     return vxl_gl_check(s->gpu, "building the ambient occlusion volume");
 }
 
+/* World units per cell: the longest of a cell's edges in world space. */
+static float cell_world(const vxl_illumination_state *s, const vxl_frame *f)
+{
+    double longest = 0;
+    for (int a = 0; a < 3; a++) {
+        const double *col = f->model + 4 * a;
+        double edge = sqrt(col[0] * col[0] + col[1] * col[1] + col[2] * col[2]) * s->storage->geom.dims[a] / s->cells[a];
+        longest = edge > longest ? edge : longest;
+    }
+    return (float)longest;
+}
+
+/* Light i's block times the visibility through the scene's occluders
+ * (issue 18), cell by cell. The compared point moves half a cell towards
+ * the light, plus the map's texels' depth error, so a cell an occluder
+ * surface cuts is not shadowed by that surface; the filter spans a cell, so
+ * the trilinear read between cells sees a soft, not a stepped, edge. */
+static int apply_scene_shadows(vxl_illumination_state *s, const vxl_frame *f, int i)
+{
+    GLuint prog;
+    int rc = pass_program(s, PASS_SCENE_SHADOWS, 0, s->cells, &prog);
+    if (rc) return rc;
+    vxl_gl *gl = &s->gpu->gl;
+    const float cell = cell_world(s, f);
+    vxl_shadow_maps_bind(&s->shadows, prog, f, i, 0.5f * cell + 1.5f * s->shadows.light[i].texel_world, 0.5f * cell);
+    float model[16];
+    vxl_mat4_to_float(model, f->model);
+    gl->UniformMatrix4fv(gl->GetUniformLocation(prog, "u_model"), 1, GL_FALSE, model);
+    vxl_uniform_i(s->gpu, prog, "u_block", i);
+    gl->BindImageTexture(VXL_IMAGE_OUT, s->tex, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R16F);
+    gl->MemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT); /* image loads of what the sweep stored */
+    dispatch_cells(s, s->cells);
+    return vxl_gl_check(s->gpu, "cutting a light's illumination volume by the scene's shadows");
+}
+
 static int uses_illumination(const vxl_frame *f) { return f->shading && f->shading_model != VXL_SHADING_PHONG; }
 
 int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
@@ -328,15 +375,19 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
     /* the lights and the occlusion follow the extinction and their own grid */
     key = vxl_fnv(key, s->extinction_cells, sizeof s->extinction_cells);
     key = vxl_fnv(key, s->cells, sizeof s->cells);
+    /* issue 18: the occluders' maps first; a light's volume follows its map */
+    if ((rc = vxl_shadow_maps_prepare(&s->shadows, f, s->storage->geom.dims))) return rc;
     for (int i = 0; i < f->light_count; i++) {
         float lv[4], radius;
         light_voxel(f, i, lv, &radius);
         uint64_t k = vxl_fnv(key, lv, sizeof lv);
         k = vxl_fnv(k, &f->light_size[i], sizeof f->light_size[i]);
         k = vxl_fnv(k, &i, sizeof i);
+        if (s->shadows.active) k = vxl_fnv(k, &s->shadows.light[i].key, sizeof s->shadows.light[i].key);
         if (s->light_key[i] == k) continue;
         s->light_key[i] = 0;
         if ((rc = build_light(s, i, lv, radius, f->light_size[i]))) return rc;
+        if (s->shadows.active && (rc = apply_scene_shadows(s, f, i))) return rc;
         s->light_key[i] = k;
         s->rebuilt++;
         s->builds++;

@@ -34,6 +34,7 @@
 
 #include "frame.h"
 #include "gpu.h"
+#include "shadow_maps.h"
 #include "storage.h"
 #include "voxlight.h"
 
@@ -52,13 +53,22 @@ typedef struct vxl_illumination_state {
     int in_use;                 /* the last prepared frame reads it */
     uint32_t rebuilt;           /* volumes the last prepare rebuilt (lights + occlusion) */
     uint32_t builds;            /* every volume built since the renderer opened (tests) */
+    /* Issue 18: the scene's occluders seen from each light; a light's
+     * volume is multiplied by their visibility and keyed by its maps. */
+    vxl_shadow_maps_state shadows;
+    /* vxl_scene_transmittance's images (transmittance.c): the scene depth
+     * in (R32F) and the transmittance out (R32F), of image_w x image_h. */
+    GLuint scene_depth_tex, transmittance_tex;
+    uint32_t image_w, image_h;
+    uint64_t image_bytes;
 } vxl_illumination_state;
 
 /* Wires s to the GL services and the storage, and registers its bytes with the budget. */
 void vxl_illumination_init(vxl_illumination_state *s, vxl_gpu *g, vxl_storage_state *st);
 
 /* Builds what frame f's shading model reads (nothing for Phong or unshaded
- * frames) and binds it on VXL_ILLUMINATION_UNIT. Needs the storage prepared
+ * frames) and binds it on VXL_ILLUMINATION_UNIT. With occluders in f
+ * (issue 18), each light's volume is cut by its shadow maps. Needs the storage prepared
  * for f and the transfer function on VXL_TF_UNIT; uses programs of its own,
  * so call it before the ray caster's program is bound. */
 int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f);

@@ -155,6 +155,9 @@ static void trace(const ref_ctx *c, double px, double py, float *out_rgba, float
         if (!isnan(dd)) t1 = fmin(t1, (-dd - z0) / dz);
     }
     if (!(t0 < t1)) return;
+    double cap[3] = {0, 0, 0}; /* issue 19: clip planes and crop box as cut.glsl (cutters are not modelled) */
+    if (f->cut.any && !vxl_frame_cut_interval(&f->cut, o, dir, &t0, &t1, cap)) return;
+    int capped = f->cut.caps && (cap[0] != 0 || cap[1] != 0 || cap[2] != 0);
     double view_dir[3];
     for (int r = 0; r < 3; r++) view_dir[r] = -(c->mv[r] * dir[0] + c->mv[4 + r] * dir[1] + c->mv[8 + r] * dir[2]);
     double vl = sqrt(view_dir[0] * view_dir[0] + view_dir[1] * view_dir[1] + view_dir[2] * view_dir[2]);
@@ -164,6 +167,11 @@ static void trace(const ref_ctx *c, double px, double py, float *out_rgba, float
         double p[3] = {o[0] + t * dir[0], o[1] + t * dir[1], o[2] + t * dir[2]}, g[3], col[4], gm;
         double alpha = vxl_ref_sample(c, p, c->step, col, g, &gm);
         if (alpha <= 0) continue;
+        if (capped && t < t0 + f->step) { /* the cap: the cut's normal over the first step (cut_cap) */
+            double cl = sqrt(cap[0] * cap[0] + cap[1] * cap[1] + cap[2] * cap[2]), span = c->vol->tex_hi - c->vol->tex_lo;
+            gm = fmax(gm, 1.0);
+            for (int k = 0; k < 3; k++) g[k] = cap[k] / cl * gm * fabs(span);
+        }
         if (f->shading) {
             double pos[3];
             for (int r = 0; r < 3; r++) pos[r] = c->mv[r] * p[0] + c->mv[4 + r] * p[1] + c->mv[8 + r] * p[2] + c->mv[12 + r];

@@ -72,7 +72,7 @@ int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int 
     return VXL_OK;
 }
 
-static void upload_tf(vxl_renderer *r, const vxl_frame *f)
+void vxl_upload_tf(vxl_renderer *r, const vxl_frame *f)
 {
     vxl_gl *gl = &r->gpu.gl;
     if (!r->tf_tex) r->tf_tex = vxl_texture_new(&r->gpu, GL_TEXTURE_1D, GL_LINEAR);
@@ -164,6 +164,8 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     GLuint prog;
     uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2) |
                      (f->gopacity << 4) | r->storage.ops->sample_flags(&r->storage) | (f->shading ? f->shading_model << 8 : 0);
+    flags = vxl_modes_flags(f, flags); /* issue 19: the mode and the MatCap */
+    flags |= vxl_cut_flags(f);         /* issue 19: clip planes, crop box, cutters */
     uint32_t filter = vxl_frame_filter(f);
     int rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
     if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);
@@ -171,17 +173,20 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     if (!rc) rc = ensure_framebuffer(r, f->width, f->height);
     if (rc) return rc;
     gl->GetError();
-    upload_tf(r, f);
+    vxl_upload_tf(r, f);
     if (f->scene_depth) upload_scene_depth(r, f);
     /* bricked storage derives its resident set from the skipping grid */
     if ((f->skip || r->storage.ops->needs_occupancy) && (rc = vxl_skipping_prepare(&r->skipping, f))) return rc;
     if ((rc = r->storage.ops->prepare(&r->storage, f))) return rc;
     if ((rc = vxl_classification_prepare(&r->classification, f))) return rc;
     if ((rc = vxl_illumination_prepare(&r->illumination, f))) return rc; /* shadows, occlusion (issue 17) */
+    if ((rc = vxl_cut_prepare(&r->cut, f))) return rc; /* issue 19: the cutter meshes peeled */
     rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
     if (rc) return rc;
     set_frame_uniforms(r, prog, f);
     vxl_illumination_bind(&r->illumination, prog, f);
+    vxl_cut_bind(&r->cut, prog, f); /* issue 19 */
+    if ((rc = vxl_modes_bind(&r->modes, f, prog)) || (rc = vxl_matcap_prepare(&r->matcap, f, prog))) return rc; /* issue 19 */
     vxl_uniform_i(&r->gpu, prog, "u_skip", f->skip);
     vxl_uniform_i(&r->gpu, prog, "u_brick_size", (int)(r->skipping.bricks.size ? r->skipping.bricks.size : VXL_DEFAULT_BRICK));
     vxl_uniform_i(&r->gpu, prog, "u_brick_distance", VXL_DISTANCE_UNIT);

@@ -65,6 +65,7 @@ static void release_volume(vxl_renderer *r)
     vxl_skipping_release(&r->skipping);
     vxl_classification_release(&r->classification);
     vxl_illumination_release(&r->illumination);
+    vxl_modes_release(&r->modes);
     if (r->storage.ops) r->storage.ops->release(&r->storage);
     r->storage.ops = NULL;
     r->storage.mode = 0;
@@ -79,6 +80,8 @@ static int job_close(void *p)
         delete_texture(r, &r->depth_tex);
         delete_texture(r, &r->scene_depth_tex);
         delete_texture(r, &r->tf_tex);
+        vxl_matcap_release(&r->matcap);
+        vxl_cut_release(&r->cut); /* issue 19: the cutter layers */
         vxl_programs_delete(&r->gpu);
         r->gpu.gl.DeleteFramebuffers(1, &r->fbo);
         r->gpu.gl.DeleteVertexArrays(1, &r->vao);
@@ -102,6 +105,9 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     vxl_skipping_init(&r->skipping, &r->gpu, &r->storage);
     vxl_classification_init(&r->classification, &r->gpu, &r->storage);
     vxl_illumination_init(&r->illumination, &r->gpu, &r->storage);
+    vxl_cut_init(&r->cut, &r->gpu); /* issue 19 cutaways */
+    vxl_modes_init(&r->modes, &r->gpu, &r->skipping, &r->storage);
+    vxl_matcap_init(&r->matcap, &r->gpu);
     r->gpu.budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
     if (opt && opt->struct_size >= offsetof(vxl_renderer_options, page_brick) + sizeof opt->page_brick) {
         if (opt->storage >= VXL_STORAGE_COUNT) {

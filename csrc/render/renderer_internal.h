@@ -7,12 +7,15 @@
 
 #include "classification.h"
 #include "context.h"
+#include "cutaway.h"
 #include "error.h"
 #include "frame.h"
 #include "gl_thread.h"
 #include "gpu.h"
 #include "gradients.h"
 #include "illumination.h"
+#include "matcap.h"
+#include "modes.h"
 #include "skipping.h"
 #include "storage.h"
 #include "voxlight.h"
@@ -35,6 +38,9 @@ struct vxl_renderer {
     vxl_skipping_state skipping;             /* skipping.h */
     vxl_classification_state classification; /* classification.h */
     vxl_illumination_state illumination;     /* illumination.h: shadows and occlusion (issue 17) */
+    vxl_cut_state cut;                       /* cutaway.h: issue 19 clip planes, crop box, cutter layers */
+    vxl_modes_state modes;                   /* modes.h: issue 19 render modes (min-max grid texture) */
+    vxl_matcap_state matcap;                 /* matcap.h: issue 19 MatCap image */
 
     GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex;
     uint32_t fb_w, fb_h;
@@ -43,5 +49,7 @@ struct vxl_renderer {
 
 /* render.c helpers shared with probe.c */
 int vxl_bind_volume_textures(vxl_renderer *r, GLuint prog, uint32_t filter, int store);
+/* the frame's transfer function on VXL_TF_UNIT (also scene_transmittance.c) */
+void vxl_upload_tf(vxl_renderer *r, const vxl_frame *f);
 
 #endif

@@ -14,10 +14,11 @@ import threading
 from . import native, runtime
 
 # Formats the library reads, by name ending (lower case); folders are image
-# stacks or DICOM series. Used for the file browser filter and to name the
-# new object after the file without its extension.
+# stacks, DICOM series or OME-Zarr stores (".zarr", docs/zarr.md). Used for
+# the file browser filter and to name the new object after the file without
+# its extension.
 EXTENSIONS = (".nii.gz", ".nii", ".hdr.gz", ".img.gz", ".hdr", ".img", ".nrrd", ".nhdr", ".mha",
-              ".mhd", ".tiff", ".tif", ".png", ".vdb", ".dcm")
+              ".mhd", ".tiff", ".tif", ".png", ".vdb", ".dcm", ".zarr")
 FILTER_GLOB = ";".join("*" + e for e in EXTENSIONS) + ";DICOMDIR"
 
 

@@ -21,13 +21,14 @@ of the add-on and the tests say `native.X`:
   native_volume        Volume, list_dicom_series
   native_tiles         tile_params, params_digest
   native_renderer      make_params, Renderer
+  native_cutaway       issue 19's cutaway, MatCap and slice structs from plain data
 """
 
 import sys
 import types
 
-from . import (native_abi, native_library, native_private_copy, native_renderer, native_tiles,
-               native_volume)
+from . import (native_abi, native_cutaway, native_library, native_private_copy, native_renderer,
+               native_tiles, native_volume)
 from .native_abi import (ABI_VERSION, BACKENDS, CLASSIFY_MODES, ENUM_FALLBACKS, FILTERS,  # noqa: F401
                          GRADIENT_OPACITY_MODES, MAX_LIGHTS, PRESETS, RENDER_PARAMS_RESERVED,
                          STORAGES, MAX_CLIP_PLANES, MAX_CUTTERS, MODES, INTERPOLATIONS, ClipPlane,
@@ -39,12 +40,13 @@ from .native_library import (LIBRARY_NAME, Library, candidate_paths, filter_name
 from .native_private_copy import (CACHE_DIR, HELPER_PREFIX, OLD_VDB_HELPER_NAME,  # noqa: F401
                                   VDB_HELPER_NAME, cache_roots, clean_stale_copies, helper_names,
                                   private_copy, restore_execute_bit)
+from .native_cutaway import cutaway_struct, matcap_struct, slice_struct  # noqa: F401
 from .native_renderer import Renderer, make_params  # noqa: F401
 from .native_tiles import params_digest, tile_params  # noqa: F401
-from .native_volume import Volume, list_dicom_series, voxel_box_corners  # noqa: F401
+from .native_volume import Volume, list_dicom_series, load_label_table, voxel_box_corners  # noqa: F401
 
 _PARTS = (native_abi, native_private_copy, native_library, native_volume, native_tiles,
-          native_renderer)
+          native_renderer, native_cutaway)
 
 
 class _Binding(types.ModuleType):

@@ -9,9 +9,9 @@ import os
 
 import numpy as np
 
-from .native_abi import (ABI_VERSION, ENUM_FALLBACKS, FILTERS, DicomSeries, LibraryUnavailable,
-                         LoadOptions, PhantomDesc, RendererInfo, RendererOptions, RenderParams,
-                         RenderStats, VolumeDesc, VolumeInfo, VoxlightError, _fptr)
+from .native_abi import (ABI_VERSION, ENUM_FALLBACKS, FILTERS, DicomSeries, LabelEntry,
+                         LibraryUnavailable, LoadOptions, PhantomDesc, RendererInfo, RendererOptions, RenderParams,
+                         RenderStats, SliceParams, VolumeDesc, VolumeInfo, VoxlightError, _fptr)
 from .native_private_copy import helper_names, private_copy, restore_execute_bit
 
 LIBRARY_NAME = "libvoxlight.so"
@@ -52,6 +52,8 @@ def _declare(lib):
         "vxl_volume_destroy": (None, [vp]),
         "vxl_dicom_list_series": (ctypes.c_int, [ctypes.c_char_p, P(DicomSeries), ctypes.c_uint32,
                                                  P(ctypes.c_uint32)]),
+        "vxl_label_table_load": (ctypes.c_int, [ctypes.c_char_p, P(LabelEntry), ctypes.c_uint32,
+                                                P(ctypes.c_uint32)]),
         "vxl_phantom_name": (ctypes.c_char_p, [ctypes.c_uint32]),
         "vxl_phantom_create": (ctypes.c_int, [P(PhantomDesc), P(vp)]),
         "vxl_renderer_create": (ctypes.c_int, [P(RendererOptions), P(vp)]),
@@ -62,10 +64,13 @@ def _declare(lib):
         "vxl_render": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                       P(ctypes.c_float)]),
         "vxl_renderer_get_stats": (ctypes.c_int, [vp, P(RenderStats)]),
+        "vxl_scene_transmittance": (ctypes.c_int, [vp, P(RenderParams), ctypes.c_uint32,
+                                                   P(ctypes.c_float)]),  # issue 18
         "vxl_default_camera": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                               P(ctypes.c_float)]),
         "vxl_probe_gradients": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                                ctypes.c_uint32, P(ctypes.c_float)]),
+        "vxl_render_slice": (ctypes.c_int, [vp, P(RenderParams), P(SliceParams), P(ctypes.c_float)]),
         "vxl_write_image": (ctypes.c_int, [ctypes.c_char_p, P(ctypes.c_float),
                                            P(ctypes.c_float), ctypes.c_uint32,
                                            ctypes.c_uint32]),

@@ -10,8 +10,9 @@ import time
 import numpy as np
 
 from .native_abi import (LibraryObject, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
-                         RendererInfo, RendererOptions, VoxlightError, matrix_from_cm, _fptr,
+                         RendererInfo, RendererOptions, SceneShadows, VoxlightError, matrix_from_cm, _fptr,
                          _matrix_cm, _sized)
+from .native_cutaway import cutaway_struct, matcap_struct, slice_struct
 from .native_library import load_library
 from .native_tiles import _empty_stats, _merge_stats, tile_params
 
@@ -43,7 +44,8 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 tf_rgba=None, classify="post", gradient_opacity="off", gradient_ref=0.0,
                 gradient_exp=0.0, iso_value=0.0, iso_thickness=0.0, preint_size=0,
                 shading_model=0, ambient_occlusion=0.0, occlusion_strength=0.0, anisotropy=0.0,
-                illumination_size=0, lib=None):
+                illumination_size=0, mode="dvr", matcap=None, matcap_key=0, cutaway=None,
+                scene_shadows=None, lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -54,7 +56,16 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     (Library.names("classify"), ...) or their VXL_* numbers, and so is
     `shading_model`. A light may carry a fourth item, its shape
     (spot_direction3, spot_angle, spot_blend, size, as vxl_light_shape);
-    the shapes' array lives as long as the params."""
+    the shapes' array lives as long as the params.
+    Issue 19: `mode` is a render mode's name (Library.names("mode")) or
+    VXL_MODE_*; `matcap` an (h, w, 3|4) linear image (row 0 = bottom) with
+    `matcap_key` its name, or None for the material and lights; `cutaway`
+    a dict as native_cutaway.cutaway_struct takes it, or None. Their structs
+    live as long as the params, and their contents are in _keep.
+    Issue 18: `scene_shadows` is (vertices (n, 3) world, triangles (m, 3)
+    vertex indices, key[, shadow_map_size]), the scene's opaque meshes that
+    shadow the volume; key 0 lets the library hash the arrays, a nonzero key
+    names this version of them (the same key: no shadow map is rebuilt)."""
     lib = lib or load_library()
     p = _sized(RenderParams)
     p.width, p.height = int(width), int(height)
@@ -133,7 +144,43 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     p.early_termination = early_termination
     p.depth_threshold = depth_threshold
     p.no_skip = 1 if no_skip else 0
+    _issue19_inputs(p, lib, mode, matcap, matcap_key, cutaway)
+    if scene_shadows is not None:
+        _set_scene_shadows(p, *scene_shadows)
     return p
+
+
+def _set_scene_shadows(p, vertices, triangles, key=0, shadow_map_size=0):
+    """params.scene_shadows from numpy-able arrays; the arrays and the
+    struct live as long as p. The digest (native_tiles.params_digest) sees
+    the key, or the arrays themselves when the key is 0."""
+    v = np.ascontiguousarray(vertices, dtype=np.float32).reshape(-1, 3)
+    t = np.ascontiguousarray(triangles, dtype=np.uint32).reshape(-1, 3)
+    s = _sized(SceneShadows)
+    s.occluder_vertex_count, s.occluder_triangle_count = len(v), len(t)
+    s.occluder_vertices = _fptr(v)
+    s.occluder_indices = t.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32))
+    s.shadow_map_size = int(shadow_map_size)
+    s.occluder_key = int(key) & 0xFFFFFFFFFFFFFFFF
+    p._scene_shadows = s
+    p._occluders = (v, t)
+    p._keep.append(np.array([s.occluder_key, len(v), len(t), s.shadow_map_size], np.uint64))
+    if not s.occluder_key:
+        p._keep.extend((v, t))
+    p.scene_shadows = ctypes.pointer(s)
+
+
+def _issue19_inputs(p, lib, mode, matcap, matcap_key, cutaway):
+    """The render mode, MatCap and cutaway of make_params."""
+    p.mode = mode if isinstance(mode, int) else lib.index("mode", mode)
+    if cutaway is not None:
+        p._cutaway, arrays = cutaway_struct(cutaway)
+        p._keep.extend(arrays)
+        p.cutaway = ctypes.pointer(p._cutaway)
+    if matcap is not None:
+        p._matcap, arrays = matcap_struct(matcap, matcap_key)
+        p._keep.extend(arrays)
+        p.matcap = ctypes.pointer(p._matcap)
 
 
 # -------------------------------------------------------------- renderer
@@ -193,6 +240,19 @@ class Renderer(LibraryObject):
         if self.on_render is not None:
             self.on_render()
         return rgba, depth
+
+    def scene_transmittance(self, params, light=0):
+        """The volume's shadow on the scene (issue 18): for every pixel of
+        params' scene_depth, the transmittance from that scene point to
+        light `light` (an index into params' lights) through the volume;
+        (h, w) float32, row 0 = bottom, 1 where the path misses the volume
+        or there is no geometry. Multiply the light's direct pass by it."""
+        w, h = params.width or 512, params.height or 512
+        out = np.empty((h, w), np.float32)
+        self._check(self.lib.cdll.vxl_scene_transmittance(self.handle, ctypes.byref(params),
+                                                          int(light), _fptr(out)),
+                    "scene transmittance")
+        return out
 
     def stats(self):
         """What the last render did (vxl_renderer_get_stats) as a dict."""
@@ -265,6 +325,23 @@ class Renderer(LibraryObject):
                                                       _fptr(pts), len(pts), _fptr(out)),
                     "probe gradients")
         return out
+
+    def render_slice(self, params, plane_to_world, interpolation="linear"):
+        """The volume resampled on a plane (vxl_render_slice): plane_to_world
+        is a 4x4 math matrix whose square [-1, 1]^2 at z = 0 is the slice
+        (a Blender plane's matrix_world); params gives the size, the
+        volume's placement (model), the window and the colour map.
+        interpolation: "nearest", "linear", "cubic" or VXL_INTERP_*.
+        Returns rgba[h, w, 4] float32, row 0 = bottom: the colour map's
+        colour with alpha 1 inside the volume's box, 0 outside."""
+        interp = (interpolation if isinstance(interpolation, int)
+                  else self.lib.index("interpolation", interpolation))
+        s = slice_struct(plane_to_world, interp)
+        w, h = params.width or 512, params.height or 512
+        rgba = np.empty((h, w, 4), np.float32)
+        self._check(self.lib.cdll.vxl_render_slice(self.handle, ctypes.byref(params),
+                                                   ctypes.byref(s), _fptr(rgba)), "slice")
+        return rgba
 
     def close(self):
         if self._handle:

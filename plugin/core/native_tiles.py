@@ -20,6 +20,9 @@ def params_digest(params, *extra):
     c.scene_depth = None
     c.tf_rgba = None
     c.light_shapes = None  # their contents are in _keep
+    c.cutaway = None  # issue 19: so are the cutaway's and the MatCap's
+    c.matcap = None
+    c.scene_shadows = None  # issue 18: its key (or arrays) are in _keep
     h = hashlib.blake2b(bytes(c), digest_size=16)
     for a in getattr(params, "_keep", ()):
         a = np.ascontiguousarray(a)
@@ -65,6 +68,9 @@ def tile_params(params, x0, y0, x1, y1):
     if shapes is not None:  # the same light shapes
         t._keep.append(shapes)
         t._shapes = shapes
+    for name in ("_cutaway", "_matcap", "_scene_shadows", "_occluders"):  # the copy points at the same structs (holding their arrays)
+        if hasattr(params, name):
+            setattr(t, name, getattr(params, name))
     t.width, t.height = x1 - x0, y1 - y0
     a, b = 2.0 * x0 / W - 1.0, 2.0 * x1 / W - 1.0
     c, d = 2.0 * y0 / H - 1.0, 2.0 * y1 / H - 1.0

@@ -1,6 +1,6 @@
 """Volumes held by libvoxlight: loaded from a file, made from a numpy array
 or generated (phantoms), with their information and histogram; the series
-of a DICOM folder.
+of a DICOM folder; the label lookup table of a segmentation.
 
 Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
@@ -9,7 +9,7 @@ import os
 
 import numpy as np
 
-from .native_abi import (DicomSeries, LibraryObject, LoadOptions, PhantomDesc, VolumeDesc,
+from .native_abi import (DicomSeries, LabelEntry, LibraryObject, LoadOptions, PhantomDesc, VolumeDesc,
                          VolumeInfo, VoxlightError, matrix_from_cm, _DTYPES, _sized)
 from .native_library import load_library
 
@@ -168,6 +168,22 @@ def list_dicom_series(path, lib=None):
              "problem": text(s.problem), "gantry_tilt_deg": s.gantry_tilt_deg,
              "frame_count": s.frame_count}
             for s in arr[:n.value]]
+
+
+def load_label_table(path, lib=None):
+    """The labels of a lookup file (FreeSurfer LUT, ITK-SNAP label
+    description, 3D Slicer .ctbl, MRIcron .lut/.txt; docs/labels.md) as
+    dicts (id, name, color: straight RGBA 0..1, visible: bool), sorted by
+    id. Raises VoxlightError with the library's message on a bad file."""
+    lib = lib or load_library()
+    n = ctypes.c_uint32()
+    lib.check(lib.cdll.vxl_label_table_load(os.fsencode(path), None, 0, ctypes.byref(n)))
+    arr = (LabelEntry * max(1, n.value))()
+    arr[0].struct_size = ctypes.sizeof(LabelEntry)
+    lib.check(lib.cdll.vxl_label_table_load(os.fsencode(path), arr, n.value, ctypes.byref(n)))
+    return [{"id": e.id, "name": e.name.decode("utf-8", "replace"), "color": tuple(e.color),
+             "visible": bool(e.visible)}
+            for e in arr[:n.value]]
 
 
 def voxel_box_corners(dims):

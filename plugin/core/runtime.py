@@ -55,6 +55,9 @@ class Job:
         self.error = None    # the exception when the library failed
         self.submitted = time.monotonic()
         self.full = False    # the viewport's last refine step (full resolution), not the half
+        # Other work than a banded frame (the viewport's scene shadows): called
+        # on the worker as run(should_stop); its return value is the result.
+        self.run = None
 
     @property
     def pending(self):
@@ -126,9 +129,11 @@ class Worker:
             result = error = None
             if not job.cancelled:
                 try:
-                    result = self.entry.renderer.render_tiled(
-                        job.params, rect=job.rect, target_seconds=self.target_seconds,
-                        should_stop=lambda: job.cancelled or self._stop)
+                    stop = lambda: job.cancelled or self._stop  # noqa: E731
+                    result = job.run(stop) if job.run is not None else \
+                        self.entry.renderer.render_tiled(
+                            job.params, rect=job.rect, target_seconds=self.target_seconds,
+                            should_stop=stop)
                 except Exception as e:  # reported by the main thread
                     error = e
             with self._cond:
@@ -136,7 +141,10 @@ class Worker:
                 job.error = error
                 if job.cancelled:  # went stale during its last band
                     result = None
-                if result is not None:
+                if result is not None and job.run is not None:
+                    job.result = result
+                    self._finish(job)
+                elif result is not None:
                     job.result = result
                     self.entry.last_frame = dict(result[2], width=job.params.width,
                                                  height=job.params.height, kind="refined")

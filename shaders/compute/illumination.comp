@@ -18,6 +18,10 @@
 //     the disc it covers seen from the cell (soft shadows).
 //  2  occlusion: per cell, the mean transmittance over 14 directions along
 //     rays of u_radius voxels (local ambient occlusion, Hernell et al. 2010).
+//  3  scene shadows (issue 18): a light's block, swept, times the
+//     visibility of each cell's centre through the scene's occluders
+//     (lib/shadow_maps.glsl), in place. The product is the cell's direct
+//     transmittance: the volume's and the meshes' attenuate the same path.
 // The results go to u_dst at z offset u_block * u_cells.z: the lights and the
 // occlusion share one texture (lib/illumination.glsl reads it).
 #include "lib/common.glsl"
@@ -69,6 +73,8 @@ void main()
             }
     imageStore(u_dst, c, vec4(depth / float(u_sub.x * u_sub.y * u_sub.z)));
 }
+#elif PASS == 3
+layout(r16f, binding = VXL_IMAGE_OUT) uniform image3D u_dst; // read and written: each cell its own texel
 #else
 layout(r16f, binding = VXL_IMAGE_OUT) writeonly uniform image3D u_dst;
 uniform sampler3D u_extinction; // pass 0's result, trilinear
@@ -186,5 +192,19 @@ void main()
         sum += exp(-depth);
     }
     store(c, sum / 14.0);
+}
+#endif
+
+#if PASS == 3
+#include "lib/shadow_maps.glsl"
+uniform mat4 u_model; // voxel -> world
+
+void main()
+{
+    ivec3 c = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(c, u_cells))) return;
+    float v = shadow_visibility((u_model * vec4(cell_centre(c), 1.0)).xyz);
+    ivec3 t = c + ivec3(0, 0, u_block * u_cells.z);
+    if (v < 1.0) imageStore(u_dst, t, imageLoad(u_dst, t) * v);
 }
 #endif

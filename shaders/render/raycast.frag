@@ -6,6 +6,8 @@
 #include "lib/gradients.glsl"
 #include "lib/classify.glsl"
 #include "lib/shading.glsl"
+#include "lib/cut.glsl" // issue 19 cutaways: CUT_CONVEX, CUT_CUTTERS
+#include "lib/matcap.glsl"
 
 #ifndef GOPACITY
 #define GOPACITY 0
@@ -103,7 +105,10 @@ bool add_sample(inout Compositing s, RaySetup r, int i, float t, vec3 p, float v
     s.last_shaded = i;
     g = reuse_gradient(s.gs, g);
 #endif
-#if SHADING_MODEL > 0
+    CUT_CAP(g, t); // issue 19: the first sample behind a cut takes the cut's normal (lib/cut.glsl)
+#ifdef MATCAP
+    rgb = shade_matcap(rgb, g, r.lighting.v); // issue 19: lib/matcap.glsl
+#elif SHADING_MODEL > 0
     rgb = shade_lit(rgb, g, r.pos0 + t * r.dpos, p, r.lighting, r.one_directional); // shadows, occlusion
 #else
     rgb = shade(rgb, g, r.pos0 + t * r.dpos, r.lighting, r.one_directional);
@@ -156,6 +161,16 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
         for (; i < u_max_steps; i++) {
             t = t_start + float(i) * u_step;
             if (t >= t1) break;
+#ifdef CUT_CUTTERS
+            int cut_next = cut_leap(i, t, t_start, u_step, u_max_steps); // issue 19: removed by a cutter
+            if (cut_next >= 0) {
+#ifdef CLASSIFY_PREINT
+                v_prev = sample_value(o + (t_start + float(cut_next) * u_step) * dir); // a segment starts as a point
+#endif
+                i = cut_next - 1;
+                continue;
+            }
+#endif
             p = o + t * dir;
             int leap = -1;
             if (u_skip != 0) {
@@ -217,6 +232,12 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
     return s.acc;
 }
 
+// issue 19: MIP, MinIP, average and ISO (lib/modes.glsl) replace march in main().
+#include "lib/modes.glsl"
+#if MODE != 0
+#define march mode_march
+#endif
+
 void main()
 {
     vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
@@ -253,6 +274,9 @@ void main()
         if (!isnan(d)) t1 = min(t1, (-d - z0) / dz);
     }
     if (!(t0 < t1)) { emit_nothing(); return; }
+#ifdef CUT_ANY
+    if (!cut_begin(o, dir, z0, dz, t0, t1)) { emit_nothing(); return; } // issue 19: only the kept part (lib/cut.glsl)
+#endif
 
     // View-space position is affine in t too: no matrix product per sample.
     RaySetup r;

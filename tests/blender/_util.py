@@ -176,6 +176,25 @@ def reset_scene():
     return scene
 
 
+def black_cycles_scene(size, samples=4):
+    """An empty scene rendering size x size pixels in Cycles on the CPU with
+    a black world and the Standard view transform, so a pixel's colour is
+    what was rendered and composited."""
+    scene = reset_scene()
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False  # Debian's Cycles has no OIDN
+    scene.cycles.device = "CPU"
+    scene.render.resolution_x = scene.render.resolution_y = size
+    scene.render.film_transparent = False
+    if scene.world.node_tree is not None:  # (World.use_nodes is deprecated in 5.0)
+        scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
+    scene.world.color = (0.0, 0.0, 0.0)
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    return scene
+
+
 def add_camera(location, target=(0.0, 0.0, 0.0), lens=50.0, name="Camera"):
     from mathutils import Vector
     cam = bpy.data.objects.new(name, bpy.data.cameras.new(name))

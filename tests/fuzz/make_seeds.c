@@ -1,7 +1,7 @@
 /* make_seeds.c - writes the seed corpus for the fuzz targets: small valid
  * files of every format and the main variants (types, byte orders,
  * compression, geometry, pages, channels).
- *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png,dicom}/seed_*
+ *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png,dicom,label_table}/seed_*
  * Built and run by `make fuzz-seeds` (./build.sh test / fuzz). */
 #include <stdint.h>
 #include <stdio.h>
@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "fuzz/dicom_writer.h"
+#include "fuzz/label_table_samples.h"
 #include "fuzz/writers.h"
 #include "nifti_writer.h"
 
@@ -136,5 +137,20 @@ int main(int argc, char **argv)
     d.frames = 2;
     ok(dcmw_write(path("dicom", "seed_multiframe.dcm"), &d), "dicom multiframe");
     free(i16_be);
+
+    /* label tables: every format's sample, the first byte picking the file */
+    unsigned char pal[768];
+    lt_palette(pal);
+    ok(lt_write_seed(path("label_table", "seed_freesurfer"), LT_MODE_TXT, lt_freesurfer, sizeof lt_freesurfer - 1, NULL, 0),
+       "label freesurfer");
+    ok(lt_write_seed(path("label_table", "seed_slicer"), LT_MODE_CTBL, lt_slicer, sizeof lt_slicer - 1, NULL, 0),
+       "label slicer");
+    ok(lt_write_seed(path("label_table", "seed_itksnap"), LT_MODE_LABEL, lt_itksnap, sizeof lt_itksnap - 1, NULL, 0),
+       "label itk-snap");
+    ok(lt_write_seed(path("label_table", "seed_names"), LT_MODE_TXT, lt_names, sizeof lt_names - 1, NULL, 0),
+       "label names");
+    ok(lt_write_seed(path("label_table", "seed_lut"), LT_MODE_LUT, pal, sizeof pal, NULL, 0), "label lut");
+    ok(lt_write_seed(path("label_table", "seed_pair"), LT_MODE_PAIR, pal, sizeof pal, lt_names, sizeof lt_names - 1),
+       "label pair");
     return failures ? 1 : 0;
 }

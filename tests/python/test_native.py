@@ -376,7 +376,7 @@ def test_render_params_tail_matches_header():
     """Issue 6's fields replaced the reserved slots, keeping the size (624
     bytes up to reserved[0]) until issue 15 gave the struct new reserved room
     after them (offsets and sizes against the compiler: test_abi.py), from
-    which issues 16 and 17 took their fields: the oldest layout still ends
+    which issues 16 to 19 took their fields: the oldest layout still ends
     where the first of them begins plus one word."""
     import ctypes
     P = native.RenderParams
@@ -384,11 +384,13 @@ def test_render_params_tail_matches_header():
     assert ctypes.sizeof(P) == 688
     assert ctypes.sizeof(P) == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
-    names = [n for n, _t in P._fields_][-14:]
+    names = [n for n, _t in P._fields_][-18:]
     assert names == ["preint_size", "gradient_opacity", "gradient_ref", "gradient_exp",
                      "iso_value", "iso_thickness", "shading_model", "light_shapes",
                      "ambient_occlusion", "occlusion_strength", "anisotropy", "illumination_size",
-                     "technique", "reserved"]
+                     "technique", "mode", "cutaway", "scene_shadows", "matcap", "reserved"]
+    # the pointers of issues 18 and 19 sit on their 8-byte alignment
+    assert P.cutaway.offset % 8 == 0 and P.matcap.offset + 8 == P.reserved.offset
 
 
 def test_make_params_transfer_function_and_modes(lib):

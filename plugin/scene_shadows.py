@@ -1,0 +1,344 @@
+"""The volume in the scene's light (issue 18), on the Blender side:
+
+* receive_shadows: the scene's opaque meshes (objects whose Shadow ray
+  visibility is on) go to the library as params.scene_shadows, so they
+  shadow the volume (occluders());
+* cast_shadows, F12: per light group a "Voxlight Shadow <group>" image
+  (1 - the transmittance from each visible scene point to the group's
+  lights, vxl_scene_transmittance on the F12 z-buffer) that the compositor
+  chain multiplies the group's light by (prepare_render(), write_render();
+  the plan is core/shadow_plan.py, the nodes compositor.py);
+* cast_shadows, viewport: a multiply layer drawn under the volumes
+  (viewport_layer(), scene_shadows_viewport.py).
+
+Light groups the add-on makes are recorded on each light and taken back by
+revert() when no volume casts shadows any more.
+"""
+
+import hashlib
+
+import bpy
+import numpy as np
+from bpy.app.handlers import persistent
+
+from . import compositor
+from .core import lights as _lights
+from .core import native, scene_geometry, shadow_plan
+
+_SOLID = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
+
+# Bumped by depsgraph_update_post whenever an object's geometry changed
+# (edit mode, modifiers, ...): part of the occluders' key, so the key (and
+# the library's shadow maps) change only when a mesh, a transform or the
+# set of meshes changes, without hashing the vertices.
+_geometry_version = 0
+_cache = {"key": None, "value": None}
+
+note = ""  # how the last F12 applied the volume's shadows, for the panel ("" = exactly)
+
+
+# ---------------------------------------------------------------- occluders
+
+def _casts_shadow(inst, for_render):
+    orig = inst.object.original
+    if for_render and orig.hide_render:
+        return False
+    if not for_render and not getattr(inst, "is_instance", False) and not orig.visible_get():
+        return False
+    return getattr(orig, "visible_shadow", True)  # Object › Visibility › Shadow (3.0+)
+
+
+def _instances(depsgraph, for_render):
+    return [(inst.object, np.array(inst.matrix_world, np.float64))
+            for inst in depsgraph.object_instances
+            if inst.object.type in _SOLID and _casts_shadow(inst, for_render)]
+
+
+def occluder_key(depsgraph, for_render=True):
+    """uint64 key of the occluders: which objects, their matrices, the
+    geometry version and (F12, where animation may deform meshes without an
+    update) the frame."""
+    h = hashlib.blake2b(digest_size=8)
+    h.update(repr((_geometry_version, for_render,
+                   depsgraph.scene.frame_current if for_render else 0)).encode())
+    for ob, mw in _instances(depsgraph, for_render):
+        h.update(("%s\0%s\0" % (ob.original.name, ob.data.name if ob.data else "")).encode())
+        h.update(mw.tobytes())
+    return int.from_bytes(h.digest(), "little") or 1
+
+
+def occluders(depsgraph, for_render=True):
+    """(vertices (n, 3) float32 world, triangles (m, 3) uint32, key) of the
+    scene's shadow-casting solids, or None when there are none. Rebuilt
+    only when the key changes."""
+    key = occluder_key(depsgraph, for_render)
+    if _cache["key"] == key:
+        return _cache["value"]
+    verts, tris, base = [], [], 0
+    for ob, mw in _instances(depsgraph, for_render):
+        arrays = scene_geometry.mesh_arrays(ob, mw)
+        if arrays is None:
+            continue
+        co, t = arrays
+        verts.append(co.astype(np.float32))
+        tris.append(t + base)
+        base += len(co)
+    value = None
+    if verts:
+        value = (np.ascontiguousarray(np.concatenate(verts)),
+                 np.ascontiguousarray(np.concatenate(tris), np.uint32), key)
+    _cache["key"], _cache["value"] = key, value
+    return value
+
+
+def receives(props):
+    """Whether a volume is shadowed by the meshes: its switch, and a model
+    with shadows (Phong has none to cut)."""
+    return bool(props.receive_shadows) and props.shading_model != "phong"
+
+
+_viewport = {"value": None}  # the viewport's occluders of the current draw
+
+
+def refresh_viewport(depsgraph, objs):
+    """Viewport draw: the occluders for the volumes in `objs` that receive
+    shadows (recomputed only when their key changes), for for_viewport()."""
+    _viewport["value"] = occluders(depsgraph, for_render=False) \
+        if any(receives(o.voxlight) for o in objs) else None
+
+
+def for_viewport(ob):
+    """params.build's scene_shadows for volume `ob` in this draw."""
+    return _viewport["value"] if receives(ob.voxlight) else None
+
+
+@persistent
+def _on_depsgraph_update(scene, depsgraph=None, *args):
+    global _geometry_version
+    if depsgraph is None:
+        return
+    for update in depsgraph.updates:
+        ident = update.id
+        if not update.is_updated_geometry:
+            continue
+        if isinstance(ident, bpy.types.Object) and ident.type in _SOLID or \
+                isinstance(ident, (bpy.types.Mesh, bpy.types.Curve, bpy.types.MetaBall)):
+            _geometry_version += 1
+            return
+
+
+# ------------------------------------------------------------------- lights
+
+def named_lights(depsgraph, for_render):
+    """[(light object name, its light group, lights.SceneLight)] in the
+    order and number lights.collect gives (strongest first, at most 8)."""
+    out = []
+    for inst in depsgraph.object_instances:
+        ob = inst.object
+        if ob.type != "LIGHT" or not _lights._shown(inst, for_render):
+            continue
+        if ob.data.type not in ("SUN", "POINT", "SPOT", "AREA"):
+            continue
+        orig = ob.original
+        out.append((orig.name, getattr(orig, "lightgroup", ""),
+                    _lights.scene_light(ob.data.type, np.array(inst.matrix_world), ob.data)))
+    out.sort(key=lambda n: -n[2].intensity * max(n[2].color))
+    return out[:native.MAX_LIGHTS]
+
+
+def _weight(light):
+    return float(light.intensity) * float(max(light.color))
+
+
+# --------------------------------------------------------------------- F12
+
+def _casting_volumes(scene):
+    return [o for o in scene.objects
+            if o.voxlight.is_volume and not o.hide_render and o.voxlight.cast_shadows]
+
+
+def _render_layer(scene):
+    """The view layer whose passes the compositor's Render Layers reads."""
+    from . import compat
+    tree = compat.compositor_tree(scene, create=False)
+    rls = [n for n in tree.nodes if n.bl_idname == "CompositorNodeRLayers"] if tree else []
+    name = rls[0].layer if rls else ""
+    return scene.view_layers.get(name) or scene.view_layers[0]
+
+
+def _plan_lights(scene):
+    return [shadow_plan.Light(o.name, getattr(o, "lightgroup", ""),
+                              str(o.get(shadow_plan.ASSIGNED_PROP, "")))
+            for o in scene.objects if o.type == "LIGHT" and not o.hide_render]
+
+
+def _set_passes(scene, view_layer, on):
+    """Turn on (or back off) the direct diffuse and glossy passes the
+    fallback reads; only switches the add-on turned on are turned off."""
+    key = "voxlight_shadow_passes"
+    done = list(scene.get(key, []))
+    if on:
+        for sw in shadow_plan.PASS_SWITCHES:
+            if not getattr(view_layer, sw):
+                setattr(view_layer, sw, True)
+                done.append("%s/%s" % (view_layer.name, sw))
+        scene[key] = done
+        return
+    for item in done:
+        layer, _s, sw = item.partition("/")
+        vl = scene.view_layers.get(layer)
+        if vl is not None and hasattr(vl, sw):
+            setattr(vl, sw, False)
+    if key in scene:
+        del scene[key]
+
+
+def revert(scene):
+    """Take back everything the shadows set up: the compositor chain, the
+    light groups the add-on gave lights (unless the user changed them since)
+    and made, and the passes it turned on."""
+    compositor.remove_shadow_chain(scene)
+    lights = [shadow_plan.Light(o.name, getattr(o, "lightgroup", ""),
+                                str(o.get(shadow_plan.ASSIGNED_PROP, "")))
+              for o in scene.objects if o.type == "LIGHT"]
+    for vl in scene.view_layers:
+        groups = getattr(vl, "lightgroups", None)
+        if groups is None:
+            continue
+        _reset, remove = shadow_plan.revert(lights, [g.name for g in groups])
+        for name in remove:
+            _remove_lightgroup(scene, vl, name)
+    reset, _remove = shadow_plan.revert(lights)
+    for name in reset:
+        scene.objects[name].lightgroup = ""
+    for o in scene.objects:
+        if o.type == "LIGHT" and shadow_plan.ASSIGNED_PROP in o:
+            del o[shadow_plan.ASSIGNED_PROP]
+    _set_passes(scene, None, False)
+
+
+def _remove_lightgroup(scene, view_layer, name):
+    """Remove one light group: the collection's remove() where it has one
+    (4.x+), else (3.x) the operator on the view layer's active group."""
+    groups = view_layer.lightgroups
+    g = groups.get(name)
+    if g is None:
+        return
+    if hasattr(groups, "remove"):
+        groups.remove(g)
+        return
+    view_layer.active_lightgroup_index = [x.name for x in groups].index(name)
+    with bpy.context.temp_override(scene=scene, view_layer=view_layer):
+        bpy.ops.scene.view_layer_remove_lightgroup()
+
+
+_plan = {}  # scene name -> (mode, {group: [light names]}) of the render being made
+
+
+def prepare_render(scene, width, height):
+    """render_init / render_pre: light groups (or passes), shadow images
+    cleared to no shadow, and the compositor chain, when a volume casts
+    shadows; otherwise revert(). Sets `note` for the fallback."""
+    global note
+    note = ""
+    _plan.pop(scene.name, None)
+    if not _casting_volumes(scene) or scene.voxlight.render_separate_layer \
+            or not scene.voxlight.use_scene_lights:
+        revert(scene)
+        if scene.voxlight.render_separate_layer and _casting_volumes(scene):
+            note = "Separate Layer: the volume casts no shadows in renders"
+        return
+    vl = _render_layer(scene)
+    mode, why = shadow_plan.choose_mode(scene.render.engine, hasattr(vl, "lightgroups"))
+    if mode == shadow_plan.MODE_LIGHT_GROUPS:
+        _set_passes(scene, vl, False)
+        plan = shadow_plan.plan_groups(_plan_lights(scene), [g.name for g in vl.lightgroups])
+        for g in plan.create:
+            vl.lightgroups.add(name=g)
+        for name, g in plan.assign.items():
+            ob = scene.objects[name]
+            ob.lightgroup = g
+            ob[shadow_plan.ASSIGNED_PROP] = g
+        groups = plan.groups
+        images = [shadow_plan.image_name(g) for g in groups]
+    else:
+        revert(scene)
+        _set_passes(scene, vl, True)
+        groups = {}
+        images = [shadow_plan.KEY_IMAGE]
+        note = why
+    for name in images:
+        compositor.write_shadow_image(name, width, height, None)
+    problem = compositor.ensure_shadow_chain(scene, shadow_plan.node_plan(mode, list(groups)))
+    if problem:
+        note = "No volume shadows in the render: " + problem
+        return
+    _plan[scene.name] = (mode, groups)
+    if note:
+        print("Voxlight: %s" % note)
+
+
+def transmittances(frame, depth, width, height):
+    """{light index: (height, width) transmittance through every casting
+    volume}, from the volumes `frame` lists (offline.render's frame_info)."""
+    out = {}
+    for entry, kwargs in frame["casters"]:
+        p = native.make_params(width=width, height=height, scene_depth=depth, **kwargs)
+        for i in range(len(kwargs["lights"])):
+            t = entry.renderer.scene_transmittance(p, i)
+            out[i] = t if i not in out else out[i] * t
+    return out
+
+
+def write_render(scene, frame, width, height):
+    """frame_change_post of an F12 render: fill the shadow images of the
+    plan prepare_render made from the frame's z-buffer and lights."""
+    planned = _plan.get(scene.name)
+    if planned is None:
+        return
+    mode, groups = planned
+    named = frame["named_lights"]
+    trans = transmittances(frame, frame["depth"], width, height) if named else {}
+    index = {name: i for i, (name, _g, _l) in enumerate(named)}
+    weight = {name: _weight(l) for name, _g, l in named}
+    if mode == shadow_plan.MODE_DIRECT:
+        t = trans.get(0)  # the key light: the strongest
+        compositor.write_shadow_image(shadow_plan.KEY_IMAGE, width, height,
+                                      None if t is None else 1.0 - t)
+        return
+    for g, members in groups.items():
+        members = [m for m in members if m in index and index[m] in trans]
+        t = None
+        for m, share in shadow_plan.group_weights(members, weight).items():
+            part = share * trans[index[m]]
+            t = part if t is None else t + part
+        compositor.write_shadow_image(shadow_plan.image_name(g), width, height,
+                                      None if t is None else 1.0 - t)
+
+
+def clear_render(scene):
+    """The frame failed or shows nothing: every shadow image to no shadow."""
+    planned = _plan.get(scene.name)
+    if planned is None:
+        return
+    mode, groups = planned
+    names = [shadow_plan.KEY_IMAGE] if mode == shadow_plan.MODE_DIRECT else \
+        [shadow_plan.image_name(g) for g in groups]
+    for name in names:
+        img = bpy.data.images.get(name)
+        if img is not None:
+            compositor.write_shadow_image(name, img.size[0], img.size[1], None)
+
+
+def register():
+    if _on_depsgraph_update not in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph_update)
+
+
+def unregister():
+    lst = bpy.app.handlers.depsgraph_update_post
+    for h in list(lst):
+        if h is _on_depsgraph_update or getattr(h, "__name__", "") == _on_depsgraph_update.__name__ \
+                and getattr(h, "__module__", "") == _on_depsgraph_update.__module__:
+            lst.remove(h)
+    _cache["key"] = _cache["value"] = None

@@ -1,0 +1,70 @@
+"""runtime.Worker runs Jobs with `run` (the viewport's scene shadows,
+issue 18) on the renderer's thread like banded frames: the result comes
+back, a newer job of the same owner replaces a queued one, and a job
+cancelled while it runs ends with no result."""
+
+import threading
+import time
+import types
+
+from voxlight.core import runtime
+
+
+def _wait(pred, timeout=10.0):
+    end = time.monotonic() + timeout
+    while not pred():
+        assert time.monotonic() < end, "timed out"
+        time.sleep(0.005)
+
+
+def _worker():
+    # run() never touches the entry's renderer: a stand-in is enough.
+    return runtime.Worker(types.SimpleNamespace(renderer=None, last_frame=None))
+
+
+def test_a_run_job_gives_its_return_value():
+    w = _worker()
+    try:
+        job = runtime.Job("owner", "key", None)
+        job.run = lambda stop: ("shadow", stop())
+        w.submit(job)
+        _wait(lambda: job.done)
+        assert job.result == ("shadow", False) and job.error is None and not job.cancelled
+    finally:
+        w.close()
+
+
+def test_a_run_job_cancelled_while_running_has_no_result():
+    w = _worker()
+    started, release = threading.Event(), threading.Event()
+
+    def slow(stop):
+        started.set()
+        release.wait(5.0)
+        return None if stop() else "stale"
+    try:
+        job = runtime.Job("owner", "key", None)
+        job.run = slow
+        w.submit(job)
+        assert started.wait(5.0)
+        newer = runtime.Job("owner", "key2", None)
+        newer.run = lambda stop: "fresh"
+        w.submit(newer)   # cancels the running one of the same owner
+        release.set()
+        _wait(lambda: job.done and newer.done)
+        assert job.result is None and job.cancelled
+        assert newer.result == "fresh"
+    finally:
+        w.close()
+
+
+def test_errors_are_kept_for_the_main_thread():
+    w = _worker()
+    try:
+        job = runtime.Job("owner", "key", None)
+        job.run = lambda stop: 1 / 0
+        w.submit(job)
+        _wait(lambda: job.done)
+        assert isinstance(job.error, ZeroDivisionError) and job.result is None
+    finally:
+        w.close()

@@ -16,6 +16,7 @@ static const char *const shading_model_names[VXL_SHADING_COUNT] = {"phong", "sha
 static const char *const technique_names[VXL_TECHNIQUE_COUNT] = {"raycast", "slices2d", "slices3d"};
 static const char *const mode_names[VXL_MODE_COUNT] = {"dvr", "mip", "minip", "average", "iso"};
 static const char *const interpolation_names[VXL_INTERP_COUNT] = {"nearest", "linear", "cubic"};
+static const char *const label_mode_names[VXL_LABEL_MODE_COUNT] = {"surface", "mask", "tint"};
 static const char *const backend_names[VXL_BACKEND_COUNT] = {"auto", "osmesa", "egl"};
 static const char *const dtype_names[VXL_DTYPE_COUNT] = {NULL,    "uint8", "int8",    "uint16", "int16",
                                                          "uint32", "int32", "float32", "float64"};
@@ -47,6 +48,7 @@ VXL_NAMES(shading_model, shading_model_names, VXL_SHADING_COUNT, "shading model"
 VXL_NAMES(technique, technique_names, VXL_TECHNIQUE_COUNT, "technique")
 VXL_NAMES(mode, mode_names, VXL_MODE_COUNT, "render mode")
 VXL_NAMES(interpolation, interpolation_names, VXL_INTERP_COUNT, "interpolation")
+VXL_NAMES(label_mode, label_mode_names, VXL_LABEL_MODE_COUNT, "label mode")
 
 
 const char *vxl_dtype_name(uint32_t dtype) { return dtype < VXL_DTYPE_COUNT ? dtype_names[dtype] : NULL; }

@@ -464,6 +464,38 @@ typedef struct vxl_scene_shadows {
                                         unchanged, no rebuild); 0: the library hashes them */
 } vxl_scene_shadows;
 
+/* Label maps (issue 20), params.labels with a label volume set by
+ * vxl_renderer_set_labels. Label ids are never interpolated as numbers: the
+ * boundary of each label is the 0.5 level of its indicator function
+ * (1 inside the label's voxels, 0 elsewhere) filtered trilinearly, so a
+ * labelled sphere renders round and its normal is the indicator's gradient.
+ * At a sample, the label is the one of the eight surrounding voxels with
+ * the largest filtered indicator (the sample is outside every label where
+ * that is below 0.5, or where the label is hidden or unlisted).
+ *   SURFACE  label-only: the first visible label the ray meets is shaded as
+ *            an opaque-per-alpha surface with its colour and the lights.
+ *   MASK     the intensity volume's transfer function, only inside visible
+ *            labels (a hidden label cuts its region away).
+ *   TINT     as MASK, with the transfer function's colour multiplied by the
+ *            label's colour. */
+#define VXL_LABEL_MODE_SURFACE 0
+#define VXL_LABEL_MODE_MASK 1
+#define VXL_LABEL_MODE_TINT 2
+#define VXL_LABEL_MODE_COUNT 3
+VXL_API const char *vxl_label_mode_name(uint32_t mode); /* "surface", "mask", "tint" */
+VXL_API int vxl_label_mode_from_name(const char *name, uint32_t *out);
+#define VXL_MAX_LABEL_ID 65535 /* label ids in [0, VXL_MAX_LABEL_ID]; 0 is the background */
+
+typedef struct vxl_label_style {
+    uint32_t struct_size;
+    uint32_t mode;               /* VXL_LABEL_MODE_* */
+    uint32_t entry_count;        /* entries in `entries` */
+    uint32_t reserved;           /* must be 0 */
+    const vxl_label_entry *entries; /* colour (alpha = opacity per voxel of path) and visibility per id;
+                                       ids not listed are hidden; stride entries[0].struct_size. Changing
+                                       them re-uploads only a small table, never the label volume */
+} vxl_label_style;
+
 /* 2 words of room: the struct then ends on its 8-byte alignment, with no padding. */
 #define VXL_RENDER_PARAMS_RESERVED 2
 
@@ -542,6 +574,9 @@ typedef struct vxl_render_params {
      * size and offsets). Must be zero: vxl_render fails with
      * VXL_ERR_INVALID_ARGUMENT naming the word otherwise. */
     uint32_t reserved[VXL_RENDER_PARAMS_RESERVED];
+    /* Appended (issue 20); read only when struct_size covers it. NULL: no
+     * labels (a label volume set on the renderer is then not drawn). */
+    const vxl_label_style *labels;
 } vxl_render_params;
 
 VXL_API int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out);
@@ -552,6 +587,13 @@ VXL_API int vxl_renderer_get_info(vxl_renderer *r, vxl_renderer_info *out);
 /* Uploads the volume; the renderer keeps its own copy on the GL side, so the
  * vxl_volume may be destroyed afterwards. */
 VXL_API int vxl_renderer_set_volume(vxl_renderer *r, const vxl_volume *vol);
+
+/* Label maps (issue 20): a volume of integer label ids (u8, u16, i16 or
+ * i32 data with values in [0, VXL_MAX_LABEL_ID]; anything else is
+ * VXL_ERR_INVALID_ARGUMENT) drawn with params.labels. Its own affine places
+ * it (the same grid as the intensity volume or another one). Kept on the GL
+ * side like the volume; NULL removes it. */
+VXL_API int vxl_renderer_set_labels(vxl_renderer *r, const vxl_volume *labels);
 
 /* rgba: width*height*4 floats, premultiplied. depth: width*height floats
  * (view-space planar distance where opacity passes depth_threshold, +inf

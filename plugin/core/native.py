@@ -31,8 +31,8 @@ from . import (native_abi, native_cutaway, native_library, native_private_copy, 
                native_tiles, native_volume)
 from .native_abi import (ABI_VERSION, BACKENDS, CLASSIFY_MODES, ENUM_FALLBACKS, FILTERS,  # noqa: F401
                          GRADIENT_OPACITY_MODES, MAX_LIGHTS, PRESETS, RENDER_PARAMS_RESERVED,
-                         STORAGES, MAX_CLIP_PLANES, MAX_CUTTERS, MODES, INTERPOLATIONS, ClipPlane,
-                         Cutaway, Cutter, LabelEntry, Matcap, SceneShadows, SliceParams, DicomSeries, Light, LightShape, LibraryUnavailable, LoadOptions, PhantomDesc,
+                         STORAGES, MAX_CLIP_PLANES, MAX_CUTTERS, MODES, INTERPOLATIONS, LABEL_MODES, MAX_LABEL_ID, ClipPlane,
+                         Cutaway, Cutter, LabelEntry, LabelStyle, Matcap, SceneShadows, SliceParams, DicomSeries, Light, LightShape, LibraryUnavailable, LoadOptions, PhantomDesc,
                          RendererInfo, RendererOptions, RenderParams, RenderStats, SHADING_MODELS,
                          VolumeDesc, VolumeInfo, VoxlightError, c_double4x4, c_float4x4, matrix_from_cm)
 from .native_library import (LIBRARY_NAME, Library, candidate_paths, filter_names,  # noqa: F401

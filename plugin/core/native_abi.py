@@ -28,12 +28,14 @@ GRADIENT_OPACITY_MODES = ("off", "boundary", "iso")  # VXL_GOPACITY_*
 SHADING_MODELS = ("phong", "shadowed", "scatter")  # VXL_SHADING_*
 MODES = ("dvr", "mip", "minip", "average", "iso")  # VXL_MODE_*
 INTERPOLATIONS = ("nearest", "linear", "cubic")  # VXL_INTERP_*
+LABEL_MODES = ("surface", "mask", "tint")  # VXL_LABEL_MODE_*
+MAX_LABEL_ID = 65535  # VXL_MAX_LABEL_ID
 # The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
 ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "storage": STORAGES,
                   "classify": CLASSIFY_MODES, "gradient_opacity": GRADIENT_OPACITY_MODES,
                   "gradient_store": ("8bit", "16f", "32f"), "shading_model": SHADING_MODELS,
                   "technique": ("raycast", "slices2d", "slices3d"), "mode": MODES,
-                  "interpolation": INTERPOLATIONS}
+                  "interpolation": INTERPOLATIONS, "label_mode": LABEL_MODES}
 MAX_LIGHTS = 8
 RENDER_PARAMS_RESERVED = 2  # VXL_RENDER_PARAMS_RESERVED
 MAX_CLIP_PLANES = 6  # VXL_MAX_CLIP_PLANES
@@ -157,6 +159,14 @@ class LabelEntry(ctypes.Structure):
                 ("name", ctypes.c_char * 64)]
 
 
+class LabelStyle(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("mode", ctypes.c_uint32),
+                ("entry_count", ctypes.c_uint32),
+                ("reserved", ctypes.c_uint32),
+                ("entries", ctypes.POINTER(LabelEntry))]
+
+
 class ClipPlane(ctypes.Structure):
     _fields_ = [("plane", ctypes.c_float * 4),
                 ("thickness", ctypes.c_float),
@@ -264,7 +274,8 @@ class RenderParams(ctypes.Structure):
                 ("cutaway", ctypes.POINTER(Cutaway)),
                 ("scene_shadows", ctypes.POINTER(SceneShadows)),
                 ("matcap", ctypes.POINTER(Matcap)),
-                ("reserved", ctypes.c_uint32 * RENDER_PARAMS_RESERVED)]  # must stay 0
+                ("reserved", ctypes.c_uint32 * RENDER_PARAMS_RESERVED),  # must stay 0
+                ("labels", ctypes.POINTER(LabelStyle))]  # appended (issue 20)
 
 
 class RenderStats(ctypes.Structure):

@@ -33,6 +33,7 @@ BINDINGS = {
     "vxl_render_params": native.RenderParams,
     "vxl_clip_plane": native.ClipPlane,
     "vxl_label_entry": native.LabelEntry,
+    "vxl_label_style": native.LabelStyle,
     "vxl_cutter": native.Cutter,
     "vxl_cutaway": native.Cutaway,
     "vxl_matcap": native.Matcap,

@@ -381,14 +381,16 @@ def test_render_params_tail_matches_header():
     import ctypes
     P = native.RenderParams
     assert P.shading_model.offset + 4 == 624
-    assert ctypes.sizeof(P) == 688
-    assert ctypes.sizeof(P) == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
+    # 688 bytes up to the reserved room's end; issue 20 appended a pointer
+    assert P.labels.offset == 688 and ctypes.sizeof(P) == 696
+    assert P.labels.offset == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
-    names = [n for n, _t in P._fields_][-18:]
+    names = [n for n, _t in P._fields_][-19:]
     assert names == ["preint_size", "gradient_opacity", "gradient_ref", "gradient_exp",
                      "iso_value", "iso_thickness", "shading_model", "light_shapes",
                      "ambient_occlusion", "occlusion_strength", "anisotropy", "illumination_size",
-                     "technique", "mode", "cutaway", "scene_shadows", "matcap", "reserved"]
+                     "technique", "mode", "cutaway", "scene_shadows", "matcap", "reserved",
+                     "labels"]
     # the pointers of issues 18 and 19 sit on their 8-byte alignment
     assert P.cutaway.offset % 8 == 0 and P.matcap.offset + 8 == P.reserved.offset
 

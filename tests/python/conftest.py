@@ -19,3 +19,22 @@ if HERE not in sys.path:
 # Tests use the library from the build tree unless VOXLIGHT_LIB says otherwise.
 os.environ.setdefault("VOXLIGHT_LIB", os.path.join(ROOT, os.environ.get("BUILD", "build"),
                                                    "libvoxlight.so"))
+
+
+# The library and a renderer without a volume, shared by the binding's tests
+# (a test module may define its own `renderer` with a volume set).
+import pytest  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def lib():
+    from voxlight.core import native
+    return native.load_library()
+
+
+@pytest.fixture(scope="module")
+def renderer(lib):
+    from voxlight.core import native
+    r = native.Renderer(lib=lib)
+    yield r
+    r.close()

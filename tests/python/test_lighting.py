@@ -124,11 +124,6 @@ def test_light_watch_sees_a_drag_and_its_end():
 
 # ------------------------------------------------------- into the params
 
-@pytest.fixture(scope="module")
-def lib():
-    return native.load_library()
-
-
 def _spot_and_sun():
     spot = lights.SceneLight((0.0, 0.0, 2.0, 1.0), (1.0, 1.0, 1.0), 1.0,
                              lights.Shape((0.0, 0.0, -1.0), 0.5, 0.25, 0.1))

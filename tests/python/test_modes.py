@@ -14,11 +14,6 @@ NX, NY, NZ = 14, 12, 10
 
 
 @pytest.fixture(scope="module")
-def lib():
-    return native.load_library()
-
-
-@pytest.fixture(scope="module")
 def noise():
     """Values on 64 levels in [0, 1], a[i, j, k] at world (i, j, k)."""
     return np.random.default_rng(7).integers(0, 64, (NX, NY, NZ)).astype(np.float32) / 63

@@ -23,18 +23,6 @@ def software_backend():
 
 
 @pytest.fixture(scope="module")
-def lib():
-    return native.load_library()
-
-
-@pytest.fixture(scope="module")
-def renderer(lib):
-    r = native.Renderer(lib=lib)
-    yield r
-    r.close()
-
-
-@pytest.fixture(scope="module")
 def ball_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("vol") / "ball.nii.gz"
     aff = np.diag([2.0, 2.0, 3.0, 1.0])

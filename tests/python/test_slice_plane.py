@@ -10,18 +10,6 @@ import pytest
 from voxlight.core import cutaway_space, native, slice_plane
 
 
-@pytest.fixture(scope="module")
-def lib():
-    return native.load_library()
-
-
-@pytest.fixture(scope="module")
-def renderer(lib):
-    r = native.Renderer(lib=lib)
-    yield r
-    r.close()
-
-
 def _rot(axis, deg):
     a = np.radians(deg)
     c, s = np.cos(a), np.sin(a)

@@ -18,11 +18,6 @@ AFFINE = np.array([[0.0, -0.5, 0.0, 10.0],
 OFFSET = (3, -9, 17)  # index of voxel (0, 0, 0): crosses a leaf boundary
 
 
-@pytest.fixture(scope="module")
-def lib():
-    return native.load_library()
-
-
 def _blob(shape=(13, 10, 7)):
     """Positive everywhere (so every voxel is active) and asymmetric."""
     i, j, k = np.meshgrid(*[np.arange(n, dtype=np.float64) for n in shape], indexing="ij")

@@ -32,11 +32,6 @@ VXL_DTYPE_F32 = 7
 
 
 @pytest.fixture(scope="module")
-def lib():
-    return native.load_library()
-
-
-@pytest.fixture(scope="module")
 def small_vdb(tmp_path_factory):
     path = tmp_path_factory.mktemp("iso") / "small.vdb"
     return write_vdb(path, [{"name": "density", "array": np.full((4, 3, 2), 2.0, np.float32)}])

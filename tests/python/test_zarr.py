@@ -19,11 +19,6 @@ SCALES = [[1, 1, 3.0, 0.5, 0.25], [1, 1, 6.0, 1.0, 0.5]]
 TRANSLATION = [0, 0, -4.0, 5.0, 6.0]
 
 
-@pytest.fixture(scope="module")
-def lib():
-    return native.load_library()
-
-
 @pytest.fixture(scope="module", params=[2, 3])
 def store(request, tmp_path_factory):
     data = ramp((2, 3, 6, 7, 9), "uint8", 11)

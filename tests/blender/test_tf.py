@@ -389,8 +389,8 @@ def panel_has_subpanels_ramp_picture_and_preset_name():
     subs = [c for c in bpy.types.Panel.__subclasses__()
             if getattr(c, "bl_parent_id", "") == "VOXLIGHT_PT_volume"]
     labels = {c.bl_label: c for c in subs}
-    assert set(labels) == {"Rendering", "Transfer Function", "Lighting", "Advanced",
-                           "Statistics"}, set(labels)
+    assert set(labels) == {"Rendering", "Transfer Function", "Lighting", "Render Mode",
+                           "Cutaway", "Advanced", "Statistics"}, set(labels)
     for name in ("Advanced", "Statistics"):
         assert "DEFAULT_CLOSED" in labels[name].bl_options
     for gop in ("off", "boundary", "iso"):

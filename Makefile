@@ -52,7 +52,8 @@ HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume error loader_uti
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
-STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlight-slicingbench $(BUILD)/voxlight-modesbench
+STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlight-slicingbench $(BUILD)/voxlight-modesbench \
+           $(BUILD)/voxlight-labelsbench
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
@@ -129,6 +130,10 @@ $(BUILD)/voxlight-storagebench: bench/storage_study.c bench/bench_util.h $(BUILD
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
 $(BUILD)/voxlight-lightbench: bench/lighting_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
+# issue 20: frame time against the number of labels (docs/labels.md)
+$(BUILD)/voxlight-labelsbench: bench/labels_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
 # issue 19: the render modes' run time against error (docs/modes.md, docs/benchmark.md)

@@ -14,12 +14,12 @@ import os
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, FloatProperty, FloatVectorProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix
 
-from . import tf
-from .core import framing, import_job, orientation, runtime, volume_space
+from . import label_props, tf
+from .core import framing, import_job, label_import, orientation, runtime, volume_space
 
 
 def _to_matrix(a):
@@ -94,6 +94,14 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
     frame_in_view: BoolProperty(name="Frame in View", default=True,
                                 description="Point every 3D viewport at the imported volume "
                                             "(as View Selected does)")
+    # Issue 20: label maps (core/label_import.py decides, label_props.py holds them).
+    import_as: EnumProperty(name="Import As", default="AUTO",
+                            items=[m + (i,) for i, m in enumerate(label_import.IMPORT_MODES)],
+                            description="An intensity volume, or a label map (integer volume of "
+                                        "label ids named by a lookup file beside it)")
+    lookup_file: StringProperty(name="Lookup File", default="", subtype="FILE_PATH",
+                                description="Label names and colours (empty = the first lookup "
+                                            "file found beside the image)")
     # Set by invoke: the file browser path runs modal, scripts block.
     use_modal: BoolProperty(default=False, options={"HIDDEN", "SKIP_SAVE"})
 
@@ -149,8 +157,22 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         if entry is None:
             self.report({"WARNING"}, "Voxlight: import of %s cancelled" % name)
             return {"CANCELLED"}
+        labels, err = self._label_plan(context, job.path, entry.info)
+        if err:
+            entry.close()
+            self.report({"ERROR"}, "Voxlight: cannot import %s as labels: %s" % (name, err))
+            return {"CANCELLED"}
+        if labels is not None and labels[0] == "attach":
+            entry.close()  # the active volume keeps its own renderer; it gets the label file
+            target = context.view_layer.objects.active
+            label_props.attach(target, job.path, labels[1], labels[2], "tint")
+            self.report({"INFO"}, "Voxlight: %s (%d labels) attached to %s"
+                        % (name, len(target.voxlight_labels.labels), target.name))
+            return {"FINISHED"}
         try:
-            self._create_object(context, job.path, entry.info)
+            obj = self._create_object(context, job.path, entry.info)
+            if labels is not None:
+                label_props.attach(obj, job.path, labels[1], labels[2], "surface")
         except Exception as e:
             entry.close()
             self.report({"ERROR"}, "Voxlight: cannot import %s: %s" % (name, e))
@@ -160,6 +182,25 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         self.report({"INFO"}, "Voxlight: imported %s (%d x %d x %d, %s)"
                     % (name, *info["dims"], info["dtype"]))
         return {"FINISHED"}
+
+    def _label_plan(self, context, path, info):
+        """((kind, lookup, table) or None for an intensity volume, error)."""
+        lookup = bpy.path.abspath(self.lookup_file) if self.lookup_file else ""
+        kind, lookup = label_import.plan(self.import_as, path, lookup)
+        kind, err = label_import.check(kind, self.import_as, info["dtype"], lookup, path,
+                                       value_range=(info["value_min"], info["value_max"]))
+        if err or kind == "intensity":
+            return None, err
+        if kind == "attach":
+            target = context.view_layer.objects.active
+            if target is None or not target.voxlight.is_volume:
+                return None, "no active Voxlight volume to attach the labels to"
+        table, err = label_props.read_lookup(lookup)
+        if err and self.import_as == "AUTO":  # a text file that is no lookup table
+            self.report({"WARNING"}, "Voxlight: %s is not a lookup file (%s): imported as an "
+                                     "intensity volume" % (os.path.basename(lookup), err))
+            return None, ""
+        return (kind, lookup, table), err
 
     def _create_object(self, context, path, info):
         dims = info["dims"]

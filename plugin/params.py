@@ -8,6 +8,7 @@ from .core import lighting
 from .core import lights as _lights
 from .core import native
 from . import cutaway
+from . import label_props
 from . import tf as _tf
 
 
@@ -54,6 +55,7 @@ def look_kwargs(props, fast=False, dragging=False):
         iso_thickness=props.iso_thickness,
         **lighting.look_kwargs(props, dragging),
         **cutaway.look_kwargs(props),  # issue 19: mode, MatCap, cutaway
+        **label_props.look_kwargs(props),  # issue 20: label map colours and visibility
     )
 
 

@@ -11,6 +11,7 @@
 #include "cli_cut.h"   /* --clip-plane, --crop, --no-caps (issue 19) */
 #include "cli_modes.h" /* --mode, --iso-value, --matcap, --ortho, --view (issue 19) */
 #include "cli_labels.h" /* the labels command (issue 20) */
+#include "cli_labels_render.h" /* render --labels ... (issue 20) */
 #include "voxlight_dev.h" /* phantoms (phantom:NAME inputs) and --no-skip */
 
 /* The option values come from the library's name functions (vxl_*_name),
@@ -29,6 +30,8 @@ static const char usage_format[] =
     "                  [--mode %s] [--iso-value V] [--matcap FILE.png] [--ortho]\n"
     "                  [--view x|-x|y|-y|z|-z]\n"
     "                  [--clip-plane A,B,C,D[,T]]... [--crop X0:X1,Y0:Y1,Z0:Z1] [--no-caps]\n"
+    "                  [--labels LABELS [--label-lut FILE] [--label-mode surface|mask|tint]\n"
+    "                   [--hide-labels ID,...] [--label-opacity ID:ALPHA,...]]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
     "  voxlight labels FILE   (a label lookup table: FreeSurfer LUT, ITK-SNAP, Slicer .ctbl, MRIcron .lut/.txt)\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
@@ -47,6 +50,10 @@ static const char usage_format[] =
     "cutaways: --clip-plane (repeatable, up to 6) keeps A x + B y + C z + D >= 0 (world mm), only the slab\n"
     "         up to T mm from the plane when T > 0; --crop keeps voxels X0..X1, Y0..Y1, Z0..Z1 (indices from 0,\n"
     "         inclusive); cut faces are shaded as surfaces (caps) unless --no-caps (docs/cutaways.md)\n"
+    "labels: --labels draws an integer label image (any loader) with its lookup file (--label-lut, else the\n"
+    "         same stem with .lut/.txt/.ctbl/.label beside it, else a palette for every nonzero id);\n"
+    "         surface (default) shades each label as a surface, mask / tint apply the transfer function\n"
+    "         inside visible labels (tint: times the label colour) (docs/labels.md)\n"
     "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of\n"
     "         %s\n"
     "         (large-sparse: default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
@@ -341,6 +348,7 @@ typedef struct render_args {
     vxl_load_options lo;
     vxl_cli_modes modes; /* issue 19 */
     vxl_cli_cut cut;     /* issue 19 cutaways */
+    vxl_cli_labels labels; /* issue 20 label maps */
 } render_args;
 
 static int parse_render(int argc, char **argv, render_args *a)
@@ -437,6 +445,8 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (r < 0) return die("%s", err);
         } else if ((r = vxl_cli_cut_option(argc, argv, &i, &a->cut, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err);
+        } else if ((r = vxl_cli_labels_option(argc, argv, &i, &a->labels, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err); /* issue 20 */
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);
@@ -456,6 +466,7 @@ static int cmd_render(int argc, char **argv)
     a.lo.struct_size = sizeof a.lo;
     vxl_cli_modes_init(&a.modes);
     vxl_cli_cut_init(&a.cut);
+    vxl_cli_labels_init(&a.labels);
     if (parse_render(argc, argv, &a)) return 1;
     uint32_t w = a.p.width ? a.p.width : 512, h = a.p.height ? a.p.height : 512;
     vxl_volume *v = NULL;
@@ -471,6 +482,7 @@ static int cmd_render(int argc, char **argv)
     char merr[512];
     if (vxl_cli_modes_apply(&a.modes, r, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_cut_apply(&a.cut, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
+    if (vxl_cli_labels_apply(&a.labels, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; } /* issue 20 */
     vxl_volume_destroy(v);
     v = NULL;
     rgba = malloc((size_t)w * h * 4 * sizeof *rgba);
@@ -506,6 +518,7 @@ done:
     free(rgba);
     free(depth);
     vxl_cli_modes_free(&a.modes);
+    vxl_cli_labels_free(&a.labels);
     vxl_renderer_destroy(r);
     vxl_volume_destroy(v);
     return status;

@@ -76,6 +76,14 @@ typedef struct vxl_frame {
     /* issue 19 cutaways (frame_cut.c): clip planes and crop box in voxel
      * space, the cutters checked; cut.any is 0 without params.cutaway. */
     vxl_frame_cut cut;
+    /* issue 20 labels (frame_labels.c): on is 0 without params.labels. */
+    struct {
+        int on;
+        uint32_t mode;                  /* VXL_LABEL_MODE_* */
+        const vxl_label_entry *entries; /* the caller's, checked */
+        uint32_t count, stride;         /* entries and their stride in bytes */
+        uint64_t key;                   /* hash of the table (ids, colours, visibility) */
+    } labels;
 } vxl_frame;
 
 /* The gradient filter a frame evaluates: rays that never evaluate gradients
@@ -129,6 +137,14 @@ static inline int vxl_mode_shades(uint32_t mode) { return mode == VXL_MODE_DVR |
  * the mode combines with classify, gradient_opacity and technique, into f.
  * Part of vxl_frame_resolve (frame_mode.c). */
 int vxl_frame_resolve_mode(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+
+/* issue 20 labels: validates p->labels (mode, reserved, entries NULL with a
+ * count, colours NaN or outside [0, 1], ids outside [0, VXL_MAX_LABEL_ID],
+ * duplicate ids) into f->labels; needs f->mode and f->technique (labels take
+ * the ray caster's DVR mode). SURFACE turns empty-space skipping off: the
+ * intensity volume's occupancy says nothing of the labels'. Part of
+ * vxl_frame_resolve (frame_labels.c). */
+int vxl_frame_resolve_labels(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
 
 /* Validates p->scene_shadows (issue 18) into f's occluder fields: NULL
  * arrays with counts, indices out of range, vertices not finite and map

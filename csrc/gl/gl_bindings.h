@@ -26,6 +26,8 @@
 #define VXL_EXTINCTION_UNIT 14    /* illumination.comp: the optical depth per cell the lights and occlusion read */
 #define VXL_SHADOW_MAP_UNIT 15    /* illumination.comp (pass 3), scene_transmittance.comp: the lights' shadow maps (issue 18) */
 #define VXL_MATCAP_UNIT 16        /* raycast: the MatCap image (issue 19, render/matcap.c) */
+#define VXL_LABELS_UNIT 18        /* raycast: the label volume (R16UI, issue 20, labels/labels.c) */
+#define VXL_LABEL_TABLE_UNIT 19   /* raycast: the per-label colour table (issue 20) */
 #define VXL_BRICK_MINMAX_UNIT 17  /* raycast: the brick min-max grid the modes skip by (issue 19, render/mode_bricks.c) */
 
 /* Image units. */

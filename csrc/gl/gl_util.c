@@ -96,6 +96,9 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
                      (flags >> VXL_FLAG_MODE_SHIFT) & 7, (flags & VXL_FLAG_MATCAP) ? "#define MATCAP 1\n" : "",
                      (flags & VXL_FLAG_CUT_CONVEX) ? "#define CUT_CONVEX 1\n" : "",
                      (flags & VXL_FLAG_CUT_CUTTERS) ? "#define CUT_CUTTERS 1\n" : "");
+        if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* issue 20: label mode + 1 */
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABELS %u\n",
+                     (flags >> VXL_FLAG_LABELS_SHIFT) & 3);
         rc = compile(g, GL_VERTEX_SHADER, kind == VXL_PROG_SLICES ? "render/slices.vert" : "render/raycast.vert", NULL, &a);
         if (rc) return rc;
         rc = compile(g, GL_FRAGMENT_SHADER, kind == VXL_PROG_SLICES ? "render/slices.frag" : "render/raycast.frag", defines, &b);

@@ -48,6 +48,8 @@
 #define VXL_FLAG_MATCAP (1u << 13)     /* MATCAP: shading reads the MatCap */
 #define VXL_FLAG_CUT_CONVEX (1u << 14) /* CUT_CONVEX: clip planes and the crop box narrow the ray */
 #define VXL_FLAG_CUT_CUTTERS (1u << 15) /* CUT_CUTTERS: cutter meshes remove depth intervals */
+/* Ray caster program flag of issue 20 (labels/labels.c): bits 16-17 hold the label mode + 1 (LABELS); 0 none. */
+#define VXL_FLAG_LABELS_SHIFT 16u
 
 typedef struct vxl_program_entry {
     uint32_t key;

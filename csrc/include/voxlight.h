@@ -467,11 +467,13 @@ typedef struct vxl_scene_shadows {
 /* Label maps (issue 20), params.labels with a label volume set by
  * vxl_renderer_set_labels. Label ids are never interpolated as numbers: the
  * boundary of each label is the 0.5 level of its indicator function
- * (1 inside the label's voxels, 0 elsewhere) filtered trilinearly, so a
- * labelled sphere renders round and its normal is the indicator's gradient.
- * At a sample, the label is the one of the eight surrounding voxels with
- * the largest filtered indicator (the sample is outside every label where
- * that is below 0.5, or where the label is hidden or unlisted).
+ * (1 inside the label's voxels, 0 elsewhere) filtered with the cubic
+ * B-spline (trilinear filtering left +-0.4 voxel bumps), so a labelled
+ * sphere renders round and its normal is the indicator's gradient.
+ * At a sample, the label is the visible one of the eight surrounding voxels
+ * with the largest filtered indicator (the sample is outside every label
+ * where that is below 0.5, or where the label is hidden or unlisted).
+ * Labels take the DVR mode and the ray caster (technique 0).
  *   SURFACE  label-only: the first visible label the ray meets is shaded as
  *            an opaque-per-alpha surface with its colour and the lights.
  *   MASK     the intensity volume's transfer function, only inside visible

@@ -30,6 +30,13 @@
 extern "C" {
 #endif
 
+/* ------------------------------------------------------- label uploads */
+
+/* Issue 20: how many label volumes and label tables the renderer has
+ * uploaded since it was created (either pointer may be NULL), so tests can
+ * check that recolouring or hiding a label re-uploads only the table. */
+VXL_API int vxl_renderer_label_uploads(vxl_renderer *r, uint64_t *volume_uploads, uint64_t *table_uploads);
+
 /* ------------------------------------------------------- gradient probe */
 
 /* Evaluates the gradient filter selected in p (filter, sample_distance,

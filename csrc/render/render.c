@@ -166,6 +166,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
                      (f->gopacity << 4) | r->storage.ops->sample_flags(&r->storage) | (f->shading ? f->shading_model << 8 : 0);
     flags = vxl_modes_flags(f, flags); /* issue 19: the mode and the MatCap */
     flags |= vxl_cut_flags(f);         /* issue 19: clip planes, crop box, cutters */
+    flags |= vxl_labels_flags(f);      /* issue 20: the label mode */
     uint32_t filter = vxl_frame_filter(f);
     int rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
     if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);
@@ -186,6 +187,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     set_frame_uniforms(r, prog, f);
     vxl_illumination_bind(&r->illumination, prog, f);
     vxl_cut_bind(&r->cut, prog, f); /* issue 19 */
+    if ((rc = vxl_labels_prepare(&r->labels, f, prog, r->storage.geom.affine))) return rc; /* issue 20 */
     if ((rc = vxl_modes_bind(&r->modes, f, prog)) || (rc = vxl_matcap_prepare(&r->matcap, f, prog))) return rc; /* issue 19 */
     vxl_uniform_i(&r->gpu, prog, "u_skip", f->skip);
     vxl_uniform_i(&r->gpu, prog, "u_brick_size", (int)(r->skipping.bricks.size ? r->skipping.bricks.size : VXL_DEFAULT_BRICK));

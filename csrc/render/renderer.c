@@ -82,6 +82,7 @@ static int job_close(void *p)
         delete_texture(r, &r->tf_tex);
         vxl_matcap_release(&r->matcap);
         vxl_cut_release(&r->cut); /* issue 19: the cutter layers */
+        vxl_labels_release(&r->labels); /* issue 20 */
         vxl_programs_delete(&r->gpu);
         r->gpu.gl.DeleteFramebuffers(1, &r->fbo);
         r->gpu.gl.DeleteVertexArrays(1, &r->vao);
@@ -108,6 +109,7 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     vxl_cut_init(&r->cut, &r->gpu); /* issue 19 cutaways */
     vxl_modes_init(&r->modes, &r->gpu, &r->skipping, &r->storage);
     vxl_matcap_init(&r->matcap, &r->gpu);
+    vxl_labels_init(&r->labels, &r->gpu); /* issue 20 label maps */
     r->gpu.budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
     if (opt && opt->struct_size >= offsetof(vxl_renderer_options, page_brick) + sizeof opt->page_brick) {
         if (opt->storage >= VXL_STORAGE_COUNT) {

@@ -14,6 +14,7 @@
 #include "gpu.h"
 #include "gradients.h"
 #include "illumination.h"
+#include "labels.h"
 #include "matcap.h"
 #include "modes.h"
 #include "skipping.h"
@@ -41,6 +42,7 @@ struct vxl_renderer {
     vxl_cut_state cut;                       /* cutaway.h: issue 19 clip planes, crop box, cutter layers */
     vxl_modes_state modes;                   /* modes.h: issue 19 render modes (min-max grid texture) */
     vxl_matcap_state matcap;                 /* matcap.h: issue 19 MatCap image */
+    vxl_labels_state labels;                 /* labels.h: issue 20 label volume and table */
 
     GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex;
     uint32_t fb_w, fb_h;

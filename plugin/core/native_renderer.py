@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from .native_abi import (LibraryObject, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
+from .native_abi import (LabelEntry, LabelStyle, LibraryObject, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
                          RendererInfo, RendererOptions, SceneShadows, VoxlightError, matrix_from_cm, _fptr,
                          _matrix_cm, _sized)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct
@@ -45,7 +45,7 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 gradient_exp=0.0, iso_value=0.0, iso_thickness=0.0, preint_size=0,
                 shading_model=0, ambient_occlusion=0.0, occlusion_strength=0.0, anisotropy=0.0,
                 illumination_size=0, mode="dvr", matcap=None, matcap_key=0, cutaway=None,
-                scene_shadows=None, lib=None):
+                scene_shadows=None, labels=None, lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -145,6 +145,8 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     p.depth_threshold = depth_threshold
     p.no_skip = 1 if no_skip else 0
     _issue19_inputs(p, lib, mode, matcap, matcap_key, cutaway)
+    if labels is not None:
+        _set_labels(p, lib, *labels)
     if scene_shadows is not None:
         _set_scene_shadows(p, *scene_shadows)
     return p
@@ -168,6 +170,27 @@ def _set_scene_shadows(p, vertices, triangles, key=0, shadow_map_size=0):
     if not s.occluder_key:
         p._keep.extend((v, t))
     p.scene_shadows = ctypes.pointer(s)
+
+
+def _set_labels(p, lib, mode, entries):
+    """params.labels (issue 20) from `mode` (a label mode's name or number)
+    and entries, a sequence of (id, rgba, visible); the struct and its
+    entries live as long as p, and _keep holds their bytes for the digest."""
+    entries = list(entries)
+    arr = (LabelEntry * max(1, len(entries)))()
+    for e, (ident, rgba, visible) in zip(arr, entries):
+        e.struct_size = ctypes.sizeof(LabelEntry)
+        e.id = int(ident)
+        rgba = tuple(float(c) for c in rgba)
+        e.color[:] = rgba if len(rgba) == 4 else rgba + (1.0,)
+        e.visible = 1 if visible else 0
+    s = _sized(LabelStyle)
+    s.mode = mode if isinstance(mode, int) else lib.index("label_mode", mode)
+    s.entry_count = len(entries)
+    s.entries = ctypes.cast(arr, ctypes.POINTER(LabelEntry))
+    p._labels, p._label_entries = s, arr
+    p._keep.append(np.frombuffer(bytes(s)[:16] + bytes(arr)[:ctypes.sizeof(LabelEntry) * len(entries)], np.uint8))
+    p.labels = ctypes.pointer(s)
 
 
 def _issue19_inputs(p, lib, mode, matcap, matcap_key, cutaway):
@@ -221,6 +244,17 @@ class Renderer(LibraryObject):
         return {"backend": i.backend, "backend_name": i.backend_name.decode(),
                 "gl_renderer": i.gl_renderer.decode(), "gl_version": i.gl_version.decode(),
                 "max_3d_texture_size": i.max_3d_texture_size}
+
+    def set_labels(self, volume):
+        """The label volume (issue 20): a Volume of integer ids, or None to remove it."""
+        self._check(self.lib.cdll.vxl_renderer_set_labels(self.handle, volume.handle if volume is not None else None),
+                    "set labels")
+
+    def label_uploads(self):
+        """(label volumes, label tables) uploaded so far (voxlight_dev.h)."""
+        v, t = ctypes.c_uint64(), ctypes.c_uint64()
+        self._check(self.lib.cdll.vxl_renderer_label_uploads(self.handle, ctypes.byref(v), ctypes.byref(t)))
+        return v.value, t.value
 
     def set_volume(self, volume):
         self._check(self.lib.cdll.vxl_renderer_set_volume(self.handle, volume.handle),

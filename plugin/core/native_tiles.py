@@ -4,11 +4,21 @@ and the statistics of a tiled frame.
 
 Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
+import ctypes
 import hashlib
 
 import numpy as np
 
 from .native_abi import RenderParams, _fptr, _matrix_cm, matrix_from_cm
+
+
+def _label_style_bytes(style):
+    """The label style's mode and entries (colours, visibility, ids), not
+    its pointer: a hidden label must change the digest, an equal list not."""
+    n = style.entry_count
+    stride = style.entries[0].struct_size if n and style.entries else 0
+    data = ctypes.string_at(ctypes.cast(style.entries, ctypes.c_void_p), n * stride) if stride else b""
+    return bytes([1]) + np.array([style.mode, n, stride], np.uint32).tobytes() + data
 
 
 def params_digest(params, *extra):
@@ -23,7 +33,12 @@ def params_digest(params, *extra):
     c.cutaway = None  # issue 19: so are the cutaway's and the MatCap's
     c.matcap = None
     c.scene_shadows = None  # issue 18: its key (or arrays) are in _keep
+    # Issue 20: the label style by contents (read before the field, which
+    # shares c's memory, is cleared).
+    labels = _label_style_bytes(c.labels.contents) if c.labels else b""
+    c.labels = None
     h = hashlib.blake2b(bytes(c), digest_size=16)
+    h.update(labels)
     for a in getattr(params, "_keep", ()):
         a = np.ascontiguousarray(a)
         h.update(str((a.dtype.str, a.shape)).encode())

@@ -19,7 +19,7 @@ import os
 import threading
 import time
 
-from . import frames, native, tf_fit
+from . import frames, label_runtime, native, tf_fit
 
 _lock = threading.Lock()
 render_count = 0
@@ -197,7 +197,8 @@ class VolumeEntry:
     @property
     def identity(self):
         """Part of every frame key: which data this renderer holds."""
-        return (self.path, self.series, self.mtime, id(self), self.frame)
+        return (self.path, self.series, self.mtime, id(self), self.frame,
+                getattr(self, "label_key", None))  # issue 20: label_runtime
 
     def _frame_key(self, frame):
         return (self.path, self.series, self.mtime, frame)
@@ -356,6 +357,9 @@ def entry_for(path, props, scene_frame, backend="auto", storage="auto", memory_b
     entry = get_entry(path, backend, props.series, storage, memory_budget)
     entry.show_frame(frames.volume_frame(scene_frame, entry.frame_count, props.frame_mode,
                                          props.frame_offset, props.fixed_frame))
+    # Issue 20: the object's label map (Object.voxlight_labels, label_props.py).
+    labels = getattr(getattr(props, "id_data", None), "voxlight_labels", None)
+    label_runtime.show(entry, getattr(labels, "active_path", "") if labels is not None else "")
     return entry
 
 

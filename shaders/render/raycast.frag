@@ -126,6 +126,10 @@ bool add_sample(inout Compositing s, RaySetup r, int i, float t, vec3 p, float v
 #define DEFER_VISIBLE 1
 #endif
 
+#ifdef LABELS
+#include "lib/labels.glsl" // issue 20 label maps: label_mask, label_march
+#endif
+
 // One ray from t0 to t1 (o + t * dir in voxels): premultiplied colour, the
 // depth where it reached u_depth_threshold, the samples taken.
 vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, out uint taken)
@@ -218,6 +222,9 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
 #else
             c = classify(v);
 #endif
+#if defined(LABELS) && LABELS > 1
+            if (c.a > 0.0) c = label_mask(p, c); // issue 20: only inside visible labels
+#endif
             if (c.a <= 0.0) continue;
 #ifdef DEFER_VISIBLE
             visible = true;
@@ -236,6 +243,9 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
 #include "lib/modes.glsl"
 #if MODE != 0
 #define march mode_march
+#endif
+#if defined(LABELS) && LABELS == 1
+#define march label_march // issue 20: labels as surfaces
 #endif
 
 void main()

@@ -1,0 +1,68 @@
+"""The Labels sub-panel of a volume object (issue 20): the label image and
+lookup file, the label mode, and a list of the labels (searchable by name
+with the list's own filter) with colour, opacity and visibility per row,
+Show All / Hide All and how many labels are visible."""
+
+import bpy
+
+from .core import label_runtime
+from .panels import _split, _VolumePanel
+
+
+class VOXLIGHT_UL_labels(bpy.types.UIList):
+    """One row per label: visibility, colour (alpha is the opacity), name, id."""
+
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
+        row = layout.row(align=True)
+        row.prop(item, "visible", text="", emboss=False,
+                 icon="HIDE_OFF" if item.visible else "HIDE_ON")
+        sub = row.row(align=True)
+        sub.scale_x = 0.35
+        sub.prop(item, "color", text="")
+        row.label(text=item.name)
+        sub = row.row(align=True)
+        sub.scale_x = 0.8
+        sub.prop(item, "color", index=3, text="", slider=True)  # opacity
+        row.label(text=str(item.label_id))
+
+
+def visible_count(settings):
+    return sum(1 for lab in settings.labels if lab.visible)
+
+
+class VOXLIGHT_PT_volume_labels(_VolumePanel, bpy.types.Panel):
+    """Collapsed by default: most volumes have no label map."""
+    bl_idname = "VOXLIGHT_PT_volume_labels"
+    bl_parent_id = "VOXLIGHT_PT_volume"
+    bl_options = {"DEFAULT_CLOSED"}
+    bl_label = "Labels"
+
+    def draw_header(self, context):
+        self.layout.prop(context.object.voxlight_labels, "enabled", text="")
+
+    def draw(self, context):
+        s = context.object.voxlight_labels
+        layout = _split(self.layout)
+        col = layout.column()
+        col.prop(s, "filepath")
+        row = col.row(align=True)
+        row.prop(s, "lookup_file")
+        row.operator("voxlight.load_label_lookup", text="", icon="FILE_REFRESH")
+        col.prop(s, "mode")
+        err = s.error or label_runtime.failure(s.active_path)
+        if err:
+            box = layout.box()
+            box.alert = True
+            for i in range(0, len(err), 70):
+                box.label(text=err[i:i + 70], icon="ERROR" if i == 0 else "NONE")
+        layout.use_property_split = False
+        layout.template_list("VOXLIGHT_UL_labels", "", s, "labels", s, "active_index", rows=6)
+        row = layout.row(align=True)
+        row.operator("voxlight.label_visibility", text="Show All", icon="HIDE_OFF").visible = True
+        row.operator("voxlight.label_visibility", text="Hide All", icon="HIDE_ON").visible = False
+        layout.label(text="%d of %d labels visible" % (visible_count(s), len(s.labels)))
+
+
+_classes = (VOXLIGHT_UL_labels, VOXLIGHT_PT_volume_labels)
+
+register, unregister = bpy.utils.register_classes_factory(_classes)

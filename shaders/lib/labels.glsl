@@ -179,13 +179,7 @@ vec4 label_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float dep
             label_indicator(p, h.id, g);
             vec3 rgb = h.color.rgb;
 #ifdef SHADING
-#ifdef MATCAP
-            rgb = shade_matcap(rgb, g, r.lighting.v);
-#elif SHADING_MODEL > 0
-            rgb = shade_lit(rgb, g, r.pos0 + th * r.dpos, p, r.lighting, r.one_directional);
-#else
-            rgb = shade(rgb, g, r.pos0 + th * r.dpos, r.lighting, r.one_directional);
-#endif
+            rgb = shade_at(rgb, g, th, p, r);
 #endif
             acc += (1.0 - acc.a) * h.color.a * vec4(rgb, 1.0);
             if (isinf(depth) && acc.a >= u_depth_threshold) depth = -(r.z0 + r.dz * th);

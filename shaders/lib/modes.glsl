@@ -177,13 +177,7 @@ vec4 iso_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth
 #ifdef SHADING
     vec3 p = o + t_hit * dir;
     vec3 g = gradient_at(p, u_iso);
-#ifdef MATCAP
-    rgb = shade_matcap(rgb, g, r.lighting.v);
-#elif SHADING_MODEL > 0
-    rgb = shade_lit(rgb, g, r.pos0 + t_hit * r.dpos, p, r.lighting, r.one_directional);
-#else
-    rgb = shade(rgb, g, r.pos0 + t_hit * r.dpos, r.lighting, r.one_directional);
-#endif
+    rgb = shade_at(rgb, g, t_hit, p, r);
 #endif
     depth = -(r.z0 + r.dz * t_hit);
     return vec4(rgb, 1.0);

@@ -62,6 +62,23 @@ struct RaySetup {
 #endif
 };
 
+#ifdef SHADING
+// The lit colour of a surface or sample with colour rgb and normal g at ray
+// parameter t (voxel position p): the MatCap, the shading model (shadows,
+// occlusion: lib/shading.glsl's shade_lit) or local Phong. One place for
+// add_sample, the ISO mode (lib/modes.glsl) and label surfaces (lib/labels.glsl).
+vec3 shade_at(vec3 rgb, vec3 g, float t, vec3 p, RaySetup r)
+{
+#ifdef MATCAP
+    return shade_matcap(rgb, g, r.lighting.v); // issue 19: lib/matcap.glsl
+#elif SHADING_MODEL > 0
+    return shade_lit(rgb, g, r.pos0 + t * r.dpos, p, r.lighting, r.one_directional);
+#else
+    return shade(rgb, g, r.pos0 + t * r.dpos, r.lighting, r.one_directional);
+#endif
+}
+#endif
+
 // What add_sample carries from sample to sample.
 struct Compositing {
     vec4 acc; // premultiplied
@@ -106,13 +123,7 @@ bool add_sample(inout Compositing s, RaySetup r, int i, float t, vec3 p, float v
     g = reuse_gradient(s.gs, g);
 #endif
     CUT_CAP(g, t); // issue 19: the first sample behind a cut takes the cut's normal (lib/cut.glsl)
-#ifdef MATCAP
-    rgb = shade_matcap(rgb, g, r.lighting.v); // issue 19: lib/matcap.glsl
-#elif SHADING_MODEL > 0
-    rgb = shade_lit(rgb, g, r.pos0 + t * r.dpos, p, r.lighting, r.one_directional); // shadows, occlusion
-#else
-    rgb = shade(rgb, g, r.pos0 + t * r.dpos, r.lighting, r.one_directional);
-#endif
+    rgb = shade_at(rgb, g, t, p, r);
 #endif
     s.acc += (1.0 - s.acc.a) * a * vec4(rgb, 1.0);
     if (isinf(s.depth) && s.acc.a >= u_depth_threshold) s.depth = -(r.z0 + r.dz * t);

@@ -48,7 +48,7 @@ SHADERS := $(wildcard shaders/lib/*.glsl shaders/compute/*.comp shaders/render/*
 OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_embedded.o
 # What the helpers' readers use of the core (volume building, errors, file
 # helpers), linked into each helper, which needs no libvoxlight.so.
-HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume error loader_util)
+HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume brick_source error loader_util)
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).

@@ -101,6 +101,7 @@ const char *vxl_error_name(int code)
     case VXL_ERR_GL: return "OpenGL error";
     case VXL_ERR_SHADER: return "shader error";
     case VXL_ERR_STATE: return "wrong state";
+    case VXL_ERR_CANCELLED: return "cancelled";
     default: return "unknown error";
     }
 }

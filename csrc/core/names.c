@@ -17,6 +17,8 @@ static const char *const technique_names[VXL_TECHNIQUE_COUNT] = {"raycast", "sli
 static const char *const mode_names[VXL_MODE_COUNT] = {"dvr", "mip", "minip", "average", "iso"};
 static const char *const interpolation_names[VXL_INTERP_COUNT] = {"nearest", "linear", "cubic"};
 static const char *const label_mode_names[VXL_LABEL_MODE_COUNT] = {"surface", "mask", "tint"};
+static const char *const streaming_names[VXL_STREAMING_COUNT] = {"auto", "off", "on"};
+static const char *const blend_names[VXL_BLEND_COUNT] = {"over", "add", "max"};
 static const char *const backend_names[VXL_BACKEND_COUNT] = {"auto", "osmesa", "egl"};
 static const char *const dtype_names[VXL_DTYPE_COUNT] = {NULL,    "uint8", "int8",    "uint16", "int16",
                                                          "uint32", "int32", "float32", "float64"};
@@ -49,6 +51,8 @@ VXL_NAMES(technique, technique_names, VXL_TECHNIQUE_COUNT, "technique")
 VXL_NAMES(mode, mode_names, VXL_MODE_COUNT, "render mode")
 VXL_NAMES(interpolation, interpolation_names, VXL_INTERP_COUNT, "interpolation")
 VXL_NAMES(label_mode, label_mode_names, VXL_LABEL_MODE_COUNT, "label mode")
+VXL_NAMES(streaming, streaming_names, VXL_STREAMING_COUNT, "streaming mode")
+VXL_NAMES(blend, blend_names, VXL_BLEND_COUNT, "blend")
 
 
 const char *vxl_dtype_name(uint32_t dtype) { return dtype < VXL_DTYPE_COUNT ? dtype_names[dtype] : NULL; }

@@ -57,6 +57,7 @@ extern "C" {
 #define VXL_ERR_GL 7               /* an OpenGL call failed */
 #define VXL_ERR_SHADER 8           /* a shader failed to compile or link */
 #define VXL_ERR_STATE 9            /* call made in the wrong state (e.g. no volume) */
+#define VXL_ERR_CANCELLED 10       /* the caller's progress callback asked to stop (issue 21) */
 
 /* ---- data types of voxels ---- */
 #define VXL_DTYPE_U8 1
@@ -167,7 +168,39 @@ typedef struct vxl_load_options {
      * 0-based index in vxl_dicom_list_series order, as a string. NULL or ""
      * = the only series (an error listing them when there are several). */
     const char *series;
+    /* Appended (issue 21, data larger than memory); read only when
+     * struct_size covers them. A streamed volume is described by a brick
+     * source that reads bricks on demand (docs/streaming.md): its voxels are
+     * never all in memory at once, on the CPU side or the GL side.
+     *   AUTO  stream when the voxels (in texture format) exceed half of
+     *         memory_budget_bytes, else read whole (today's path)
+     *   OFF   read whole; over the budget is VXL_ERR_LIMIT (today's)
+     *   ON    stream whatever the size
+     * Uncompressed NIfTI, NRRD, MetaImage and TIFF are read by offset;
+     * gzip-compressed files are streamed through once into a bricked cache
+     * (compressed per brick, with the min-max and a downsampled pyramid)
+     * that later opens read; OME-Zarr reads its chunks and uses its
+     * multiscale pyramid as the levels. Formats without random access or a
+     * cache are read whole (and are VXL_ERR_LIMIT over the budget). */
+    uint32_t streaming;           /* VXL_STREAMING_* */
+    uint32_t reserved1;           /* must be 0 */
+    const char *cache_dir;        /* where bricked caches go; NULL or "": beside the source file
+                                     (a read-only folder: $XDG_CACHE_HOME/voxlight, else ~/.cache/voxlight) */
+    /* Called now and then during long work (the first pass over a file, a
+     * cache being written) with the fraction done in [0, 1] and what is being
+     * done; a nonzero return cancels: the call fails with VXL_ERR_CANCELLED
+     * and leaves no partial cache behind. NULL: no progress. May be called
+     * from the calling thread only. */
+    int (*progress)(void *user, double fraction, const char *stage);
+    void *progress_user;
 } vxl_load_options;
+
+#define VXL_STREAMING_AUTO 0
+#define VXL_STREAMING_OFF 1
+#define VXL_STREAMING_ON 2
+#define VXL_STREAMING_COUNT 3
+VXL_API const char *vxl_streaming_name(uint32_t mode); /* "auto", "off", "on" */
+VXL_API int vxl_streaming_from_name(const char *name, uint32_t *out);
 
 /* A volume handed over from memory (e.g. a numpy array). Data is x fastest:
  * index = i + dims[0]*(j + dims[1]*k), native byte order. */
@@ -200,6 +233,12 @@ typedef struct vxl_volume_info {
     /* Appended: written only when the caller's struct_size covers them. */
     uint32_t frame_count;       /* volumes in a 4D input; 1 for 3D */
     uint32_t frame;             /* which of them this volume is */
+    /* Appended (issue 21). */
+    uint32_t streamed;          /* 1: read on demand from a brick source (vxl_load_options.streaming) */
+    uint32_t level_count;       /* resolution levels the source offers (1 = full only) */
+    uint64_t resident_bytes;    /* CPU bytes the volume holds now (whole: its voxels; streamed: its
+                                   index, coarse level and brick cache) */
+    uint64_t bytes_read;        /* bytes read from the file (or cache) so far, by all users */
 } vxl_volume_info;
 
 VXL_API int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **out);
@@ -498,6 +537,57 @@ typedef struct vxl_label_style {
                                        them re-uploads only a small table, never the label volume */
 } vxl_label_style;
 
+/* Overlays (issue 20): up to VXL_MAX_OVERLAYS more volumes in the same ray
+ * march as the renderer's volume, each set with vxl_renderer_set_overlay
+ * and drawn when params.overlays lists its slot. Each has its own affine
+ * (placement), transfer function, window, interpolation and GL storage;
+ * they overlap in space and are sampled together at every step of the ray
+ * (in the base volume's voxel steps), which marches over the union of all
+ * the volumes' boxes and skips only where every volume is empty (the union
+ * of their occupancies). At each step the base volume's sample and each
+ * overlay's (classified: colour c_i, opacity per step a_i after the step
+ * correction) combine by the overlay's blend:
+ *   OVER  one medium: extinctions add and emissions mix by their share,
+ *         a = 1 - prod(1 - a_i), colour = sum(w_i c_i) with
+ *         w_i = ln(1 - a_i) / sum_j ln(1 - a_j) (the exact mixture of
+ *         media each constant over the step)
+ *   ADD   the overlay's emission a_i c_i is added to the step's colour
+ *         without absorbing anything (a glow: PET hot spots); what lies in
+ *         front still attenuates it
+ *   MAX   the step takes the overlay's sample where its opacity exceeds
+ *         that of the rest of the step
+ * OVER overlays mix first, then MAX ones, then ADD ones add. Overlays
+ * render in the DVR mode with the ray caster (technique 0); another mode,
+ * technique or the SURFACE label mode with overlays is VXL_ERR_INVALID_ARGUMENT.
+ * docs/overlays.md. */
+#define VXL_MAX_OVERLAYS 3 /* with the base volume, 4 volumes in one ray march */
+#define VXL_BLEND_OVER 0
+#define VXL_BLEND_ADD 1
+#define VXL_BLEND_MAX 2
+#define VXL_BLEND_COUNT 3
+VXL_API const char *vxl_blend_name(uint32_t blend); /* "over", "add", "max" */
+VXL_API int vxl_blend_from_name(const char *name, uint32_t *out);
+
+typedef struct vxl_overlay_style {
+    uint32_t struct_size;
+    uint32_t slot;              /* < VXL_MAX_OVERLAYS: the volume set by vxl_renderer_set_overlay */
+    uint32_t blend;             /* VXL_BLEND_* */
+    uint32_t interpolation;     /* VXL_INTERP_*: 0 (nearest) ... see below; the default is LINEAR:
+                                   interpolation_set 0 means linear */
+    uint32_t interpolation_set; /* 1: use interpolation as given (so NEAREST, 0, can be asked) */
+    uint32_t preset;            /* VXL_PRESET_* used when tf_rgba is NULL */
+    uint32_t tf_size;           /* entries in tf_rgba (>= 2) */
+    uint32_t has_window;        /* 0: the preset's default window / the data range */
+    const float *tf_rgba;       /* straight RGBA, opacity per voxel of the base volume's path */
+    float window_low, window_high; /* data units of the overlay */
+    float opacity_scale;        /* 0 = 1 */
+    uint32_t shading_off;       /* 0: lit like the base volume (the frame's shading model, lights
+                                   and material, with its own central-difference gradient); 1: emission only */
+    uint32_t has_model;         /* 0: its own affine */
+    float model[16];            /* voxel -> world, column-major */
+    uint32_t reserved;          /* must be 0 */
+} vxl_overlay_style;
+
 /* 2 words of room: the struct then ends on its 8-byte alignment, with no padding. */
 #define VXL_RENDER_PARAMS_RESERVED 2
 
@@ -579,6 +669,16 @@ typedef struct vxl_render_params {
     /* Appended (issue 20); read only when struct_size covers it. NULL: no
      * labels (a label volume set on the renderer is then not drawn). */
     const vxl_label_style *labels;
+    /* Appended (issue 20): overlay_count entries (stride overlays[0].struct_size), each naming a
+     * slot set with vxl_renderer_set_overlay; 0 / NULL: none drawn. */
+    uint32_t overlay_count;     /* <= VXL_MAX_OVERLAYS */
+    /* Appended (issue 21): 1: do not wait for streamed bricks (the viewport): the frame renders at
+     * once from what is resident, coarser where finer bricks are still loading on the renderer's
+     * loader thread, visible bricks large on screen first; stats.refine_pending > 0 says a later
+     * frame will be finer. 0: wait until every brick the frame needs is resident at the finest
+     * level the budget allows (F12). Only streamed volumes care. */
+    uint32_t progressive;
+    const vxl_overlay_style *overlays;
 } vxl_render_params;
 
 VXL_API int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out);
@@ -596,6 +696,12 @@ VXL_API int vxl_renderer_set_volume(vxl_renderer *r, const vxl_volume *vol);
  * it (the same grid as the intensity volume or another one). Kept on the GL
  * side like the volume; NULL removes it. */
 VXL_API int vxl_renderer_set_labels(vxl_renderer *r, const vxl_volume *labels);
+
+/* Overlays (issue 20): puts vol in overlay slot `slot` (< VXL_MAX_OVERLAYS),
+ * kept on the GL side like the volume (charged to the renderer's budget;
+ * over it: VXL_ERR_LIMIT, and the slot keeps what it had). NULL empties the
+ * slot. Any grid: its affine places it. */
+VXL_API int vxl_renderer_set_overlay(vxl_renderer *r, uint32_t slot, const vxl_volume *vol);
 
 /* rgba: width*height*4 floats, premultiplied. depth: width*height floats
  * (view-space planar distance where opacity passes depth_threshold, +inf
@@ -634,6 +740,11 @@ typedef struct vxl_render_stats {
                                     budget is short); 0 when the frame used none */
     uint32_t illumination_rebuilt; /* volumes (one per light, plus the occlusion) the frame rebuilt: 0
                                       when only the camera moved */
+    /* Appended (issue 21): streamed volumes (0 otherwise). */
+    uint32_t refine_pending;    /* bricks the frame wanted finer than it drew (progressive: still loading) */
+    uint32_t stream_level;      /* the coarsest level any drawn brick came from (0 = full resolution) */
+    uint64_t bytes_read;        /* bytes the frame read from the file or cache */
+    double load_ms;             /* milliseconds the frame waited for bricks (0 when progressive) */
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);

@@ -239,6 +239,7 @@ int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double h
 void vxl_volume_destroy(vxl_volume *v)
 {
     if (!v) return;
+    vxl_brick_source_free(v->source);
     free(v->texels);
     free(v);
 }

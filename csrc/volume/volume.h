@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "brick_source.h"
 #include "error.h"
 #include "voxlight.h"
 
@@ -28,6 +29,11 @@ struct vxl_volume {
     double affine[16];      /* column-major voxel -> world */
     uint32_t frame_count;   /* volumes in the 4D input (0 is read as 1) */
     uint32_t frame;         /* the one this is */
+    /* Streamed (issue 21): texels is NULL and the voxels are read on demand
+     * from source (owned; storage_bytes is what reading it whole would take).
+     * Code that needs every voxel either reads through source a box at a
+     * time or refuses a streamed volume with a clear error. */
+    vxl_brick_source *source;
 };
 
 /* Checks dims against max_dim and the budget before anything is allocated.

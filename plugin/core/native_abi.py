@@ -29,13 +29,17 @@ SHADING_MODELS = ("phong", "shadowed", "scatter")  # VXL_SHADING_*
 MODES = ("dvr", "mip", "minip", "average", "iso")  # VXL_MODE_*
 INTERPOLATIONS = ("nearest", "linear", "cubic")  # VXL_INTERP_*
 LABEL_MODES = ("surface", "mask", "tint")  # VXL_LABEL_MODE_*
+BLENDS = ("over", "add", "max")  # VXL_BLEND_*
+STREAMING_MODES = ("auto", "off", "on")  # VXL_STREAMING_*
+MAX_OVERLAYS = 3  # VXL_MAX_OVERLAYS
 MAX_LABEL_ID = 65535  # VXL_MAX_LABEL_ID
 # The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
 ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "storage": STORAGES,
                   "classify": CLASSIFY_MODES, "gradient_opacity": GRADIENT_OPACITY_MODES,
                   "gradient_store": ("8bit", "16f", "32f"), "shading_model": SHADING_MODELS,
                   "technique": ("raycast", "slices2d", "slices3d"), "mode": MODES,
-                  "interpolation": INTERPOLATIONS, "label_mode": LABEL_MODES}
+                  "interpolation": INTERPOLATIONS, "label_mode": LABEL_MODES,
+                  "blend": BLENDS, "streaming": STREAMING_MODES}
 MAX_LIGHTS = 8
 RENDER_PARAMS_RESERVED = 2  # VXL_RENDER_PARAMS_RESERVED
 MAX_CLIP_PLANES = 6  # VXL_MAX_CLIP_PLANES
@@ -52,6 +56,9 @@ c_float4x4 = ctypes.c_float * 16
 c_double4x4 = ctypes.c_double * 16
 
 
+# int (*progress)(void *user, double fraction, const char *stage): nonzero cancels
+PROGRESS_CALLBACK = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, ctypes.c_char_p)
+
 # --------------------------------------------------------------- structs
 # Field order and types copied from voxlight.h (vxl_phantom_desc from
 # voxlight_dev.h); only fixed-width types.
@@ -63,7 +70,13 @@ class LoadOptions(ctypes.Structure):
                 ("voxel_size", ctypes.c_double * 3),
                 ("frame", ctypes.c_uint32),      # 4D inputs: which volume
                 ("reserved0", ctypes.c_uint32),
-                ("series", ctypes.c_char_p)]     # DICOM: index or SeriesInstanceUID
+                ("series", ctypes.c_char_p),     # DICOM: index or SeriesInstanceUID
+                # appended (issue 21): streaming
+                ("streaming", ctypes.c_uint32),
+                ("reserved1", ctypes.c_uint32),
+                ("cache_dir", ctypes.c_char_p),
+                ("progress", PROGRESS_CALLBACK),
+                ("progress_user", ctypes.c_void_p)]
 
 
 class DicomSeries(ctypes.Structure):
@@ -106,7 +119,11 @@ class VolumeInfo(ctypes.Structure):
                 ("texture_bits", ctypes.c_uint32),
                 ("affine_source", ctypes.c_uint32),
                 ("frame_count", ctypes.c_uint32),
-                ("frame", ctypes.c_uint32)]
+                ("frame", ctypes.c_uint32),
+                ("streamed", ctypes.c_uint32),        # appended (issue 21)
+                ("level_count", ctypes.c_uint32),
+                ("resident_bytes", ctypes.c_uint64),
+                ("bytes_read", ctypes.c_uint64)]
 
 
 class PhantomDesc(ctypes.Structure):
@@ -219,6 +236,25 @@ class SliceParams(ctypes.Structure):
                 ("plane_to_world", c_float4x4)]
 
 
+class OverlayStyle(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("slot", ctypes.c_uint32),
+                ("blend", ctypes.c_uint32),
+                ("interpolation", ctypes.c_uint32),
+                ("interpolation_set", ctypes.c_uint32),
+                ("preset", ctypes.c_uint32),
+                ("tf_size", ctypes.c_uint32),
+                ("has_window", ctypes.c_uint32),
+                ("tf_rgba", ctypes.POINTER(ctypes.c_float)),
+                ("window_low", ctypes.c_float),
+                ("window_high", ctypes.c_float),
+                ("opacity_scale", ctypes.c_float),
+                ("shading_off", ctypes.c_uint32),
+                ("has_model", ctypes.c_uint32),
+                ("model", c_float4x4),
+                ("reserved", ctypes.c_uint32)]
+
+
 class RenderParams(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("width", ctypes.c_uint32),
@@ -275,7 +311,10 @@ class RenderParams(ctypes.Structure):
                 ("scene_shadows", ctypes.POINTER(SceneShadows)),
                 ("matcap", ctypes.POINTER(Matcap)),
                 ("reserved", ctypes.c_uint32 * RENDER_PARAMS_RESERVED),  # must stay 0
-                ("labels", ctypes.POINTER(LabelStyle))]  # appended (issue 20)
+                ("labels", ctypes.POINTER(LabelStyle)),  # appended (issue 20)
+                ("overlay_count", ctypes.c_uint32),      # appended (issue 20)
+                ("progressive", ctypes.c_uint32),        # appended (issue 21)
+                ("overlays", ctypes.POINTER(OverlayStyle))]
 
 
 class RenderStats(ctypes.Structure):
@@ -298,7 +337,11 @@ class RenderStats(ctypes.Structure):
                 ("lod_wanted_bytes", ctypes.c_uint64),
                 ("decode_ms", ctypes.c_double),
                 ("illumination_size", ctypes.c_uint32),
-                ("illumination_rebuilt", ctypes.c_uint32)]
+                ("illumination_rebuilt", ctypes.c_uint32),
+                ("refine_pending", ctypes.c_uint32),     # appended (issue 21)
+                ("stream_level", ctypes.c_uint32),
+                ("bytes_read", ctypes.c_uint64),
+                ("load_ms", ctypes.c_double)]
 
 
 def _sized(struct_type):

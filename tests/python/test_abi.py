@@ -34,6 +34,7 @@ BINDINGS = {
     "vxl_clip_plane": native.ClipPlane,
     "vxl_label_entry": native.LabelEntry,
     "vxl_label_style": native.LabelStyle,
+    "vxl_overlay_style": native.OverlayStyle,
     "vxl_cutter": native.Cutter,
     "vxl_cutaway": native.Cutaway,
     "vxl_matcap": native.Matcap,
@@ -60,6 +61,10 @@ def header_structs():
             for decl in body.split(";"):
                 decl = re.sub(r"\[[^\]]*\]", "", decl).strip()  # array sizes
                 if not decl:
+                    continue
+                fn = re.search(r"\(\s*\*\s*(\w+)\s*\)", decl)  # "int (*progress)(void *, ...)"
+                if fn:
+                    fields.append(fn.group(1))
                     continue
                 first, *more = [d.strip() for d in decl.split(",")]
                 fields.append(re.findall(r"\w+", first)[-1])  # "const float *scene_depth"

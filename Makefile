@@ -36,11 +36,12 @@ DICOM_CXX := csrc/io/dicom.cpp
 HELPER_C := $(wildcard csrc/*/helper_*.c)
 # csrc/cli/*.c: the command-line tool's own files, linked into it alone.
 CLI_C := $(wildcard csrc/cli/*.c)
-# OME-Zarr (csrc/io/zarr.h): decoded with libzstd and libblosc, so built
-# into the helper voxlight-read-zarr only; zarr_detect.c stays in the library.
-ZARR_C := csrc/io/json.c csrc/io/zarr_store.c csrc/io/zarr_chunk.c csrc/io/zarr_read.c
-ZARR_LIBS := -lblosc -lzstd
-LIB_C := $(filter-out $(CLI_C) $(HELPER_C) $(ZARR_C),$(wildcard csrc/*/*.c))
+# OME-Zarr (csrc/io/zarr.h): the same objects are in the library (the brick
+# source streams chunks, zarr_source.c) and in the helper voxlight-read-zarr
+# (whole reads); libzstd and libblosc are dlopen'ed on the first chunk that
+# needs one (zarr_codecs.c), never linked, so neither links them.
+ZARR_C := csrc/io/json.c csrc/io/zarr_store.c csrc/io/zarr_chunk.c csrc/io/zarr_read.c csrc/io/zarr_codecs.c
+LIB_C := $(filter-out $(CLI_C) $(HELPER_C),$(wildcard csrc/*/*.c))
 LIBS := -ldl -lpthread -lz -lm
 # shaders/lib: included code; compute/: compute programs; render/: the ray
 # caster's stages. A shader's name is its path under shaders/ (csrc/gl/shader_source.h).
@@ -53,7 +54,7 @@ HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/vox
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
 STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlight-slicingbench $(BUILD)/voxlight-modesbench \
-           $(BUILD)/voxlight-labelsbench
+           $(BUILD)/voxlight-labelsbench $(BUILD)/voxlight-streambench $(BUILD)/voxlight-overlaysbench
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
@@ -106,7 +107,7 @@ $(BUILD)/voxlight-read-oiio: $(BUILD)/obj/helper_oiio.o $(patsubst %.cpp,$(BUILD
 
 $(BUILD)/voxlight-read-zarr: $(BUILD)/obj/helper_zarr.o $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(ZARR_C))) \
 		$(BUILD)/obj/zarr_detect.o $(HELPER_CORE)
-	$(CC) $(OPT) -o $@ $^ $(ZARR_LIBS) -lz -lm
+	$(CC) $(OPT) -o $@ $^ -ldl -lpthread -lz -lm
 
 $(BUILD)/voxlight-read-dicom: $(BUILD)/obj/helper_dicom.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(DICOM_CXX))) $(HELPER_CORE)
 	$(CXX) $(OPT) -o $@ $^ $(DCMTK_LIBS) -lz -lm
@@ -136,12 +137,28 @@ $(BUILD)/voxlight-lightbench: bench/lighting_study.c bench/bench_util.h $(BUILD)
 $(BUILD)/voxlight-labelsbench: bench/labels_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
+# issue 21: open, first and refined frame, F12, bytes read and peak RSS of one file (docs/streaming.md)
+$(BUILD)/voxlight-streambench: bench/stream_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
+# issue 20: frame time against the number of overlays (docs/overlays.md)
+$(BUILD)/voxlight-overlaysbench: bench/overlays_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
 # issue 19: the render modes' run time against error (docs/modes.md, docs/benchmark.md)
 $(BUILD)/voxlight-modesbench: bench/modes_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
 $(BUILD)/voxlight-sceneshadowbench: bench/scene_shadow_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
+# test_brick_cache calls the cache's internals (csrc/io/brick_cache.h), so it
+# links their objects and those its checks compare against, as well as the library.
+BRICK_CACHE_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,brick_cache brick_cache_read brick_cache_write \
+	brick_cache_format brick_source brick_levels bricks volume error paging lod)
+$(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wildcard tests/*.h) $(BRICK_CACHE_TEST_OBJ) \
+		$(BUILD)/libvoxlight.so | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(BRICK_CACHE_TEST_OBJ) -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h tests/fuzz/*.h) $(BUILD)/libvoxlight.so | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
@@ -161,7 +178,10 @@ FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc
 # the core's loaders and dispatch (the helper-run readers are called
 # in-process by their targets: libFuzzer sees coverage in its own process only)
 FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
-	reader_spawn.c remote_readers.c label_table.c zarr_detect.c $(notdir $(ZARR_C))
+	reader_spawn.c remote_readers.c label_table.c zarr_detect.c $(notdir $(ZARR_C)) zarr_source.c brick_source.c
+# the brick cache of .nii.gz files (issue 21): opened by the loaders, read by fuzz_brick_cache
+FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
+	brick_levels.c raw_source.c stream_load.c)
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))
@@ -180,7 +200,7 @@ $(FUZZ_BUILD)/obj/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h csrc/in
 	clang $(FUZZ_CFLAGS) -c $< -o $@
 
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/fuzz_%.o $(FUZZ_OBJ)
-	clang++ $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@ $(LIBS) $(OIIO_LIBS) $(DCMTK_LIBS) $(ZARR_LIBS)
+	clang++ $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@ $(LIBS) $(OIIO_LIBS) $(DCMTK_LIBS)
 
 $(FUZZ_BUILD)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/writers.h tests/fuzz/dicom_writer.h tests/nifti_writer.h | $(FUZZ_BUILD)/obj
 	$(CC) -std=c11 -D_GNU_SOURCE $(WARN) -O1 -Itests $< -o $@ -lz

@@ -3,8 +3,10 @@
  * transfer function alone (the baseline), then with a label volume of the
  * same grid split into 1, 16 and 256 labels (blocks inside the phantom's
  * ellipsoid) in each label mode (surface, mask, tint), all labels visible.
- * Prints the median frame time and its ratio to the baseline (the goal is
- * <= 1.5x); the times mean nothing on a loaded machine. Command:
+ * Prints the median frame time, its ratio to the baseline (the goal is
+ * <= 1.5x) and the samples a ray took (vxl_render_stats: the work, which
+ * the label bricks' leaps cut, independent of the machine's load); the
+ * times mean nothing on a loaded machine. Command:
  *   make -j1 build/voxlight-labelsbench && ./build/voxlight-labelsbench [--size 512] [--frames 5] */
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,6 +39,14 @@ static vxl_volume *label_volume(const vxl_volume *phantom, uint32_t count)
     return vxl_volume_create(&d, NULL, &v) ? NULL : v;
 }
 
+/* Samples per ray of the last frame. */
+static double samples_per_ray(vxl_renderer *r)
+{
+    vxl_render_stats st = {.struct_size = sizeof st};
+    if (vxl_renderer_get_stats(r, &st) || !st.rays) return 0;
+    return (double)st.samples / st.rays;
+}
+
 int main(int argc, char **argv)
 {
     uint32_t size = 512;
@@ -63,7 +73,8 @@ int main(int argc, char **argv)
     vxl_render_params p = base_params(size);
     p.preset = VXL_PRESET_BONE;
     double base = median_ms(r, &p, img, frames);
-    printf("| labels | mode | frame ms | x single TF |\n|---|---|---|---|\n| - | transfer function | %.1f | 1.00 |\n", base);
+    printf("| labels | mode | frame ms | x single TF | samples a ray |\n|---|---|---|---|---|\n"
+           "| - | transfer function | %.1f | 1.00 | %.1f |\n", base, samples_per_ray(r));
     const uint32_t counts[3] = {1, 16, 256};
     int rc = base < 0;
     for (int c = 0; c < 3 && !rc; c++) {
@@ -86,7 +97,9 @@ int main(int argc, char **argv)
             double t = median_ms(r, &p, img, frames);
             p.labels = NULL;
             if (t < 0) rc = 1;
-            else printf("| %u | %s | %.1f | %.2f |\n", counts[c], vxl_label_mode_name(m), t, t / base);
+            else
+                printf("| %u | %s | %.1f | %.2f | %.1f |\n", counts[c], vxl_label_mode_name(m), t, t / base,
+                       samples_per_ray(r));
         }
     }
     if (rc) fprintf(stderr, "voxlight-labelsbench: %s\n", vxl_renderer_error(r));

@@ -47,13 +47,14 @@ if UNSUPPORTED is None:
                    volume_object)
     from . import cutaway_ui, slice_planes  # noqa: E402  (issue 19)
     from . import label_props, label_ui  # noqa: E402  (issue 20)
+    from . import overlay_props, overlay_ui  # noqa: E402  (issue 20 overlays)
     from .core import (depth, import_job, lights, native, runtime, scene_geometry,  # noqa: E402,F401
                        volume_space, zbuffer)
     from .api import render_volume  # noqa: E402,F401
 
     # Registration order: properties before the UI that shows them; handlers last.
-    _modules = (preferences, properties, label_props, tf, operators, importer, volume_object, panels,
-                slice_planes, cutaway_ui, label_ui, render_hooks, scene_shadows, viewport)
+    _modules = (preferences, properties, label_props, overlay_props, tf, operators, importer, volume_object,
+                panels, slice_planes, cutaway_ui, label_ui, overlay_ui, render_hooks, scene_shadows, viewport)
 else:
     _modules = ()
 

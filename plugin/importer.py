@@ -18,7 +18,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
 from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix
 
-from . import label_props, tf
+from . import label_props, preferences, tf
 from .core import framing, import_job, label_import, orientation, runtime, volume_space
 
 
@@ -111,6 +111,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         path = resolve_path(self.filepath, self.directory)
+        preferences.sync(context)  # issue 21: streaming mode and cache folder
         opts = runtime.options_of(context.scene.voxlight)  # backend, storage, memory budget
         if self.use_modal and context.window is not None:
             self._job = import_job.ImportJob(path, tuple(self.voxel_size), series=self.series, **opts)
@@ -132,6 +133,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             return {"CANCELLED"}
         if event.type == "TIMER":
             context.window_manager.progress_update(job.progress)
+            _show_status(context, job)
             if job.done:
                 self._end_modal(context)
                 return self._finish(context, job)
@@ -145,6 +147,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         wm = context.window_manager
         wm.event_timer_remove(self._timer)
         wm.progress_end()
+        _show_status(context, None)
 
     def _finish(self, context, job):
         """Creates the object from a finished job, or reports its error."""
@@ -179,8 +182,9 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             return {"CANCELLED"}
         runtime.adopt(entry)
         info = entry.info
-        self.report({"INFO"}, "Voxlight: imported %s (%d x %d x %d, %s)"
-                    % (name, *info["dims"], info["dtype"]))
+        streamed = ", streamed from disk (%d levels)" % info["level_count"] if info.get("streamed") else ""
+        self.report({"INFO"}, "Voxlight: imported %s (%d x %d x %d, %s%s)"
+                    % (name, *info["dims"], info["dtype"], streamed))
         return {"FINISHED"}
 
     def _label_plan(self, context, path, info):
@@ -242,6 +246,21 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         if self.frame_in_view:
             frame_in_views(context, obj)
         return obj
+
+
+def _show_status(context, job):
+    """The status bar while a file is opened (issue 21): what the library's
+    first pass is doing and how far it is, and that Esc cancels; job None
+    gives the status bar back."""
+    workspace = getattr(context, "workspace", None)
+    if workspace is None:
+        return
+    if job is None:
+        workspace.status_text_set(None)
+        return
+    what = job.stage or "loading"
+    workspace.status_text_set("Voxlight: %s %s: %d%% (Esc cancels)"
+                              % (what, os.path.basename(job.path), round(job.progress * 100)))
 
 
 def frame_in_views(context, obj):

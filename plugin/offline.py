@@ -7,7 +7,7 @@ the scene's meshes in numpy (zbuffer.py) and passing that as scene_depth.
 import bpy
 import numpy as np
 
-from . import params, scene_shadows
+from . import overlay_frames, params, scene_shadows
 from .core import native, runtime, scene_geometry, volume_space, zbuffer
 
 
@@ -79,6 +79,8 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
     vols = volume_instances(depsgraph, only, for_render)
     if not vols:
         return None
+    # Issue 20: overlays are drawn inside their base, not on their own.
+    vols, fused = overlay_frames.fuse_instances(volume_instances(depsgraph, None, for_render), vols)
     view = proj = None
     named = scene_shadows.named_lights(depsgraph, for_render) \
         if scene.voxlight.use_scene_lights else []
@@ -90,7 +92,8 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
         # (and no z-buffer when none is left).
         vols = [(ob, mw) for ob, mw in vols if not volume_space.outside_frustum(
             mw @ np.array(ob.voxlight.voxel_to_local, np.float64).reshape(4, 4).T,
-            tuple(ob.voxlight.dims), view, proj)]
+            tuple(ob.voxlight.dims), view, proj) or not overlay_frames.instances_outside(
+            fused.get(ob.original, ()), view, proj)]
     # A volume outside the frame may still shadow what is in it.
     want_shadows = bool(frame_info is not None and camera is not None and casters and lights)
     zbuf = None
@@ -119,6 +122,7 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
     layers = []
     for ob, mw in vols:
         entry, kw = volume_kwargs(ob, mw)
+        kw.update(overlay_frames.render_kwargs(entry, ob, fused.get(ob.original, ()), scene.frame_current))
         if shadows is not None and scene_shadows.receives(ob.voxlight):
             kw["scene_shadows"] = shadows
         p = native.make_params(width=width, height=height,

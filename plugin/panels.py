@@ -265,6 +265,8 @@ class VOXLIGHT_PT_volume_stats(_VolumePanel, bpy.types.Panel):
         else:
             col.label(text="Empty-space skipping off")
         col.label(text=storage_text(frame))
+        if stream_text(frame):  # issue 21
+            col.label(text=stream_text(frame))
         if frame.get("lod_level"):
             col.label(text=lod_text(frame), icon="ERROR")
 
@@ -277,6 +279,21 @@ def storage_text(frame):
     return "Storage: %s, %.1f MiB (%d of %d bricks resident, %d constant)" % (
         frame["storage_name"], mib, frame["pages_resident"], frame["pages_total"],
         frame["pages_constant"])
+
+
+def stream_text(frame):
+    """What a streamed volume's last frame read and still waits for (issue
+    21); empty for other volumes."""
+    level, pending = frame.get("stream_level", 0), frame.get("refine_pending", 0)
+    read = frame.get("bytes_read", 0)
+    if not (level or pending or read):
+        return ""
+    text = "Streamed: %.1f MiB read" % (read / 1048576.0)
+    if level:
+        text += ", coarsest level %d (%dx)" % (level, 1 << level)
+    if pending:
+        text += ", %d bricks loading" % pending
+    return text
 
 
 def lod_text(frame):

@@ -91,10 +91,13 @@ def while_lights_move(lights, now, settle_time):
 
 
 def build(obj, width, height, view, proj, scene_depth=None, lights=(), fast=False, lib=None,
-          scene_shadows=None):
+          scene_shadows=None, overlays=None):
     """scene_shadows: the occluders (vertices, triangles, key) that shadow
-    the volume (issue 18), or None."""
+    the volume (issue 18), or None. overlays: make_params' overlay dicts
+    (issue 20, overlay_frames.prepare), or None."""
     kw = look_kwargs(obj.voxlight, fast, dragging=getattr(lights, "dragged", False))
+    if overlays:
+        kw["overlays"] = overlays
     if scene_shadows is not None:
         kw["scene_shadows"] = scene_shadows
     return native.make_params(width=width, height=height, view=view, proj=proj,

@@ -374,8 +374,11 @@ class VoxlightSceneProperties(bpy.types.PropertyGroup):
                                       "this changes)")
     memory_budget_mib: IntProperty(name="Memory Budget (MiB)", default=2048, min=1,
                                    max=1 << 20,
-                                   description="GPU memory a volume may use (volumes reload "
-                                               "when this changes)")
+                                   description="Memory a volume may use, CPU and GPU together: "
+                                               "half for its own copy (a streamed volume's bricks), "
+                                               "the rest for its renderer, all of it once a volume "
+                                               "read whole is uploaded (volumes reload when this "
+                                               "changes)")
 
 
 _classes = cutaway_props.CLASSES + (VoxlightVolumeProperties, VoxlightSceneProperties)

@@ -52,7 +52,7 @@ import gpu
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import gpu_quad, params, scene_shadows, scene_shadows_viewport
+from . import gpu_quad, overlay_frames, params, scene_shadows, scene_shadows_viewport
 from .core import depth as _depth
 from .core import native, resolution_policy, runtime, volume_space
 
@@ -142,6 +142,14 @@ _profile_handles = []
 class _Image:
     """One rendered frame, uploaded: GPUTextures must outlive the draw call
     that samples them, so they live here until replaced."""
+
+    # Issue 21, streamed volumes: bricks drawn coarser than the frame wanted
+    # (stats refine_pending), the coarsest level drawn, when it was made, and
+    # since when the passes of its view have not got finer (None: they do).
+    pending = 0
+    level = 0
+    made_at = 0.0
+    stalled_since = None
 
     def __init__(self, key, rgba, vdepth, win_small, proj, full, scale=1.0, rect=None):
         self.key = key
@@ -449,18 +457,22 @@ class _Frame:
         self.scale = scale
         dims = tuple(ob.voxlight.dims)
         _profile.mark("frame_setup")
-        self.rect = volume_space.screen_rect(model, dims, view, proj, w, h)
+        ovl = overlay_frames.current(ob.name)  # issue 20: the pixels and depths of its overlays too
+        self.rect = overlay_frames.screen_rect(model, dims, ovl, view, proj, w, h)
         self.win_small = None
         scene_depth = None
         if window_depth is not None:
-            near, far = volume_space.planar_range(model, dims, view)
+            near, far = overlay_frames.planar_range(model, dims, ovl, view)
             quantum = 0.125 * volume_space.voxel_size(model)
             self.win_small, scene_depth = _scene_depth(window_depth, w, h, proj, near, far,
                                                        quantum, self.rect)
         _profile.mark("scene_depth")
         self.params = params.build(ob, w, h, view, proj, scene_depth=scene_depth,
                                    lights=lights, fast=fast,
-                                   scene_shadows=scene_shadows.for_viewport(ob))
+                                   scene_shadows=scene_shadows.for_viewport(ob), overlays=ovl.overlays)
+        # Issue 21: never wait for a streamed volume's bricks here; what is
+        # still loading is drawn coarser and refined later (_keep_refining).
+        self.params.progressive = 1
         _profile.mark("params")
         self.key = native.params_digest(self.params, entry.identity)
         _profile.mark("digest")
@@ -527,6 +539,9 @@ def _draw():
     # and local view; such volumes cost nothing.
     objs = [o for o in view_layer.objects
             if o.type in volume_space.VOLUME_TYPES and o.voxlight.is_volume and o.visible_get(viewport=space)]
+    # Issue 20: an overlay is drawn inside its base's frame, not on its own.
+    fused = {b.name: ovs for b, ovs in overlay_frames.fuse(objs)}
+    objs = [o for o in objs if o.name in fused]
     region_ptr = region.as_pointer()
     drawn = set()
     moving_any = False
@@ -547,7 +562,9 @@ def _draw():
         for obj in objs:
             ob = obj.evaluated_get(depsgraph)
             model = params.model_matrix(ob)
-            if _outside_frustum(model, tuple(ob.voxlight.dims), view, proj):
+            overlays = [o.evaluated_get(depsgraph) for o in fused[obj.name]]
+            if _outside_frustum(model, tuple(ob.voxlight.dims), view, proj) and all(
+                    _outside_frustum(params.model_matrix(o), tuple(o.voxlight.dims), view, proj) for o in overlays):
                 culled_count += 1
                 continue
             key = (region_ptr, obj.name)
@@ -566,6 +583,7 @@ def _draw():
             try:
                 entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
                                           scene.frame_current, **runtime.options_of(s))
+                overlay_frames.prepare(entry, ob, overlays, scene.frame_current)  # issue 20
             except native.VoxlightError as e:
                 _report(e)
                 continue
@@ -720,6 +738,8 @@ def _refine_still(st, s, args, owner):
             if _rect_pixels(fr.rect) > 0 and stats.get("seconds", 0.0) > 0.0:
                 st.refine_spp = stats["seconds"] / _rect_pixels(fr.rect)
             img = _Image(fr.key, rgba, vdepth, fr.win_small, args[5], fr is full, fr.scale, fr.rect)
+            _note_streaming(img, stats, st.full if fr is full and st.full is not None
+                            and st.full.key == fr.key else None)
             st.job = None
             if fr is full:
                 st.full = img
@@ -732,7 +752,8 @@ def _refine_still(st, s, args, owner):
             raise native.VoxlightError(str(job.error))
     if st.full is not None and st.full.key == full.key:
         st.full.update_depth(full.win_small)
-        st.cancel_job()
+        if not _keep_refining(st, args[1], full, owner):
+            st.cancel_job()
         return True, st.full
     half = half_frame()
     if st.error_key in [fr.key for fr in (full, half) if fr is not None] or full.rect is None:
@@ -745,6 +766,50 @@ def _refine_still(st, s, args, owner):
         st.half.update_depth(half.win_small)
         return True, st.half
     return False, None
+
+
+# Issue 21: a streamed volume's frame is drawn at once from the bricks at
+# hand, coarser where finer ones are still loading on the renderer's loader
+# thread (stats refine_pending > 0). The still view is then rendered again
+# every STREAM_REFINE_S, each finer image replacing the last, until nothing
+# is pending. A safety net ends it when the passes have not got finer for
+# STREAM_STALL_S: neither fewer pending bricks nor a finer coarsest level.
+# Loading a level can take a while with the count unchanged (12 s for the
+# 3 GiB volume of tests/blender/test_streaming.py on 2 busy cores), so the
+# net is wide.
+STREAM_REFINE_S = 0.25
+STREAM_STALL_S = 60.0
+
+
+def _note_streaming(img, stats, previous):
+    """img's pending bricks and coarsest level from its stats, and since
+    when its view has not got finer, against the image of the same view it
+    replaces (None: a new view)."""
+    img.pending = int(stats.get("refine_pending", 0))
+    img.level = int(stats.get("stream_level", 0))
+    img.made_at = time.monotonic()
+    if previous is not None and previous.pending and img.pending >= previous.pending \
+            and img.level >= previous.level:
+        img.stalled_since = previous.stalled_since if previous.stalled_since is not None \
+            else previous.made_at
+
+
+def _keep_refining(st, entry, full, owner):
+    """The full image of a still view is on screen: while it is coarser than
+    wanted, queue the next pass of the same frame (or a redraw that queues
+    it once STREAM_REFINE_S has passed). False when it is final."""
+    img = st.full
+    now = time.monotonic()
+    if not img.pending or (img.stalled_since is not None and now - img.stalled_since > STREAM_STALL_S):
+        return False
+    if st.job is not None and not st.job.done:
+        return True  # the next pass is on its way; the poll timer redraws
+    wait = STREAM_REFINE_S - (now - img.made_at)
+    if wait > 0.0:
+        _schedule_refine(wait)
+        return True
+    st.submit(entry, full, True, owner)
+    return True
 
 
 def _preview(st, s, args):

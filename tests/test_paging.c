@@ -20,16 +20,7 @@
 /* compressed_domain: compressed storage filtered in the compressed domain */
 static vxl_renderer *make_stored_in(uint32_t storage, uint32_t page_brick, uint64_t budget, uint32_t compressed_domain)
 {
-    vxl_renderer_options o;
-    memset(&o, 0, sizeof o);
-    o.struct_size = sizeof o;
-    o.backend = software_backend();
-    o.storage = storage;
-    o.page_brick = page_brick;
-    o.memory_budget_bytes = budget;
-    o.compressed_domain = compressed_domain;
-    vxl_renderer *r = NULL;
-    return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
+    return make_stored_renderer(storage, page_brick, budget, compressed_domain);
 }
 
 static vxl_renderer *make_stored(uint32_t storage, uint32_t page_brick, uint64_t budget)
@@ -66,14 +57,7 @@ static int compressed_serves(const vxl_render_params *p, int domain)
     return !derived && !(domain && p->classify == VXL_CLASSIFY_PRE);
 }
 
-static vxl_render_stats stats_of(vxl_renderer *r)
-{
-    vxl_render_stats s;
-    memset(&s, 0, sizeof s);
-    s.struct_size = sizeof s;
-    vxl_renderer_get_stats(r, &s);
-    return s;
-}
+static vxl_render_stats stats_of(vxl_renderer *r) { return renderer_stats(r); }
 
 /* The 45x40x37 phantom (45 is not a multiple of 8: partial bricks at the
  * far faces) on each of the n renderers. */

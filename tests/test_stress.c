@@ -398,6 +398,146 @@ static int render_issue19_modes(case_run *cr, int b, stress_view_ctx *vc, buffer
     return errors;
 }
 
+/* Issue 20: the case's volume once more as an overlay in slot 0, shrunk to
+ * 0.6 and turned about its centre (so the ray walks the union of two boxes
+ * and samples a grid at an angle to its own), OVER or MAX and nearest,
+ * linear or cubic in rotation from case to case, shaded in every other
+ * case. A valid case's settings overlays refuse are reset, as the modes
+ * do; an invalid case keeps them. ADD is left to test_overlays.c: its glow
+ * rightly exceeds alpha, which pixels_sane forbids. Returns the number of
+ * failed renders. */
+static int render_issue20_overlay(case_run *cr, int b, stress_view_ctx *vc, buffers *bu, const vxl_volume *v)
+{
+    const stress_case *c = cr->c;
+    stress_case only_depth = *c; /* as the modes: only the invariants and the scene-depth invariance */
+    only_depth.flags &= F_SAME_AS_NO_DEPTH;
+    case_run run = *cr;
+    run.c = &only_depth;
+    vxl_volume_info info = {.struct_size = sizeof info};
+    vxl_volume_get_info(v, &info);
+    const double a = 0.5, ca = cos(a), sa = sin(a);
+    double m[16] = {0.6 * ca, 0.6 * sa, 0, 0, -0.6 * sa, 0.6 * ca, 0, 0, 0, 0, 0.6, 0, 0, 0, 0, 1}, mv[16];
+    for (int r = 0; r < 3; r++) { /* voxel c stays where it is */
+        m[12 + r] = vc->c[r];
+        for (int k = 0; k < 3; k++) m[12 + r] -= m[k * 4 + r] * vc->c[k];
+    }
+    vxl_overlay_style s = {.struct_size = sizeof s, .slot = 0, .blend = cr->idx % 2 ? VXL_BLEND_MAX : VXL_BLEND_OVER,
+                           .interpolation = (uint32_t)(cr->idx % VXL_INTERP_COUNT), .interpolation_set = 1,
+                           .has_model = 1, .shading_off = (uint32_t)(cr->idx % 2)};
+    for (int col = 0; col < 4; col++) /* model = affine * m */
+        for (int r = 0; r < 4; r++) {
+            mv[col * 4 + r] = 0;
+            for (int k = 0; k < 4; k++) mv[col * 4 + r] += info.affine[k * 4 + r] * m[col * 4 + k];
+            s.model[col * 4 + r] = (float)mv[col * 4 + r];
+        }
+    char label[320];
+    snprintf(label, sizeof label, "[%s] overlay blend=%s interpolation=%u backend=%s", c->name, vxl_blend_name(s.blend),
+             s.interpolation, backend_names[b]);
+    int rc = vxl_renderer_set_overlay(R[b], 0, v);
+    if (rc != VXL_OK) { /* a clean refusal (an affine that cannot be inverted) is no failure */
+        if (rc == VXL_ERR_INVALID_ARGUMENT && *vxl_renderer_error(R[b])) return 0;
+        fail(cr, label, "set_overlay returned %s: %s", vxl_error_name(rc), vxl_renderer_error(R[b]));
+        return 1;
+    }
+    vxl_render_params p = stress_base_params(&ENV);
+    p.iso_value = (float)(0.5 * vc->value_min + 0.5 * vc->value_max);
+    c->view(&p, vc);
+    if (c->expect_rc == VXL_OK) {
+        p.mode = VXL_MODE_DVR;
+        p.classify = p.classify == VXL_CLASSIFY_PREINT ? VXL_CLASSIFY_POST : p.classify;
+        p.gradient_opacity = VXL_GOPACITY_OFF;
+        p.technique = VXL_TECHNIQUE_RAYCAST;
+        s.preset = p.preset;
+        s.tf_rgba = p.tf_rgba;
+        s.tf_size = p.tf_size;
+        s.has_window = p.has_window;
+        s.window_low = p.window_low;
+        s.window_high = p.window_high;
+        s.opacity_scale = p.opacity_scale;
+    }
+    p.overlay_count = 1;
+    p.overlays = &s;
+    int errors = render_one(&run, b, &p, 0, label, bu, vc);
+    vxl_renderer_set_overlay(R[b], 0, NULL);
+    return errors;
+}
+
+/* Issue 20 labels: a 24x20x16 label volume laid over the case's volume by
+ * its own affine (the case's, scaled to the box: another grid), ids 1..5 in
+ * bands inside an ellipsoid (3 hidden, 2 and 4 translucent) and a block of
+ * id 65535, drawn in every label mode (surface, mask, tint), shaded in
+ * every other case. A valid case's settings labels refuse (modes, slicing)
+ * are reset, as the modes do; an invalid case keeps them. A label affine
+ * the library cannot use (the case's is not invertible) is a clean
+ * refusal. Returns the number of failed renders. */
+static int render_issue20_labels(case_run *cr, int b, stress_view_ctx *vc, buffers *bu, const vxl_volume *v)
+{
+    enum { LX = 24, LY = 20, LZ = 16 };
+    uint16_t ids[LX * LY * LZ];
+    for (int z = 0; z < LZ; z++)
+        for (int y = 0; y < LY; y++)
+            for (int x = 0; x < LX; x++) {
+                double u = (x + 0.5) / LX - 0.5, w = (y + 0.5) / LY - 0.5, t = (z + 0.5) / LZ - 0.5;
+                uint16_t id = u * u / 0.2 + w * w / 0.16 + t * t / 0.2 <= 1 ? (uint16_t)(1 + (x + 2 * y + 3 * z) / 4 % 5) : 0;
+                ids[x + LX * (y + LY * z)] = x >= 2 && x < 6 && y >= 2 && y < 5 && z < 3 ? 65535 : id;
+            }
+    vxl_volume_info info = {.struct_size = sizeof info};
+    vxl_volume_get_info(v, &info);
+    const uint32_t ld[3] = {LX, LY, LZ};
+    const stress_case *c = cr->c;
+    case_run run = *cr;
+    stress_case only_depth = *c; /* as the modes: only the invariants and the scene-depth invariance */
+    only_depth.flags &= F_SAME_AS_NO_DEPTH;
+    run.c = &only_depth;
+    vxl_volume_desc d = {.struct_size = sizeof d, .dtype = VXL_DTYPE_U16, .dims = {LX, LY, LZ}, .has_affine = 1, .data = ids};
+    for (int col = 0; col < 4; col++) /* label voxel i -> case voxel (i + 0.5) * dims / ld - 0.5 -> world */
+        for (int r = 0; r < 4; r++) {
+            double sum = col < 3 ? info.affine[col * 4 + r] * info.dims[col] / ld[col] : info.affine[12 + r];
+            for (int k = 0; col == 3 && k < 3; k++) sum += info.affine[k * 4 + r] * (0.5 * info.dims[k] / ld[k] - 0.5);
+            d.affine[col * 4 + r] = sum;
+        }
+    char label[320];
+    snprintf(label, sizeof label, "[%s] labels backend=%s", c->name, backend_names[b]);
+    vxl_volume *lab = NULL;
+    int rc = vxl_volume_create(&d, NULL, &lab);
+    if (rc == VXL_OK) rc = vxl_renderer_set_labels(R[b], lab);
+    vxl_volume_destroy(lab);
+    if (rc != VXL_OK) { /* a clean refusal (an affine that cannot be inverted) is no failure */
+        if (rc == VXL_ERR_INVALID_ARGUMENT && *vxl_last_error()) return 0;
+        fail(cr, label, "the label volume: %s: %s", vxl_error_name(rc), vxl_last_error());
+        return 1;
+    }
+    vxl_label_entry e[6];
+    memset(e, 0, sizeof e);
+    for (int k = 0; k < 6; k++) {
+        e[k].struct_size = sizeof e[k];
+        e[k].id = k < 5 ? k + 1 : 65535;
+        e[k].color[0] = 0.2f * (float)k;
+        e[k].color[1] = 1.0f - 0.15f * (float)k;
+        e[k].color[2] = 0.5f;
+        e[k].color[3] = k == 1 ? 0.5f : k == 3 ? 0.3f : 1.0f;
+        e[k].visible = k != 2;
+    }
+    int errors = 0;
+    for (uint32_t m = 0; m < VXL_LABEL_MODE_COUNT; m++) {
+        vxl_label_style s = {.struct_size = sizeof s, .mode = m, .entry_count = 6, .entries = e};
+        vxl_render_params p = stress_base_params(&ENV);
+        p.iso_value = (float)(0.5 * vc->value_min + 0.5 * vc->value_max);
+        p.shading_off = (uint32_t)(cr->idx % 2);
+        c->view(&p, vc);
+        if (c->expect_rc == VXL_OK) {
+            p.mode = VXL_MODE_DVR;
+            p.technique = VXL_TECHNIQUE_RAYCAST;
+        }
+        p.labels = &s;
+        snprintf(label, sizeof label, "[%s] labels=%s classify=%u backend=%s", c->name, vxl_label_mode_name(m),
+                 p.classify, backend_names[b]);
+        errors += render_one(&run, b, &p, 0, label, bu, vc);
+    }
+    vxl_renderer_set_labels(R[b], NULL);
+    return errors;
+}
+
 typedef struct backend_job {
     case_run cr;
     int b;
@@ -456,6 +596,8 @@ static void *run_backend(void *arg)
                 }
             }
     errors += render_issue19_modes(cr, b, &vc, &bu);
+    errors += render_issue20_overlay(cr, b, &vc, &bu, j->v);
+    errors += render_issue20_labels(cr, b, &vc, &bu, j->v);
     if (errors) { /* after any failed render the renderer must still work */
         snprintf(label, sizeof label, "[%s] backend=%s (a plain render after %d failed ones)", c->name,
                  backend_names[b], errors);
@@ -543,6 +685,72 @@ static vxl_renderer *make_sparse_renderer(void)
     o.page_brick = 8;
     vxl_renderer *r = NULL;
     return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
+}
+
+/* Issue 21: every valid case streamed (vxl_volume_stream_copy: bricks read
+ * on demand by the renderer's loader thread), F12 and progressive, with an
+ * on-the-fly filter and a classification in rotation; the unshaded F12
+ * frame equals the whole volume's in the same sparse storage (the same
+ * bricks). */
+TEST(streamed)
+{
+    vxl_renderer *rs = make_sparse_renderer(), *rw = make_sparse_renderer();
+    REQUIRE(rs && rw);
+    const size_t nmax = (size_t)ENV.max_image * ENV.max_image;
+    float *img = malloc(nmax * 4 * sizeof(float)), *ref = malloc(nmax * 4 * sizeof(float));
+    REQUIRE(img && ref);
+    int cases = 0;
+    for (size_t i = 0; i < STRESS_CASE_COUNT; i++) {
+        const stress_case *c = &stress_cases[i];
+        if (c->expect_rc != VXL_OK || ((c->flags & F_FULL_ONLY) && !ENV.full)) continue;
+        if ((only_filter && !strstr(c->name, only_filter)) || (skip_filter && strstr(c->name, skip_filter))) continue;
+        vxl_volume *v = NULL, *sv = NULL;
+        if (stress_make_volume(&c->vol, &ENV, &v) != VXL_OK) continue; /* refused cleanly: run_case reports it */
+        int rc = vxl_volume_stream_copy(v, 0, &sv);
+        CHECKF(rc == VXL_OK, "[%s] stream copy: %s", c->name, vxl_last_error());
+        stress_view_ctx vc;
+        stress_view_ctx_init(&vc, &ENV, v);
+        vxl_render_params p = stress_base_params(&ENV);
+        p.filter = (uint32_t)(i % VXL_FILTER_PRECOMPUTED); /* the derived filters refuse streamed volumes */
+        p.classify = (uint32_t)(i % VXL_CLASSIFY_COUNT);
+        p.iso_value = (float)(0.5 * vc.value_min + 0.5 * vc.value_max);
+        if (!rc && vc.depth && vc.tf) c->view(&p, &vc);
+        const size_t npix = (size_t)p.width * p.height;
+        const int s1 = !rc && npix <= nmax ? vxl_renderer_set_volume(rs, sv) : -1;
+        const int s2 = s1 >= 0 ? vxl_renderer_set_volume(rw, v) : -1;
+        CHECKF(s1 == VXL_OK || s2 != VXL_OK, "[%s] set_volume of the streamed copy: %s", c->name, vxl_renderer_error(rs));
+        if (s1 == VXL_OK && s2 == VXL_OK) {
+            cases++;
+            p.progressive = 1;
+            int r1 = vxl_render(rs, &p, img, NULL);
+            const int clean = r1 != VXL_OK && (c->alt_rc_mask & (1u << r1));
+            CHECKF(r1 == VXL_OK || clean, "[%s] progressive: %s", c->name, vxl_renderer_error(rs));
+            CHECKF(r1 != VXL_OK || image_is_sane(img, NULL, npix), "[%s] progressive frame not sane", c->name);
+            p.progressive = 0;
+            int r2 = vxl_render(rs, &p, img, NULL);
+            CHECKF(r2 == VXL_OK || (c->alt_rc_mask & (1u << r2)), "[%s] F12: %s", c->name, vxl_renderer_error(rs));
+            CHECKF(r2 != VXL_OK || image_is_sane(img, NULL, npix), "[%s] F12 frame not sane", c->name);
+            /* unshaded, as the shading of a gradient near 0 (a checker seen
+             * through Sobel8) turns on the last bit of the pool's addressing */
+            p.shading_off = 1;
+            r2 = vxl_render(rs, &p, img, NULL);
+            int r3 = vxl_render(rw, &p, ref, NULL);
+            CHECKF(r2 == r3, "[%s] streamed %d, whole %d: %s", c->name, r2, r3, vxl_renderer_error(rs));
+            if (r2 == VXL_OK && r3 == VXL_OK) {
+                const double psnr = image_psnr(img, ref, npix * 4);
+                CHECKF(image_is_sane(img, NULL, npix) && psnr >= 60, "[%s] streamed against whole: %.1f dB", c->name, psnr);
+            }
+        }
+        stress_view_ctx_free(&vc);
+        vxl_volume_destroy(sv);
+        vxl_volume_destroy(v);
+    }
+    fprintf(stderr, "    streamed: %d cases\n", cases);
+    CHECK(cases > 0 || only_filter || skip_filter);
+    free(img);
+    free(ref);
+    vxl_renderer_destroy(rs);
+    vxl_renderer_destroy(rw);
 }
 
 /* The matrix needs its backends: a missing one is a failure, not a skip. */
@@ -651,6 +859,7 @@ int main(int argc, char **argv)
     RUN(steps);
     RUN(lighting);
     RUN(invalid_inputs);
+    RUN(streamed); /* issue 21 */
 
     pthread_mutex_lock(&lock); /* the watchdog must not fire during teardown */
     for (int b = 0; b < BACKEND_N; b++) render_started[b] = 0;

@@ -105,6 +105,33 @@ static inline vxl_renderer *make_renderer(uint32_t backend)
     return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
 }
 
+/* A renderer on the software backend with the given storage, page brick
+ * and memory budget (0: defaults); compressed_domain as voxlight_dev.h says. */
+static inline vxl_renderer *make_stored_renderer(uint32_t storage, uint32_t page_brick, uint64_t budget,
+                                                 uint32_t compressed_domain)
+{
+    vxl_renderer_options o;
+    memset(&o, 0, sizeof o);
+    o.struct_size = sizeof o;
+    o.backend = software_backend();
+    o.storage = storage;
+    o.page_brick = page_brick;
+    o.memory_budget_bytes = budget;
+    o.compressed_domain = compressed_domain;
+    vxl_renderer *r = NULL;
+    return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
+}
+
+/* The stats of r's last frame (zeros but struct_size when it has none). */
+static inline vxl_render_stats renderer_stats(vxl_renderer *r)
+{
+    vxl_render_stats s;
+    memset(&s, 0, sizeof s);
+    s.struct_size = sizeof s;
+    vxl_renderer_get_stats(r, &s);
+    return s;
+}
+
 static inline vxl_render_params default_params(uint32_t w, uint32_t h)
 {
     vxl_render_params p;

@@ -68,8 +68,8 @@ static int check_ok(vxl_test_ctx *T_, char **f, const vxl_load_options *opt)
     int ok = 1;
     for (int a = 0; a < 3; a++) {
         ok &= info.dims[a] == dims[a];
-        ok &= fabs(info.affine[a * 4 + a] - atof(f[8 + a])) < 1e-12; /* scale on the diagonal */
-        ok &= fabs(info.affine[12 + a] - atof(f[11 + a])) < 1e-12;   /* translation */
+        ok &= fabs(info.affine[a * 4 + a] - atof(f[8 + a])) < 1e-12; /* scale on the diagonal, mm */
+        ok &= fabs(info.affine[12 + a] - atof(f[11 + a])) < 1e-12;   /* translation, mm */
     }
     ok &= info.frame_count == (uint32_t)atoi(f[14]) && info.frame == (uint32_t)atoi(f[2]);
     CHECKF(ok, "%s: dims %ux%ux%u frames %u, geometry or frame count differ from the manifest", f[1], info.dims[0],
@@ -115,7 +115,8 @@ TEST(generated_stores_read_exactly_and_bad_ones_fail_clearly)
     while (fgets(line, sizeof line, m)) {
         char *f[16];
         int n = fields(line, f, 16);
-        vxl_load_options opt = {.struct_size = sizeof opt};
+        /* the whole read (the streamed source: test_zarr_source.c) */
+        vxl_load_options opt = {.struct_size = sizeof opt, .streaming = VXL_STREAMING_OFF};
         if (n >= 4) {
             opt.frame = (uint32_t)atoi(f[2]);
             opt.memory_budget_bytes = strtoull(f[3], NULL, 10);

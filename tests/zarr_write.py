@@ -193,8 +193,9 @@ class Manifest:
         exp = self.out / f"{name}.f64"
         exp.write_bytes(vol.tobytes())
         sc = scales[level] if scales else [1.0 if a in "tc" else float(2 ** level) for a in axes]
-        s = [sc[axes.index(a)] for a in "xyz"]
-        tr = [translation[axes.index(a)] if translation else 0.0 for a in "xyz"]
+        # write_store's axes are in micrometers: the reader's affine is in mm
+        s = [sc[axes.index(a)] * 1e-3 for a in "xyz"]
+        tr = [translation[axes.index(a)] * 1e-3 if translation else 0.0 for a in "xyz"]
         nt = levels[0].shape[axes.index("t")] if "t" in axes else 1
         path = str(store) + (fragment if fragment is not None else f"#level={level}&c={c}")
         self.lines.append("\t".join(["OK", path, str(t), str(budget), str(exp),

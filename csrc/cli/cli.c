@@ -1,5 +1,7 @@
 /* cli.c - the `voxlight` command-line tool: `render`, `info` and `labels`. Every
- * failure ends with one line "voxlight: error: ..." and exit status 1. */
+ * failure ends with one line "voxlight: error: ..." and exit status 1; Ctrl-C
+ * while a file is first opened ends with "voxlight: cancelled: ..." and exit
+ * status 130 (cli_stream.c). */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -12,6 +14,8 @@
 #include "cli_modes.h" /* --mode, --iso-value, --matcap, --ortho, --view (issue 19) */
 #include "cli_labels.h" /* the labels command (issue 20) */
 #include "cli_labels_render.h" /* render --labels ... (issue 20) */
+#include "cli_overlays.h" /* render --overlay ... (issue 20) */
+#include "cli_stream.h" /* --streaming, --cache-dir, first-open progress, Ctrl-C, budget split (issue 21) */
 #include "voxlight_dev.h" /* phantoms (phantom:NAME inputs) and --no-skip */
 
 /* The option values come from the library's name functions (vxl_*_name),
@@ -28,15 +32,23 @@ static const char usage_format[] =
     "                  [--light dir:X,Y,Z[,INTENSITY] | point:X,Y,Z[,INTENSITY]]... [--shading %s]\n"
     "                  [--ambient-occlusion RADIUS] [--anisotropy G]\n"
     "                  [--mode %s] [--iso-value V] [--matcap FILE.png] [--ortho]\n"
-    "                  [--view x|-x|y|-y|z|-z]\n"
+    "                  [--view x|-x|y|-y|z|-z] [--streaming %s] [--cache-dir DIR]\n"
     "                  [--clip-plane A,B,C,D[,T]]... [--crop X0:X1,Y0:Y1,Z0:Z1] [--no-caps]\n"
     "                  [--labels LABELS [--label-lut FILE] [--label-mode surface|mask|tint]\n"
     "                   [--hide-labels ID,...] [--label-opacity ID:ALPHA,...]]\n"
-    "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
+    "                  [--overlay FILE[:PRESET][:LO:HI] [--overlay-blend over|add|max] [--overlay-opacity X]]...\n"
+    "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID] [--streaming MODE] [--cache-dir DIR]\n"
     "  voxlight labels FILE   (a label lookup table: FreeSurfer LUT, ITK-SNAP, Slicer .ctbl, MRIcron .lut/.txt)\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
     "--voxel-size (mm) is for inputs without geometry (TIFF/PNG stacks); one value sets all three\n"
+    "memory budget: --memory-budget SIZE (default 2G) bounds the volume and the renderer together: the\n"
+    "         volume's CPU side gets half (a file read whole must fit it); a streamed volume keeps its index,\n"
+    "         coarse level and brick cache in that half and the renderer (GL side) gets the other half; a\n"
+    "         volume read whole is freed once uploaded, so the renderer may then use all of it\n"
+    "streaming: auto reads bricks on demand when the voxels exceed half of the volume's share, on always,\n"
+    "         off never; a .nii.gz is streamed once into a bricked cache (beside the file, or in --cache-dir)\n"
+    "         with progress on stderr; Ctrl-C during that first open cancels it (exit status 130, no cache kept)\n"
     "filters: %s; presets: %s\n"
     "storage: auto = one texture when it fits the texture limit and --memory-budget, else bricked;\n"
     "         sparse keeps only the bricks the transfer function can show; compressed holds every brick\n"
@@ -54,6 +66,9 @@ static const char usage_format[] =
     "         same stem with .lut/.txt/.ctbl/.label beside it, else a palette for every nonzero id);\n"
     "         surface (default) shades each label as a surface, mask / tint apply the transfer function\n"
     "         inside visible labels (tint: times the label colour) (docs/labels.md)\n"
+    "overlays: --overlay (repeatable, up to 3) adds a volume in its own grid (placed by its affine) to the\n"
+    "         same ray march, classified by PRESET (default auto) and the window LO:HI in its data units;\n"
+    "         --overlay-blend and --overlay-opacity (a scale, > 0) set the --overlay given last (docs/overlays.md)\n"
     "INPUT may be a generated phantom: phantom:NAME[:WxHxD], NAME one of\n"
     "         %s\n"
     "         (large-sparse: default 2500x1500x400, 1.5 GB of 8-bit voxels)\n";
@@ -77,7 +92,7 @@ static const char *name_list(name_fn name, uint32_t first, const char *sep, char
 static void print_usage(FILE *out)
 {
     char backends[64], stores[64], classify[64], gopacity[64], storage[128], filters[256], presets[128], phantoms[256],
-        techniques[64], shading[64], modes[64];
+        techniques[64], shading[64], modes[64], streaming[64];
     fprintf(out, usage_format, name_list(vxl_backend_name, 0, "|", backends, sizeof backends),
             name_list(vxl_gradient_store_name, 0, "|", stores, sizeof stores),
             name_list(vxl_classify_name, 0, "|", classify, sizeof classify),
@@ -86,6 +101,7 @@ static void print_usage(FILE *out)
             name_list(vxl_technique_name, 0, "|", techniques, sizeof techniques),
             name_list(vxl_shading_model_name, 0, "|", shading, sizeof shading),
             name_list(vxl_mode_name, 0, "|", modes, sizeof modes),
+            name_list(vxl_streaming_name, 0, "|", streaming, sizeof streaming),
             name_list(vxl_filter_name, 0, " ", filters, sizeof filters),
             name_list(vxl_preset_name, 0, " ", presets, sizeof presets),
             name_list(vxl_phantom_name, 1, " ", phantoms, sizeof phantoms));
@@ -299,11 +315,18 @@ static int load_input(const char *input, const vxl_load_options *lo, vxl_volume 
 static int cmd_info(int argc, char **argv)
 {
     vxl_load_options lo = {.struct_size = sizeof lo};
+    vxl_cli_stream stream; /* issue 21 */
+    vxl_cli_stream_init(&stream);
+    char serr[512];
     const char *input = NULL;
     for (int i = 0; i < argc; i++) {
         int r = parse_input_option(argc, argv, &i, &lo);
         if (r < 0) return 1;
         if (r) continue;
+        if ((r = vxl_cli_stream_option(argc, argv, &i, &stream, serr, sizeof serr)) != 0) {
+            if (r < 0) return die("%s", serr);
+            continue;
+        }
         if (argv[i][0] == '-' && argv[i][1]) return die("unknown option '%s' (see voxlight --help)", argv[i]);
         if (input) return die("info takes one INPUT (see voxlight --help)");
         input = argv[i];
@@ -316,7 +339,11 @@ static int cmd_info(int argc, char **argv)
         return 0;
     }
     vxl_volume *v = NULL;
-    if (load_input(input, &lo, &v)) return strncmp(input, "phantom:", 8) ? die("%s", vxl_last_error()) : 1;
+    vxl_cli_stream_begin(&stream, input, 0, &lo);
+    int load_rc = load_input(input, &lo, &v);
+    int cancelled = vxl_cli_stream_end(&stream, load_rc);
+    if (cancelled) return vxl_volume_destroy(v), cancelled;
+    if (load_rc) return strncmp(input, "phantom:", 8) ? die("%s", vxl_last_error()) : 1;
     vxl_volume_info in = {.struct_size = sizeof in};
     vxl_volume_get_info(v, &in);
     /* NIfTI names its two affines; other formats store one (reported as 2) */
@@ -336,7 +363,9 @@ static int cmd_info(int argc, char **argv)
     printf("inf voxels:  %llu\n", (unsigned long long)in.inf_count);
     printf("affine:      %s (voxel -> world mm)\n", in.affine_source < 3 ? src[in.affine_source] : "?");
     for (int r = 0; r < 4; r++)
-        printf("  [%10.4f %10.4f %10.4f %10.4f]\n", in.affine[r], in.affine[4 + r], in.affine[8 + r], in.affine[12 + r]);
+        /* %g: microscopy voxels are 0.0002 mm, which a fixed 4 decimals would round */
+        printf("  [%10.6g %10.6g %10.6g %10.6g]\n", in.affine[r], in.affine[4 + r], in.affine[8 + r], in.affine[12 + r]);
+    vxl_cli_stream_print_info(&in, stdout); /* issue 21 */
     vxl_volume_destroy(v);
     return 0;
 }
@@ -349,6 +378,8 @@ typedef struct render_args {
     vxl_cli_modes modes; /* issue 19 */
     vxl_cli_cut cut;     /* issue 19 cutaways */
     vxl_cli_labels labels; /* issue 20 label maps */
+    vxl_cli_overlays overlays; /* issue 20 overlays */
+    vxl_cli_stream stream; /* issue 21 streaming */
 } render_args;
 
 static int parse_render(int argc, char **argv, render_args *a)
@@ -426,8 +457,8 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (enum_option("backend", val, vxl_backend_name, vxl_backend_from_name, &a->ro.backend)) return 1;
         } else if (!strcmp(o, "--memory-budget")) {
             NEED_VALUE();
+            /* the whole budget for now: cmd_render splits it (cli_stream.c) */
             if (!parse_size(val, &a->ro.memory_budget_bytes)) return die("bad --memory-budget '%s': e.g. 2G or 512M", val);
-            a->lo.memory_budget_bytes = a->ro.memory_budget_bytes;
         } else if (!strcmp(o, "--storage")) {
             NEED_VALUE();
             if (enum_option("storage", val, vxl_storage_name, vxl_storage_from_name, &a->ro.storage)) return 1;
@@ -447,6 +478,10 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (r < 0) return die("%s", err);
         } else if ((r = vxl_cli_labels_option(argc, argv, &i, &a->labels, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err); /* issue 20 */
+        } else if ((r = vxl_cli_overlays_option(argc, argv, &i, &a->overlays, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err); /* issue 20 overlays */
+        } else if ((r = vxl_cli_stream_option(argc, argv, &i, &a->stream, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err); /* issue 21 */
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);
@@ -467,22 +502,32 @@ static int cmd_render(int argc, char **argv)
     vxl_cli_modes_init(&a.modes);
     vxl_cli_cut_init(&a.cut);
     vxl_cli_labels_init(&a.labels);
+    vxl_cli_overlays_init(&a.overlays);
+    vxl_cli_stream_init(&a.stream);
     if (parse_render(argc, argv, &a)) return 1;
     uint32_t w = a.p.width ? a.p.width : 512, h = a.p.height ? a.p.height : 512;
     vxl_volume *v = NULL;
     vxl_renderer *r = NULL;
     float *rgba = NULL, *depth = NULL;
     int status = 1;
-    if (load_input(a.input, &a.lo, &v)) {
+    /* issue 21: --memory-budget is split between the volume and the renderer */
+    vxl_cli_stream_begin(&a.stream, a.input, a.ro.memory_budget_bytes, &a.lo);
+    int load_rc = load_input(a.input, &a.lo, &v);
+    int cancelled = vxl_cli_stream_end(&a.stream, load_rc);
+    if (cancelled) { status = cancelled; goto done; }
+    if (load_rc) {
         if (strncmp(a.input, "phantom:", 8)) die("%s", vxl_last_error());
         goto done;
     }
+    a.ro.memory_budget_bytes = vxl_cli_stream_renderer_budget(&a.stream, v);
+    a.p.progressive = 0; /* a file is written once: wait for every brick at full resolution */
     if (vxl_renderer_create(&a.ro, &r)) { die("%s", vxl_last_error()); goto done; }
     if (vxl_renderer_set_volume(r, v)) { die("%s", vxl_renderer_error(r)); goto done; }
     char merr[512];
     if (vxl_cli_modes_apply(&a.modes, r, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_cut_apply(&a.cut, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_labels_apply(&a.labels, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; } /* issue 20 */
+    if (vxl_cli_overlays_apply(&a.overlays, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     vxl_volume_destroy(v);
     v = NULL;
     rgba = malloc((size_t)w * h * 4 * sizeof *rgba);
@@ -508,6 +553,7 @@ static int cmd_render(int argc, char **argv)
                 st.resident_bytes / 1048576.0, secs);
     if (st.storage == VXL_STORAGE_COMPRESSED)
         fprintf(stderr, "voxlight: compressed bricks decoded into the cache in %.1f ms\n", st.decode_ms);
+    vxl_cli_stream_print_stats(&a.stream, &st, stderr); /* issue 21 */
     if (st.lod_level) /* never silently coarser */
         fprintf(stderr, "voxlight: LOD fallback: level %u (%ux coarser per axis): the visible bricks need %.1f MiB at full "
                 "resolution, over the memory budget of %.1f MiB\n", st.lod_level, 1u << st.lod_level,

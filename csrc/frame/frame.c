@@ -68,7 +68,7 @@ static int check_float(vxl_err *e, const char *name, float v, float lo, float hi
     return VXL_OK;
 }
 
-static int resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e)
+int vxl_frame_resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e)
 {
     uint32_t preset = vxl_preset_resolve(p->preset, g->value_min, g->value_max);
     if (p->tf_rgba) {
@@ -300,6 +300,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     /* ISO opacity: the occupancy follows the iso-surface instead of the
      * table (bricks.c), conservatively for filters without a gradient bound. */
     f->skip = !p->no_skip;
+    f->progressive = p->progressive != 0; /* issue 21 */
     f->depth_threshold = p->depth_threshold == 0 ? 0.5f : p->depth_threshold;
     rc = check_float(e, "depth_threshold", f->depth_threshold, 1e-6f, 1);
     if (rc) return rc;
@@ -310,7 +311,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     if (!rc) rc = vxl_frame_resolve_scene_shadows(f, p, e); /* issue 18 */
     if (!rc) rc = vxl_frame_cut_resolve(&f->cut, p, f->model, f->technique, e); /* issue 19 cutaways */
     if (!rc) rc = vxl_frame_resolve_labels(f, p, e); /* issue 20 labels */
-    if (!rc) rc = resolve_tf(f, p, g, e);
+    if (!rc) rc = vxl_frame_resolve_tf(f, p, g, e);
     if (rc) vxl_frame_free(f);
     return rc;
 }
@@ -319,6 +320,7 @@ void vxl_frame_free(vxl_frame *f)
 {
     free(f->tf_copy);
     f->tf_copy = NULL;
+    vxl_frame_overlays_free(f); /* issue 20 */
 }
 
 uint64_t vxl_classification_key(const vxl_frame *f)

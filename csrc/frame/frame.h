@@ -19,6 +19,19 @@ typedef struct vxl_volume_geom {
     double value_min, value_max;
 } vxl_volume_geom;
 
+/* One overlay of a frame (issue 20), resolved against its volume's geometry. */
+typedef struct vxl_frame_overlay {
+    uint32_t slot, blend, interpolation; /* VXL_BLEND_*, VXL_INTERP_* */
+    uint32_t shading;           /* lit (the frame shades and the overlay's shading_off is 0) */
+    double model[16];           /* overlay voxel -> world */
+    const float *tf;            /* tf_size straight RGBA, clamped to [0,1]: tf_copy or preset_tf */
+    uint32_t tf_size;
+    float window_offset, window_scale, opacity_scale; /* as the frame's, on the overlay's normalised texels */
+    uint64_t key;               /* vxl_classification_key of the above: the GL side's TF and occupancy cache */
+    float *tf_copy;             /* owned when the caller gave a table */
+    float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
+} vxl_frame_overlay;
+
 typedef struct vxl_frame {
     uint32_t width, height;
     uint32_t filter, shading, reuse, store, jitter, seed;
@@ -64,6 +77,7 @@ typedef struct vxl_frame {
     uint64_t occluder_key;               /* the caller's version, or the arrays' hash; never 0 with occluders */
     float early_termination, depth_threshold;
     int skip;                   /* empty-space skipping and the screen-space bound */
+    uint32_t progressive;       /* issue 21: 1 = draw streamed volumes from what is resident (docs/streaming.md) */
     const float *scene_depth;
     float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
     float *tf_copy;             /* owned when the caller gave a table */
@@ -84,6 +98,11 @@ typedef struct vxl_frame {
         uint32_t count, stride;         /* entries and their stride in bytes */
         uint64_t key;                   /* hash of the table (ids, colours, visibility) */
     } labels;
+    /* issue 20 overlays (frame_overlays.c): count is 0 without params.overlays. */
+    struct {
+        uint32_t count;
+        vxl_frame_overlay ov[VXL_MAX_OVERLAYS];
+    } overlays;
 } vxl_frame;
 
 /* The gradient filter a frame evaluates: rays that never evaluate gradients
@@ -145,6 +164,26 @@ int vxl_frame_resolve_mode(vxl_frame *f, const vxl_render_params *p, vxl_err *e)
  * intensity volume's occupancy says nothing of the labels'. Part of
  * vxl_frame_resolve (frame_labels.c). */
 int vxl_frame_resolve_labels(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+
+/* issue 20 overlays: validates p->overlays (count <= VXL_MAX_OVERLAYS, the
+ * stride, each slot in range, listed once and set (geoms[slot] non-NULL:
+ * the overlay volume's geometry, else VXL_ERR_STATE), blend, interpolation,
+ * reserved, a finite invertible model; DVR with the ray caster only, not
+ * with SURFACE labels, pre-integration or gradient opacity) into
+ * f->overlays, each transfer function and window resolved against its own
+ * volume (vxl_frame_resolve_tf). Widens f->step and f->max_steps to the
+ * union of all boxes, in the base volume's voxels. After vxl_frame_resolve
+ * (it needs the mode, matrices and labels); frame_overlays.c. */
+int vxl_frame_resolve_overlays(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *const geoms[VXL_MAX_OVERLAYS],
+                               const vxl_volume_geom *base, vxl_err *e);
+/* Frees what vxl_frame_resolve_overlays allocated (part of vxl_frame_free). */
+void vxl_frame_overlays_free(vxl_frame *f);
+
+/* The transfer function, window and opacity scale of p (preset or table,
+ * resampled to at most 4096 entries and clamped) against volume g into
+ * f->tf, f->tf_size, f->window_offset/scale, f->opacity_scale (f->tf_copy
+ * owned). Part of vxl_frame_resolve; overlays resolve theirs with it. */
+int vxl_frame_resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e);
 
 /* Validates p->scene_shadows (issue 18) into f's occluder fields: NULL
  * arrays with counts, indices out of range, vertices not finite and map

@@ -28,6 +28,12 @@
 #define VXL_MATCAP_UNIT 16        /* raycast: the MatCap image (issue 19, render/matcap.c) */
 #define VXL_LABELS_UNIT 18        /* raycast: the label volume (R16UI, issue 20, labels/labels.c) */
 #define VXL_LABEL_TABLE_UNIT 19   /* raycast: the per-label colour table (issue 20) */
+#define VXL_LABEL_BRICKS_UNIT 23  /* raycast: per label brick, the visible-label distance map and uniform id (issue 20, labels/label_bricks.c) */
+/* Overlays (issue 20, overlay/overlays.c) take three units each from 32 up (within GL 4.5's 80
+ * combined units), so the units below stay free for the other rooms. */
+#define VXL_OVERLAY_VOLUME_UNIT 32   /* raycast: overlay k's volume on unit 32 + k, k < VXL_MAX_OVERLAYS */
+#define VXL_OVERLAY_TF_UNIT 35       /* raycast: overlay k's transfer function on unit 35 + k */
+#define VXL_OVERLAY_DISTANCE_UNIT 38 /* raycast: overlay k's brick distance map (empty-space skipping) on unit 38 + k */
 #define VXL_BRICK_MINMAX_UNIT 17  /* raycast: the brick min-max grid the modes skip by (issue 19, render/mode_bricks.c) */
 
 /* Image units. */

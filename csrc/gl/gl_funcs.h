@@ -80,7 +80,8 @@
     X(PFNGLFRAMEBUFFERTEXTURELAYERPROC, FramebufferTextureLayer)              \
     X(PFNGLDEPTHFUNCPROC, DepthFunc)                                          \
     X(PFNGLDEPTHMASKPROC, DepthMask)                                          \
-    X(PFNGLUNIFORM1FVPROC, Uniform1fv)
+    X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                        \
+    X(PFNGLCOPYIMAGESUBDATAPROC, CopyImageSubData) /* issue 21: a streamed pool grown keeps its bricks */
 
 typedef struct vxl_gl {
 #define VXL_GL_MEMBER(type, name) type name;

@@ -99,6 +99,9 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* issue 20: label mode + 1 */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABELS %u\n",
                      (flags >> VXL_FLAG_LABELS_SHIFT) & 3);
+        if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3) /* issue 20: the number of overlays */
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define OVERLAYS %u\n",
+                     (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3);
         rc = compile(g, GL_VERTEX_SHADER, kind == VXL_PROG_SLICES ? "render/slices.vert" : "render/raycast.vert", NULL, &a);
         if (rc) return rc;
         rc = compile(g, GL_FRAGMENT_SHADER, kind == VXL_PROG_SLICES ? "render/slices.frag" : "render/raycast.frag", defines, &b);

@@ -50,6 +50,8 @@
 #define VXL_FLAG_CUT_CUTTERS (1u << 15) /* CUT_CUTTERS: cutter meshes remove depth intervals */
 /* Ray caster program flag of issue 20 (labels/labels.c): bits 16-17 hold the label mode + 1 (LABELS); 0 none. */
 #define VXL_FLAG_LABELS_SHIFT 16u
+/* Ray caster program flag of issue 20 (overlay/overlays.c): bits 18-19 hold the number of overlays (OVERLAYS); 0 none. */
+#define VXL_FLAG_OVERLAYS_SHIFT 18u
 
 typedef struct vxl_program_entry {
     uint32_t key;

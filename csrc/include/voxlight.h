@@ -176,12 +176,15 @@ typedef struct vxl_load_options {
      *         memory_budget_bytes, else read whole (today's path)
      *   OFF   read whole; over the budget is VXL_ERR_LIMIT (today's)
      *   ON    stream whatever the size
-     * Uncompressed NIfTI, NRRD, MetaImage and TIFF are read by offset;
-     * gzip-compressed files are streamed through once into a bricked cache
-     * (compressed per brick, with the min-max and a downsampled pyramid)
-     * that later opens read; OME-Zarr reads its chunks and uses its
-     * multiscale pyramid as the levels. Formats without random access or a
-     * cache are read whole (and are VXL_ERR_LIMIT over the budget). */
+     * Uncompressed NIfTI, NRRD and MetaImage are read by offset;
+     * gzip-compressed files (.nii.gz, detached gzip NRRD data) are streamed
+     * through once into a bricked cache (compressed per brick, with the
+     * min-max and a downsampled pyramid) that later opens read; OME-Zarr
+     * reads its chunks and uses its multiscale pyramid as the levels.
+     * Formats without random access or a cache (TIFF/PNG stacks, DICOM,
+     * OpenVDB, gzip data attached to a NRRD header, zlib MetaImage) are
+     * read whole, and over the budget are VXL_ERR_LIMIT saying streaming
+     * is not available for them. */
     uint32_t streaming;           /* VXL_STREAMING_* */
     uint32_t reserved1;           /* must be 0 */
     const char *cache_dir;        /* where bricked caches go; NULL or "": beside the source file
@@ -573,7 +576,8 @@ typedef struct vxl_overlay_style {
     uint32_t slot;              /* < VXL_MAX_OVERLAYS: the volume set by vxl_renderer_set_overlay */
     uint32_t blend;             /* VXL_BLEND_* */
     uint32_t interpolation;     /* VXL_INTERP_*: 0 (nearest) ... see below; the default is LINEAR:
-                                   interpolation_set 0 means linear */
+                                   interpolation_set 0 means linear. CUBIC is here the approximating
+                                   cubic B-spline (smooth, never overshoots: docs/overlays.md) */
     uint32_t interpolation_set; /* 1: use interpolation as given (so NEAREST, 0, can be asked) */
     uint32_t preset;            /* VXL_PRESET_* used when tf_rgba is NULL */
     uint32_t tf_size;           /* entries in tf_rgba (>= 2) */
@@ -744,7 +748,8 @@ typedef struct vxl_render_stats {
     uint32_t refine_pending;    /* bricks the frame wanted finer than it drew (progressive: still loading) */
     uint32_t stream_level;      /* the coarsest level any drawn brick came from (0 = full resolution) */
     uint64_t bytes_read;        /* bytes the frame read from the file or cache */
-    double load_ms;             /* milliseconds the frame waited for bricks (0 when progressive) */
+    double load_ms;             /* milliseconds the frame waited for bricks (progressive: only for the
+                                   coarsest level's visible bricks, read once, small) */
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);

@@ -30,6 +30,30 @@
 extern "C" {
 #endif
 
+/* ------------------------------------------------ streamed volumes (issue 21) */
+
+/* A streamed copy of a whole volume: the same info, no texels, its voxels
+ * served by a brick source over a copy of whole's texels with n_levels
+ * levels (0 = as many as a file of that size would get), so tests can
+ * render streamed against whole. Destroy with vxl_volume_destroy. */
+VXL_API int vxl_volume_stream_copy(const vxl_volume *whole, uint32_t n_levels, vxl_volume **out);
+
+/* The texels (texture format: 8/16-bit codes or floats, x fastest) of the
+ * box lo .. lo+size-1 of resolution level `level` (each 2x coarser per
+ * axis): a streamed volume reads them through its source; a whole one
+ * computes level k with the LOD fallback's downsampling (storage/lod.c) and
+ * cuts the box out. Tests compare the two. */
+VXL_API int vxl_volume_read_level(const vxl_volume *vol, uint32_t level, const uint32_t lo[3],
+                                  const uint32_t size[3], void *out);
+
+/* The brick min-max index (2 floats per brick, x fastest, over the brick and
+ * a one-voxel apron). Streamed: the source's own, *brick set to its brick.
+ * Whole: vxl_bricks_minmax_cpu with bricks of *brick voxels (the skipping
+ * grid's CPU copy). dims gets the bricks per axis; out (may be NULL) the
+ * first max_floats floats. */
+VXL_API int vxl_volume_brick_index(const vxl_volume *vol, uint32_t *brick, uint32_t dims[3], float *out,
+                                   size_t max_floats);
+
 /* ------------------------------------------------------- label uploads */
 
 /* Issue 20: how many label volumes and label tables the renderer has

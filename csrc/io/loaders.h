@@ -34,6 +34,10 @@ int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl_volume **o
 /* OME-Zarr (v2 and v3): the image's folder, optionally "#level=N&c=N"
  * (zarr_read.c in voxlight-read-zarr; docs/zarr.md). */
 int vxl_zarr_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* The dispatch's OME-Zarr entry: a streamed volume over the store's chunks
+ * (zarr_source.c) when vxl_load_options.streaming asks for one, else
+ * vxl_zarr_load. */
+int vxl_zarr_load_any(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 /* Whether path (a folder, maybe followed by "#options") is a Zarr store:
  * it holds .zattrs, .zgroup or zarr.json; in zarr_detect.c. The path may
  * also name one of those files (the store is its folder). */

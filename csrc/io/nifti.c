@@ -10,8 +10,10 @@
  * (from the same file at vox_offset, or from the paired .img) -> swap if the
  * file's byte order is foreign -> hand over to vxl_volume_build, which owns
  * scaling, NaN handling and normalisation. */
+#include "hash.h"
 #include "loader_util.h"
 #include "loaders.h"
+#include "stream_load.h"
 
 #include <errno.h>
 #include <math.h>
@@ -640,9 +642,11 @@ static int open_files(nii_load *L, nii_header *h, gzFile *data, const char **dat
     return VXL_OK;
 }
 
-/* Validates the header and works out what to read. */
-static int plan_read(const nii_header *h, const char *path, const vxl_load_options *opt,
-                     uint32_t dims[3], uint32_t *dtype, uint64_t *offset, uint64_t *nbytes, vxl_err *e)
+/* Validates the header and works out what to read: whole (today's checks
+ * against the budget, before anything is allocated) or streamed (issue 21:
+ * *stream = 1, stream_load.h). */
+static int plan_read(const nii_header *h, const char *path, const vxl_load_options *opt, uint32_t dims[3],
+                     uint32_t *dtype, uint64_t *offset, uint64_t *nbytes, int *stream, vxl_err *e)
 {
     int rc = check_dims(h, dims, path, e);
     if (rc) return rc;
@@ -652,19 +656,11 @@ static int plan_read(const nii_header *h, const char *path, const vxl_load_optio
                         datatype_name(h->datatype));
     rc = check_vox_offset(h, offset, path, e);
     if (rc) return rc;
-    /* Same check vxl_volume_build makes, but before we allocate the raw
-     * buffer; it also guarantees the voxel count below cannot overflow. */
-    vxl_err inner = {0};
-    if (vxl_volume_check_limits(dims, vxl_texture_bits_for(*dtype) / 8, opt, &inner))
-        return fail_with_path(e, path, &inner);
-    uint64_t n = (uint64_t)dims[0] * dims[1] * dims[2];
-    uint64_t size = vxl_dtype_size(*dtype);
-    /* The raw buffer is at most 2x the texture (f64 -> float texture), so
-     * this only trips on 32-bit hosts. */
-    if (n > (uint64_t)SIZE_MAX / size)
-        return vxl_fail(e, VXL_ERR_LIMIT, "'%s': volume too large for this address space", path);
-    *nbytes = n * size;
-    return VXL_OK;
+    /* The budget check vxl_volume_build makes, but before we allocate the
+     * raw buffer; it also guarantees the voxel count below cannot overflow.
+     * The raw buffer is at most 2x the texture (f64 -> float texture), so
+     * the address-space check only trips on 32-bit hosts. */
+    return vxl_stream_plan(path, dims, *dtype, opt, NULL, stream, nbytes, e);
 }
 
 /* 4D and beyond: every axis past the third counts volumes (fMRI time,
@@ -687,6 +683,8 @@ static int select_frame(const nii_header *h, const char *path, const vxl_load_op
                         *frame, *count, *count - 1);
     /* frame < 2^32 and nbytes is within the memory budget: no overflow
      * short of a 2^64-byte file, which the size check then reports */
+    if (*frame && nbytes > UINT64_MAX / *frame) /* a streamed volume's nbytes is not budget-bounded */
+        return vxl_fail(e, VXL_ERR_LIMIT, "'%s': frame %u lies beyond any possible file size", path, *frame);
     uint64_t skip = (uint64_t)*frame * nbytes;
     if (skip > (uint64_t)INT64_MAX - *offset)
         return vxl_fail(e, VXL_ERR_LIMIT, "'%s': frame %u lies beyond any possible file size", path, *frame);
@@ -708,6 +706,31 @@ static void scaling_from(const nii_header *h, double *slope, double *inter)
     }
 }
 
+/* Streams the chosen volume instead of reading it (issue 21): the layout
+ * of its voxels for a raw source (.nii, .img) or a bricked cache (.nii.gz,
+ * .img.gz), keyed by the header. */
+static int stream_volume(const nii_header *h, const char *data_path, const uint32_t dims[3],
+                         uint32_t dtype, uint64_t offset, uint32_t frame_count, uint32_t frame,
+                         const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+{
+    double sp[3], A[16];
+    spacing_from(h, sp);
+    const uint32_t affine_source = choose_affine(h, sp, A);
+    vxl_raw_layout l;
+    int rc = vxl_layout_init(&l, data_path, offset, dims, dtype, sp, A, e);
+    if (rc) return rc;
+    l.compressed = vxl_file_is_gzip(data_path);
+    l.swap = h->swapped;
+    scaling_from(h, &l.slope, &l.inter);
+    if (l.slope == 0.0) l.slope = 1.0; /* raw_layout: unscaled is slope 1, inter 0 */
+    l.affine_source = affine_source;
+    l.nifti_version = (uint32_t)h->version;
+    l.frame_count = frame_count;
+    l.frame = frame;
+    l.header_hash = vxl_fnv(14695981039346656037ull, h, sizeof *h); /* the parsed header (zeroed padding) */
+    return vxl_stream_load(&l, opt, out, e);
+}
+
 int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
@@ -721,9 +744,23 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     const char *data_path = NULL;
     uint32_t dims[3], dtype = 0, frame_count = 1, frame = 0;
     uint64_t offset = 0, nbytes = 0;
+    int stream = 0;
     int rc = open_files(&L, &h, &data, &data_path, e);
-    if (!rc) rc = plan_read(&h, L.hdr_path, opt, dims, &dtype, &offset, &nbytes, e);
+    if (!rc) rc = plan_read(&h, L.hdr_path, opt, dims, &dtype, &offset, &nbytes, &stream, e);
     if (!rc) rc = select_frame(&h, L.hdr_path, opt, nbytes, &offset, &frame_count, &frame, e);
+    if (!rc && stream && !vxl_stream_file_holds(data_path, offset, vxl_file_is_gzip(data_path), nbytes, opt)) {
+        stream = 0; /* AUTO and a file too short to stream: today's whole-read checks say why */
+        rc = vxl_plan_voxels(L.hdr_path, dims, dtype, opt, &nbytes, e);
+    }
+    if (!rc && stream) {
+        /* the files' buffers are not needed: the source opens its own */
+        if (L.img_file) gzclose(L.img_file);
+        gzclose(L.hdr_file);
+        L.img_file = L.hdr_file = NULL;
+        rc = stream_volume(&h, data_path, dims, dtype, offset, frame_count, frame, opt, out, e);
+        load_cleanup(&L);
+        return rc;
+    }
     if (!rc) rc = read_voxels(data, data_path, offset, nbytes, &L.raw, e);
     if (rc) {
         load_cleanup(&L);

@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 
 #include "loaders.h"
+#include "stream_load.h"
 
 static int has_suffix(const char *s, const char *suffix)
 {
@@ -22,7 +23,7 @@ typedef int (*vxl_loader_fn)(const char *path, const vxl_load_options *opt, vxl_
 static vxl_loader_fn vxl_loader_for(const char *path)
 {
     struct stat st;
-    if (vxl_zarr_path_is_zarr(path)) return vxl_zarr_load; /* before the folder test: "store.zarr#level=1" */
+    if (vxl_zarr_path_is_zarr(path)) return vxl_zarr_load_any; /* before the folder test: "store.zarr#level=1" */
     if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
         return vxl_dicom_path_is_dicom(path, 1) ? vxl_dicom_load : vxl_image_stack_load;
     static const struct { const char *ext; vxl_loader_fn fn; } by_ext[] = {
@@ -57,5 +58,14 @@ int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **
     if (!out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
     *out = NULL;
     if (!path || !*path) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "path is empty");
-    return vxl_loader_for(path)(path, opt, out, NULL);
+    vxl_loader_fn fn = vxl_loader_for(path);
+    vxl_err e = {0};
+    int rc = fn(path, opt, out, &e);
+    /* Issue 21: these formats are read whole even when streaming is asked
+     * for; over the budget, say that streaming would not have helped. */
+    const char *whole_only = fn == vxl_dicom_load ? "DICOM" : fn == vxl_image_stack_load ? "TIFF/PNG image stacks"
+                             : fn == vxl_vdb_load ? "OpenVDB" : NULL;
+    if (rc == VXL_ERR_LIMIT && whole_only && vxl_load_streaming(opt) != VXL_STREAMING_OFF)
+        return vxl_fail(NULL, rc, "%s (streaming is not available for %s)", e.msg, whole_only);
+    return rc;
 }

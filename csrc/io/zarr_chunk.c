@@ -3,18 +3,17 @@
  * blosc with libblosc) into exactly the chunk's decoded size. A chunk that
  * decodes to more or fewer bytes than the metadata says, or whose file is
  * larger than any encoding of that size could be, is an error naming the
- * file; nothing is allocated from a stored size. */
-#include <blosc.h>
+ * file; nothing is allocated from a stored size. libzstd and libblosc are
+ * reached through the dlopen'd tables of zarr_codecs.c. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <zlib.h>
-#include <zstd.h>
-#include <zstd_errors.h>
 
 #include "loader_util.h"
 #include "zarr.h"
+#include "zarr_codecs.h"
 
 static int decode_zlib(const void *src, size_t n, void *out, uint64_t nbytes, const char *name, vxl_err *e)
 {
@@ -48,20 +47,24 @@ static int decode_zlib(const void *src, size_t n, void *out, uint64_t nbytes, co
     return VXL_OK;
 }
 
-static int decode_zstd(const void *src, size_t n, void *out, uint64_t nbytes, const char *name, vxl_err *e)
+static int decode_zstd(vxl_zarr_codecs *codecs, const void *src, size_t n, void *out, uint64_t nbytes,
+                       const char *name, vxl_err *e)
 {
-    unsigned long long claimed = ZSTD_getFrameContentSize(src, n);
+    const vxl_zstd_api *z = NULL;
+    int rc = vxl_zarr_zstd(codecs, name, &z, e);
+    if (rc) return rc;
+    unsigned long long claimed = z->getFrameContentSize(src, n);
     if (claimed == ZSTD_CONTENTSIZE_ERROR) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': not a zstd chunk", name);
     if (claimed != ZSTD_CONTENTSIZE_UNKNOWN && claimed > nbytes)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the chunk decompresses to %llu bytes, more than the %llu its array "
                         "metadata says", name, claimed, (unsigned long long)nbytes);
     /* the output capacity bounds the work whatever the frames claim */
-    size_t got = ZSTD_decompress(out, (size_t)nbytes, src, n);
-    if (ZSTD_isError(got)) {
-        if (ZSTD_getErrorCode(got) == ZSTD_error_dstSize_tooSmall)
+    size_t got = z->decompress(out, (size_t)nbytes, src, n);
+    if (z->isError(got)) {
+        if (z->getErrorCode(got) == ZSTD_error_dstSize_tooSmall)
             return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the chunk decompresses to more than the %llu bytes its array "
                             "metadata says", name, (unsigned long long)nbytes);
-        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': corrupt zstd chunk (%s)", name, ZSTD_getErrorName(got));
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': corrupt zstd chunk (%s)", name, z->getErrorName(got));
     }
     if (got != nbytes)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the chunk decompresses to %zu bytes, not the %llu its array "
@@ -69,28 +72,32 @@ static int decode_zstd(const void *src, size_t n, void *out, uint64_t nbytes, co
     return VXL_OK;
 }
 
-static int decode_blosc(const void *src, size_t n, void *out, uint64_t nbytes, const char *name, vxl_err *e)
+static int decode_blosc(vxl_zarr_codecs *codecs, const void *src, size_t n, void *out, uint64_t nbytes,
+                        const char *name, vxl_err *e)
 {
+    const vxl_blosc_api *b = NULL;
+    int rc = vxl_zarr_blosc(codecs, name, &b, e);
+    if (rc) return rc;
     size_t claimed = 0, cbytes = 0, blocksize = 0;
     /* blosc's header is 16 bytes; validate checks its sizes against n
      * before anything is decompressed */
-    if (n < BLOSC_MIN_HEADER_LENGTH || blosc_cbuffer_validate(src, n, &claimed) < 0)
+    if (n < BLOSC_MIN_HEADER_LENGTH || b->cbuffer_validate(src, n, &claimed) < 0)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': not a valid blosc chunk", name);
-    blosc_cbuffer_sizes(src, &claimed, &cbytes, &blocksize);
+    b->cbuffer_sizes(src, &claimed, &cbytes, &blocksize);
     if (claimed != nbytes)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the blosc chunk holds %zu bytes, not the %llu its array metadata "
                         "says", name, claimed, (unsigned long long)nbytes);
     if (cbytes != n)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the blosc chunk says %zu bytes compressed, the file has %zu",
                         name, cbytes, n);
-    int got = blosc_decompress_ctx(src, out, (size_t)nbytes, 1); /* no global state, one thread */
+    int got = b->decompress_ctx(src, out, (size_t)nbytes, 1); /* no global state, one thread */
     if (got < 0 || (uint64_t)got != nbytes)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': corrupt blosc chunk", name);
     return VXL_OK;
 }
 
-int vxl_zarr_decode(const vxl_zarr_array *a, const void *src, size_t n, void *out, uint64_t nbytes,
-                    const char *name, vxl_err *e)
+int vxl_zarr_decode(const vxl_zarr_array *a, vxl_zarr_codecs *codecs, const void *src, size_t n, void *out,
+                    uint64_t nbytes, const char *name, vxl_err *e)
 {
     if (nbytes > VXL_ZARR_MAX_CHUNK_BYTES || n > (size_t)2 * VXL_ZARR_MAX_CHUNK_BYTES)
         return vxl_fail(e, VXL_ERR_LIMIT, "'%s': chunk too large", name);
@@ -104,8 +111,8 @@ int vxl_zarr_decode(const vxl_zarr_array *a, const void *src, size_t n, void *ou
         rc = VXL_OK;
         break;
     case VXL_ZARR_ZLIB: rc = decode_zlib(src, n, out, nbytes, name, e); break;
-    case VXL_ZARR_ZSTD: rc = decode_zstd(src, n, out, nbytes, name, e); break;
-    case VXL_ZARR_BLOSC: rc = decode_blosc(src, n, out, nbytes, name, e); break;
+    case VXL_ZARR_ZSTD: rc = decode_zstd(codecs, src, n, out, nbytes, name, e); break;
+    case VXL_ZARR_BLOSC: rc = decode_blosc(codecs, src, n, out, nbytes, name, e); break;
     default: return vxl_fail(e, VXL_ERR_FORMAT, "'%s': unknown codec", name);
     }
     if (rc) return rc;
@@ -152,7 +159,14 @@ static void fill_chunk(const vxl_zarr_array *a, void *out, uint64_t nbytes)
     for (uint64_t i = 0; i < count; i++) memcpy(o + i * elem, v, elem);
 }
 
-int vxl_zarr_read_chunk(const vxl_zarr_array *a, const uint64_t *idx, void *out, vxl_err *e)
+int vxl_zarr_read_chunk(const vxl_zarr_array *a, const uint64_t *idx, vxl_zarr_codecs *codecs, void *out,
+                        vxl_err *e)
+{
+    return vxl_zarr_read_chunk_counted(a, idx, codecs, out, NULL, e);
+}
+
+int vxl_zarr_read_chunk_counted(const vxl_zarr_array *a, const uint64_t *idx, vxl_zarr_codecs *codecs, void *out,
+                                uint64_t *bytes_read, vxl_err *e)
 {
     const uint64_t nbytes = vxl_zarr_chunk_bytes(a);
     if (!nbytes) return vxl_fail(e, VXL_ERR_LIMIT, "'%s': chunk too large", a->path);
@@ -177,7 +191,8 @@ int vxl_zarr_read_chunk(const vxl_zarr_array *a, const uint64_t *idx, void *out,
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %llu bytes, more than any encoding of the chunk's %llu bytes",
                         p, (unsigned long long)size, (unsigned long long)nbytes);
     if (rc) return rc;
-    rc = vxl_zarr_decode(a, buf, n, out, nbytes, p, e);
+    if (bytes_read) __atomic_fetch_add(bytes_read, (uint64_t)n, __ATOMIC_RELAXED);
+    rc = vxl_zarr_decode(a, codecs, buf, n, out, nbytes, p, e);
     free(buf);
     return rc;
 }

@@ -7,8 +7,8 @@
  * fits the memory budget and the per-axis limit is read. The time point is
  * vxl_load_options.frame, as for 4D NIfTI; frame_count is the t extent.
  * Voxel (i, j, k) is array element [.., z=k, y=j, x=i] and the affine is
- * the level's scale and translation on x, y, z, in the axes' own units
- * (often micrometres; not converted: docs/zarr.md). */
+ * the level's scale and translation on x, y, z, converted from the axes'
+ * units to mm (zarr_store.c; docs/zarr.md). */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,13 +18,8 @@
 #include "loaders.h"
 #include "zarr.h"
 
-typedef struct zarr_choice {
-    int level;    /* -1: the finest that fits */
-    uint64_t c;
-} zarr_choice;
-
 /* Splits "folder#level=1&c=0" into the folder and the choices. */
-static int parse_fragment(const char *path, char *folder, size_t size, zarr_choice *ch, vxl_err *e)
+int vxl_zarr_parse_path(const char *path, char *folder, size_t size, vxl_zarr_choice *ch, vxl_err *e)
 {
     ch->level = -1;
     ch->c = 0;
@@ -54,6 +49,27 @@ static int parse_fragment(const char *path, char *folder, size_t size, zarr_choi
     return VXL_OK;
 }
 
+int vxl_zarr_select(const char *path, const vxl_zarr_store *s, int level, const vxl_load_options *opt,
+                    const vxl_zarr_choice *ch, uint64_t sel[VXL_ZARR_ROLES], uint64_t *nt, vxl_err *e)
+{
+    if (level < 0 || level >= s->nlevels)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': level %d asked for, the image has %d (0 to %d)", path,
+                        level, s->nlevels, s->nlevels - 1);
+    const vxl_zarr_array *a = &s->level[level];
+    memset(sel, 0, VXL_ZARR_ROLES * sizeof *sel);
+    sel[VXL_ZARR_T] = vxl_load_frame(opt);
+    sel[VXL_ZARR_C] = ch->c;
+    *nt = s->axis[VXL_ZARR_T] >= 0 ? a->shape[s->axis[VXL_ZARR_T]] : 1;
+    const uint64_t nc = s->axis[VXL_ZARR_C] >= 0 ? a->shape[s->axis[VXL_ZARR_C]] : 1;
+    if (sel[VXL_ZARR_T] >= *nt)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %llu asked for, the image has %llu time points",
+                        path, (unsigned long long)sel[VXL_ZARR_T], (unsigned long long)*nt);
+    if (sel[VXL_ZARR_C] >= nc)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': channel %llu asked for, the image has %llu channels",
+                        path, (unsigned long long)sel[VXL_ZARR_C], (unsigned long long)nc);
+    return VXL_OK;
+}
+
 /* The level's volume dims (x, y, z). */
 static void level_dims(const vxl_zarr_store *s, int l, uint32_t dims[3])
 {
@@ -65,8 +81,8 @@ static void level_dims(const vxl_zarr_store *s, int l, uint32_t dims[3])
     dims[2] = z > UINT32_MAX ? UINT32_MAX : (uint32_t)z;
 }
 
-static int pick_level(const char *path, const vxl_zarr_store *s, const zarr_choice *ch, const vxl_load_options *opt,
-                      int *level, vxl_err *e)
+static int pick_level(const char *path, const vxl_zarr_store *s, const vxl_zarr_choice *ch,
+                      const vxl_load_options *opt, int *level, vxl_err *e)
 {
     if (ch->level >= 0) {
         if (ch->level >= s->nlevels)
@@ -148,14 +164,19 @@ static int read_level(const char *path, const vxl_zarr_store *s, const vxl_zarr_
         return vxl_fail(e, VXL_ERR_LIMIT, "'%s': one chunk needs %.1f MiB, over the memory budget of %.1f MiB",
                         a->path, cbytes / 1048576.0, budget / 1048576.0);
     unsigned char *chunk = malloc((size_t)cbytes);
-    if (!chunk) return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for a chunk of %llu bytes", path,
-                                (unsigned long long)cbytes);
+    vxl_zarr_codecs *codecs = vxl_zarr_codecs_new();
+    if (!chunk || !codecs) {
+        free(chunk);
+        vxl_zarr_codecs_free(codecs);
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for a chunk of %llu bytes", path,
+                        (unsigned long long)cbytes);
+    }
     uint64_t idx[VXL_ZARR_MAX_NDIM], origin[VXL_ZARR_MAX_NDIM];
     memcpy(idx, lo, sizeof idx);
     int rc = VXL_OK;
     for (uint64_t n = 0; n < total && !rc; n++) {
         for (int i = 0; i < a->ndim; i++) origin[i] = idx[i] * a->chunks[i];
-        rc = vxl_zarr_read_chunk(a, idx, chunk, e);
+        rc = vxl_zarr_read_chunk(a, idx, codecs, chunk, e);
         if (!rc) copy_chunk(s, a, origin, chunk, sel, raw, dims);
         for (int i = a->ndim - 1; i >= 0; i--) { /* next index, last dimension fastest */
             if (++idx[i] < hi[i]) break;
@@ -163,6 +184,7 @@ static int read_level(const char *path, const vxl_zarr_store *s, const vxl_zarr_
         }
     }
     free(chunk);
+    vxl_zarr_codecs_free(codecs);
     return rc;
 }
 
@@ -170,8 +192,8 @@ int vxl_zarr_read(const char *path, const vxl_load_options *opt, vxl_volume **ou
 {
     *out = NULL;
     char folder[4096];
-    zarr_choice ch;
-    int rc = parse_fragment(path, folder, sizeof folder, &ch, e);
+    vxl_zarr_choice ch;
+    int rc = vxl_zarr_parse_path(path, folder, sizeof folder, &ch, e);
     if (rc) return rc;
     vxl_zarr_store *s = calloc(1, sizeof *s);
     if (!s) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory");
@@ -179,19 +201,8 @@ int vxl_zarr_read(const char *path, const vxl_load_options *opt, vxl_volume **ou
     int l = 0;
     if ((rc = pick_level(path, s, &ch, opt, &l, e))) goto done;
     const vxl_zarr_array *a = &s->level[l];
-    uint64_t sel[VXL_ZARR_ROLES] = {vxl_load_frame(opt), ch.c, 0, 0, 0};
-    const uint64_t nt = s->axis[VXL_ZARR_T] >= 0 ? a->shape[s->axis[VXL_ZARR_T]] : 1;
-    const uint64_t nc = s->axis[VXL_ZARR_C] >= 0 ? a->shape[s->axis[VXL_ZARR_C]] : 1;
-    if (sel[VXL_ZARR_T] >= nt) {
-        rc = vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %llu asked for, the image has %llu time points",
-                      path, (unsigned long long)sel[VXL_ZARR_T], (unsigned long long)nt);
-        goto done;
-    }
-    if (sel[VXL_ZARR_C] >= nc) {
-        rc = vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': channel %llu asked for, the image has %llu channels",
-                      path, (unsigned long long)sel[VXL_ZARR_C], (unsigned long long)nc);
-        goto done;
-    }
+    uint64_t sel[VXL_ZARR_ROLES], nt;
+    if ((rc = vxl_zarr_select(path, s, l, opt, &ch, sel, &nt, e))) goto done;
     uint32_t dims[3];
     level_dims(s, l, dims);
     uint64_t nbytes;

@@ -139,6 +139,20 @@ static int role_of(const char *name)
     return -1;
 }
 
+/* The factor from an NGFF length unit to mm; 0 for a unit that is not a
+ * length this reader knows (kept as written). */
+static double unit_to_mm(const char *unit)
+{
+    static const struct { const char *name; double mm; } map[] = {
+        {"meter", 1e3}, {"decimeter", 1e2}, {"centimeter", 10}, {"millimeter", 1}, {"micrometer", 1e-3},
+        {"nanometer", 1e-6}, {"picometer", 1e-9}, {"angstrom", 1e-7}, {"femtometer", 1e-12}, {"kilometer", 1e6},
+        {"inch", 25.4}, {"foot", 304.8}, {"yard", 914.4}, {"mile", 1609344},
+    };
+    for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
+        if (!strcmp(unit, map[i].name)) return map[i].mm;
+    return 0;
+}
+
 static int parse_axes(const vxl_json_doc *d, const vxl_json *axes, const char *name, vxl_zarr_store *s, vxl_err *e)
 {
     if (axes && axes->type == VXL_JSON_ARRAY && axes->count < 3)
@@ -161,10 +175,35 @@ static int parse_axes(const vxl_json_doc *d, const vxl_json *axes, const char *n
         s->axis[r] = i;
         const char *unit = vxl_json_string(vxl_json_get(d, a, "unit"));
         if (r == VXL_ZARR_X && unit) snprintf(s->unit, sizeof s->unit, "%s", unit);
+        const double mm = unit && r >= VXL_ZARR_Z ? unit_to_mm(unit) : 0;
+        s->to_mm[i] = mm > 0 ? mm : 1.0;
     }
     if (s->axis[VXL_ZARR_Z] < 0 || s->axis[VXL_ZARR_Y] < 0 || s->axis[VXL_ZARR_X] < 0)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the axes lack z, y or x (2D images are not volumes)", name);
     return VXL_OK;
+}
+
+/* omero.channels[c].window: "min"/"max" (the data's range), else
+ * "start"/"end"; a channel without two finite, ordered numbers has none. */
+static void parse_windows(const vxl_json_doc *d, const vxl_json *omero, vxl_zarr_store *s)
+{
+    const vxl_json *ch = vxl_json_get(d, omero, "channels");
+    if (!ch || ch->type != VXL_JSON_ARRAY) return;
+    int c = 0;
+    for (int32_t k = ch->first; k >= 0 && c < VXL_ZARR_MAX_WINDOWS; k = d->nodes[k].next, c++) {
+        const vxl_json *w = vxl_json_get(d, &d->nodes[k], "window");
+        static const char *keys[2][2] = {{"min", "max"}, {"start", "end"}};
+        for (int pair = 0; pair < 2 && !s->window_set[c]; pair++) {
+            const vxl_json *lo = vxl_json_get(d, w, keys[pair][0]), *hi = vxl_json_get(d, w, keys[pair][1]);
+            if (lo && hi && lo->type == VXL_JSON_NUMBER && hi->type == VXL_JSON_NUMBER && isfinite(lo->num) &&
+                isfinite(hi->num) && lo->num < hi->num) {
+                s->window[c][0] = lo->num;
+                s->window[c][1] = hi->num;
+                s->window_set[c] = 1;
+            }
+        }
+    }
+    s->window_count = c;
 }
 
 int vxl_zarr_parse_group(const char *text, size_t len, int is_v3, const char *name, vxl_zarr_store *s,
@@ -223,7 +262,12 @@ int vxl_zarr_parse_group(const char *text, size_t len, int is_v3, const char *na
         if ((rc = apply_transforms(&d, vxl_json_get(&d, m, "coordinateTransformations"), s->ndim, s->scale[i],
                                    s->translation[i], name, e)))
             goto done;
+        for (int a = 0; a < s->ndim; a++) { /* the axes' units to mm */
+            s->scale[i][a] *= s->to_mm[a];
+            s->translation[i][a] *= s->to_mm[a];
+        }
     }
+    parse_windows(&d, vxl_json_get(&d, attrs, "omero"), s);
 done:
     vxl_json_free(&d);
     return rc;

@@ -24,6 +24,8 @@ static void delete_tex(vxl_labels_state *s, GLuint *t)
 static void release_volume(vxl_labels_state *s)
 {
     delete_tex(s, &s->volume_tex);
+    delete_tex(s, &s->bricks_tex);
+    vxl_label_bricks_free(&s->bricks);
     s->volume_bytes = 0;
     s->bytes = s->table_bytes;
 }
@@ -72,7 +74,9 @@ int vxl_labels_set(vxl_labels_state *s, const vxl_volume *v)
     if (!vxl_mat4_invert(inv, v->affine))
         return vxl_fail(&g->err, VXL_ERR_INVALID_ARGUMENT, "the label volume's affine is not invertible");
     const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
-    const uint64_t bytes = n * sizeof(uint16_t);
+    uint64_t bricks = 1; /* the brick texture: one word per brick */
+    for (int a = 0; a < 3; a++) bricks *= (v->dims[a] + VXL_LABEL_BRICK - 1) / VXL_LABEL_BRICK;
+    const uint64_t bytes = n * sizeof(uint16_t) + bricks * sizeof(uint32_t);
     /* the volume it replaces is not charged against it, the table is */
     uint64_t kept = s->volume_bytes;
     s->bytes -= kept;
@@ -83,6 +87,10 @@ int vxl_labels_set(vxl_labels_state *s, const vxl_volume *v)
     uint16_t *ids = malloc(bytes ? bytes : 1);
     if (!ids) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the label volume");
     rc = convert_ids(v, ids, n, &g->err);
+    vxl_label_bricks grid;
+    memset(&grid, 0, sizeof grid);
+    if (!rc && vxl_label_bricks_build(&grid, ids, v->dims))
+        rc = vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the label volume's brick grid");
     if (rc) {
         free(ids);
         return rc;
@@ -93,15 +101,17 @@ int vxl_labels_set(vxl_labels_state *s, const vxl_volume *v)
     gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
     gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R16UI, (GLsizei)v->dims[0], (GLsizei)v->dims[1], (GLsizei)v->dims[2], 0,
                    GL_RED_INTEGER, GL_UNSIGNED_SHORT, ids);
-    gl->PixelStorei(GL_UNPACK_ALIGNMENT, 4);
     free(ids);
     rc = vxl_gl_check(g, "uploading the label volume");
     if (rc) {
         gl->DeleteTextures(1, &tex);
+        vxl_label_bricks_free(&grid);
         return rc;
     }
     release_volume(s);
     s->volume_tex = tex;
+    s->bricks = grid;
+    s->bricks_stale = 1;
     memcpy(s->dims, v->dims, sizeof s->dims);
     memcpy(s->affine, v->affine, sizeof s->affine);
     s->volume_bytes = bytes;
@@ -113,6 +123,25 @@ int vxl_labels_set(vxl_labels_state *s, const vxl_volume *v)
 uint32_t vxl_labels_flags(const vxl_frame *f)
 {
     return f->labels.on ? (f->labels.mode + 1u) << VXL_FLAG_LABELS_SHIFT : 0u;
+}
+
+/* Entry i of f's labels (the caller's stride). */
+static const vxl_label_entry *frame_entry(const vxl_frame *f, uint32_t i)
+{
+    return (const vxl_label_entry *)((const char *)f->labels.entries + (size_t)i * f->labels.stride);
+}
+
+/* *tex (made on first use) bound to target on the scratch unit, to be filled. */
+static void bind_for_upload(vxl_labels_state *s, GLuint *tex, GLenum target)
+{
+    vxl_gl *gl = &s->gpu->gl;
+    gl->GetError();
+    if (!*tex) {
+        *tex = vxl_texture_new(s->gpu, target, GL_NEAREST);
+        return;
+    }
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
+    gl->BindTexture(target, *tex);
 }
 
 static int upload_table(vxl_labels_state *s, const vxl_frame *f)
@@ -131,20 +160,13 @@ static int upload_table(vxl_labels_state *s, const vxl_frame *f)
         table[4 * i + 3] = -1.0f; /* unlisted: hidden */
     }
     for (uint32_t i = 0; i < f->labels.count; i++) {
-        const vxl_label_entry *en =
-            (const vxl_label_entry *)((const char *)f->labels.entries + (size_t)i * f->labels.stride);
+        const vxl_label_entry *en = frame_entry(f, i);
         float *t = table + 4 * (size_t)en->id;
         memcpy(t, en->color, 4 * sizeof(float));
         if (!en->visible) t[3] = -1.0f;
     }
-    vxl_gl *gl = &g->gl;
-    gl->GetError();
-    if (!s->table_tex) s->table_tex = vxl_texture_new(g, GL_TEXTURE_2D, GL_NEAREST);
-    else {
-        gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
-        gl->BindTexture(GL_TEXTURE_2D, s->table_tex);
-    }
-    gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, VXL_LABEL_TABLE_SIDE, VXL_LABEL_TABLE_SIDE, 0, GL_RGBA, GL_FLOAT, table);
+    bind_for_upload(s, &s->table_tex, GL_TEXTURE_2D);
+    g->gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, VXL_LABEL_TABLE_SIDE, VXL_LABEL_TABLE_SIDE, 0, GL_RGBA, GL_FLOAT, table);
     free(table);
     int rc = vxl_gl_check(g, "uploading the label table");
     if (rc) {
@@ -160,6 +182,33 @@ static int upload_table(vxl_labels_state *s, const vxl_frame *f)
     return VXL_OK;
 }
 
+/* The label bricks under f's table (label_bricks.h), uploaded to bricks_tex. */
+static int derive_bricks(vxl_labels_state *s, const vxl_frame *f)
+{
+    vxl_gpu *g = s->gpu;
+    uint8_t *visible = calloc((VXL_MAX_LABEL_ID + 1) / 8, 1);
+    if (!visible) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the label bricks");
+    for (uint32_t i = 0; i < f->labels.count; i++) {
+        const vxl_label_entry *en = frame_entry(f, i);
+        if (en->visible) visible[en->id >> 3] |= (uint8_t)(1u << (en->id & 7));
+    }
+    int failed = vxl_label_bricks_classify(&s->bricks, visible);
+    free(visible);
+    if (failed) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the label bricks");
+    bind_for_upload(s, &s->bricks_tex, GL_TEXTURE_3D);
+    const uint32_t *d = s->bricks.dims;
+    g->gl.TexImage3D(GL_TEXTURE_3D, 0, GL_R32UI, (GLsizei)d[0], (GLsizei)d[1], (GLsizei)d[2], 0, GL_RED_INTEGER,
+                   GL_UNSIGNED_INT, s->bricks.words);
+    int rc = vxl_gl_check(g, "uploading the label bricks");
+    if (rc) {
+        delete_tex(s, &s->bricks_tex);
+        return rc;
+    }
+    s->bricks_key = f->labels.key;
+    s->bricks_stale = 0;
+    return VXL_OK;
+}
+
 int vxl_labels_prepare(vxl_labels_state *s, const vxl_frame *f, GLuint prog, const double vox_to_world[16])
 {
     if (!f->labels.on) return VXL_OK;
@@ -168,6 +217,10 @@ int vxl_labels_prepare(vxl_labels_state *s, const vxl_frame *f, GLuint prog, con
         return vxl_fail(&g->err, VXL_ERR_STATE, "params.labels is set but no label volume: call vxl_renderer_set_labels first");
     if (!s->table_tex || s->table_key != f->labels.key) {
         int rc = upload_table(s, f);
+        if (rc) return rc;
+    }
+    if (!s->bricks_tex || s->bricks_stale || s->bricks_key != f->labels.key) {
+        int rc = derive_bricks(s, f);
         if (rc) return rc;
     }
     /* intensity voxel -> world -> label voxel; a gradient in label voxels
@@ -184,7 +237,10 @@ int vxl_labels_prepare(vxl_labels_state *s, const vxl_frame *f, GLuint prog, con
     gl->BindTexture(GL_TEXTURE_3D, s->volume_tex);
     gl->ActiveTexture(GL_TEXTURE0 + VXL_LABEL_TABLE_UNIT);
     gl->BindTexture(GL_TEXTURE_2D, s->table_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_LABEL_BRICKS_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, s->bricks_tex);
     vxl_uniform_i(g, prog, "u_labels", VXL_LABELS_UNIT);
+    vxl_uniform_i(g, prog, "u_label_bricks", VXL_LABEL_BRICKS_UNIT);
     vxl_uniform_i(g, prog, "u_label_table", VXL_LABEL_TABLE_UNIT);
     gl->UniformMatrix4fv(gl->GetUniformLocation(prog, "u_label_from_vox"), 1, GL_FALSE, mf);
     gl->UniformMatrix3fv(gl->GetUniformLocation(prog, "u_label_grad_to_vox"), 1, GL_FALSE, gt);

@@ -4,7 +4,9 @@
  * per-label table (65536 ids as a 256x256 RGBA32F texture: colour and
  * alpha, alpha -1 for a hidden or unlisted id) rebuilt only when the
  * frame's table hash changes. shaders/lib/labels.glsl reads both.
- * Storage is dense (2 bytes per voxel), charged to the budget as a holding. */
+ * Storage is dense (2 bytes per voxel), charged to the budget as a holding.
+ * Beside them, the label bricks (label_bricks.h): where visible labels can
+ * be, re-derived with the table, so the ray caster leaps over the rest. */
 #ifndef VXL_LABELS_H
 #define VXL_LABELS_H
 
@@ -12,6 +14,7 @@
 
 #include "frame.h"
 #include "gpu.h"
+#include "label_bricks.h"
 
 #define VXL_LABEL_TABLE_SIDE 256 /* the table is SIDE x SIDE texels: every id in [0, VXL_MAX_LABEL_ID] */
 
@@ -22,7 +25,11 @@ typedef struct vxl_labels_state {
     uint32_t dims[3];
     double affine[16];        /* the label volume's voxel -> world, column-major */
     uint64_t table_key;       /* the frame key of the table in table_tex */
-    uint64_t volume_bytes, table_bytes, bytes; /* bytes = the holding */
+    vxl_label_bricks bricks;  /* the label volume's ids per brick */
+    GLuint bricks_tex;        /* R32UI per brick: distance, uniform, id (label_bricks.h) */
+    uint64_t bricks_key;      /* the frame key bricks_tex was derived under */
+    int bricks_stale;         /* a new label volume: derive bricks_tex again */
+    uint64_t volume_bytes, table_bytes, bytes; /* bytes = the holding (volume_bytes counts bricks_tex too) */
     uint64_t volume_uploads;  /* label volumes uploaded (the dev stats) */
     uint64_t table_uploads;   /* tables uploaded */
 } vxl_labels_state;
@@ -35,8 +42,9 @@ void vxl_labels_init(vxl_labels_state *s, vxl_gpu *g);
 int vxl_labels_set(vxl_labels_state *s, const vxl_volume *v);
 /* The ray caster's program flags of frame f (LABELS = mode + 1): 0 without labels. */
 uint32_t vxl_labels_flags(const vxl_frame *f);
-/* Uploads f's table when its key changed, binds the label textures and sets
- * prog's label uniforms; vox_to_world is the intensity volume's affine.
+/* Uploads f's table and derives the label bricks when its key changed (or
+ * the label volume did), binds the label textures and sets prog's label
+ * uniforms; vox_to_world is the intensity volume's affine.
  * VXL_ERR_STATE when f has labels but no label volume is set. Nothing
  * without labels. */
 int vxl_labels_prepare(vxl_labels_state *s, const vxl_frame *f, GLuint prog, const double vox_to_world[16]);

@@ -18,6 +18,9 @@ static int job_set_labels(void *p)
 int vxl_renderer_set_labels(vxl_renderer *r, const vxl_volume *labels)
 {
     if (!r) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "renderer is NULL");
+    if (labels && labels->source) /* issue 21: the label volume is uploaded whole */
+        return vxl_fail(&r->gpu.err, VXL_ERR_INVALID_ARGUMENT,
+                        "a label map is uploaded whole and this one is streamed: load it with streaming off");
     labels_job j = {r, labels, {0, 0}};
     int rc = vxl_gl_thread_call(&r->thread, job_set_labels, &j);
     if (rc) vxl_publish_error(&r->gpu.err);

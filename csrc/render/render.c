@@ -167,6 +167,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     flags = vxl_modes_flags(f, flags); /* issue 19: the mode and the MatCap */
     flags |= vxl_cut_flags(f);         /* issue 19: clip planes, crop box, cutters */
     flags |= vxl_labels_flags(f);      /* issue 20: the label mode */
+    flags |= vxl_overlays_flags(f);    /* issue 20: the overlay count */
     uint32_t filter = vxl_frame_filter(f);
     int rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
     if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);
@@ -188,6 +189,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     vxl_illumination_bind(&r->illumination, prog, f);
     vxl_cut_bind(&r->cut, prog, f); /* issue 19 */
     if ((rc = vxl_labels_prepare(&r->labels, f, prog, r->storage.geom.affine))) return rc; /* issue 20 */
+    if ((rc = vxl_overlays_prepare(&r->overlays, f, prog))) return rc; /* issue 20 */
     if ((rc = vxl_modes_bind(&r->modes, f, prog)) || (rc = vxl_matcap_prepare(&r->matcap, f, prog))) return rc; /* issue 19 */
     vxl_uniform_i(&r->gpu, prog, "u_skip", f->skip);
     vxl_uniform_i(&r->gpu, prog, "u_brick_size", (int)(r->skipping.bricks.size ? r->skipping.bricks.size : VXL_DEFAULT_BRICK));
@@ -214,7 +216,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     gl->ClearBufferfv(GL_COLOR, 0, clear_color);
     gl->ClearBufferfv(GL_COLOR, 1, clear_depth);
     GLint rect[4] = {0, 0, (GLint)f->width, (GLint)f->height};
-    if (f->skip) screen_bounds(r, f, rect);
+    if (f->skip && !f->overlays.count) screen_bounds(r, f, rect); /* overlays: rays test the union of the boxes */
     gl->Enable(GL_SCISSOR_TEST);
     gl->Scissor(rect[0], rect[1], rect[2], rect[3]);
     gl->BindVertexArray(r->vao);
@@ -266,7 +268,10 @@ static int job_render(void *p)
     vxl_frame f;
     int rc = vxl_frame_resolve(&f, j->p, &g, &r->gpu.err);
     if (rc) return rc;
-    rc = draw(r, &f, j->rgba, j->depth);
+    const vxl_volume_geom *ov_geoms[VXL_MAX_OVERLAYS];
+    vxl_overlays_geoms(&r->overlays, ov_geoms);
+    rc = vxl_frame_resolve_overlays(&f, j->p, ov_geoms, &g, &r->gpu.err); /* issue 20 */
+    if (!rc) rc = draw(r, &f, j->rgba, j->depth);
     vxl_frame_free(&f);
     return rc;
 }

@@ -83,6 +83,7 @@ static int job_close(void *p)
         vxl_matcap_release(&r->matcap);
         vxl_cut_release(&r->cut); /* issue 19: the cutter layers */
         vxl_labels_release(&r->labels); /* issue 20 */
+        vxl_overlays_release(&r->overlays); /* issue 20 */
         vxl_programs_delete(&r->gpu);
         r->gpu.gl.DeleteFramebuffers(1, &r->fbo);
         r->gpu.gl.DeleteVertexArrays(1, &r->vao);
@@ -110,6 +111,7 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     vxl_modes_init(&r->modes, &r->gpu, &r->skipping, &r->storage);
     vxl_matcap_init(&r->matcap, &r->gpu);
     vxl_labels_init(&r->labels, &r->gpu); /* issue 20 label maps */
+    vxl_overlays_init(&r->overlays, &r->gpu); /* issue 20 overlays */
     r->gpu.budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
     if (opt && opt->struct_size >= offsetof(vxl_renderer_options, page_brick) + sizeof opt->page_brick) {
         if (opt->storage >= VXL_STORAGE_COUNT) {
@@ -204,9 +206,9 @@ static int job_set_volume(void *p)
     const uint32_t asked = vxl_storage_choose(&r->storage, v);
     vxl_storage_plan plan;
     /* refuse before anything is released: a failed set_volume loses nothing */
-    int rc = vxl_storage_ops_for(asked)->plan(&r->storage, v, asked, &plan);
+    int rc = vxl_storage_ops_for_volume(v, asked)->plan(&r->storage, v, asked, &plan);
     if (rc) return rc;
-    const vxl_storage_ops *ops = vxl_storage_ops_for(plan.mode);
+    const vxl_storage_ops *ops = vxl_storage_ops_for_volume(v, plan.mode);
     release_volume(r); /* the data changed */
     r->storage.has_volume = 0;
     r->storage.ops = ops;

@@ -17,6 +17,7 @@
 #include "labels.h"
 #include "matcap.h"
 #include "modes.h"
+#include "overlays.h"
 #include "skipping.h"
 #include "storage.h"
 #include "voxlight.h"
@@ -43,6 +44,7 @@ struct vxl_renderer {
     vxl_modes_state modes;                   /* modes.h: issue 19 render modes (min-max grid texture) */
     vxl_matcap_state matcap;                 /* matcap.h: issue 19 MatCap image */
     vxl_labels_state labels;                 /* labels.h: issue 20 label volume and table */
+    vxl_overlays_state overlays;             /* overlays.h: issue 20 overlay volumes */
 
     GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex;
     uint32_t fb_w, fb_h;

@@ -14,9 +14,14 @@ static const vxl_storage_ops *const tables[VXL_STORAGE_COUNT] = {
 
 const vxl_storage_ops *vxl_storage_ops_for(uint32_t mode) { return mode < VXL_STORAGE_COUNT ? tables[mode] : NULL; }
 
+const vxl_storage_ops *vxl_storage_ops_for_volume(const vxl_volume *v, uint32_t mode)
+{
+    return v->source ? &vxl_storage_streamed : vxl_storage_ops_for(mode); /* issue 21: no texels to upload */
+}
+
 uint32_t vxl_storage_choose(const vxl_storage_state *st, const vxl_volume *v)
 {
-    if (st->request != VXL_STORAGE_AUTO) return st->request;
+    if (st->request != VXL_STORAGE_AUTO || v->source) return st->request; /* streamed: the streamed plan decides */
     for (int a = 0; a < 3; a++)
         if (v->dims[a] > (uint32_t)st->gpu->info.max_3d_texture_size) return VXL_STORAGE_AUTO;
     return vxl_budget_fits(st->gpu->budget, NULL, VXL_HOLD_STORAGE, v->storage_bytes) ? VXL_STORAGE_DENSE : VXL_STORAGE_AUTO;

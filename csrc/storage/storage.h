@@ -107,6 +107,9 @@ typedef struct vxl_storage_ops {
 /* The tables: storage_dense.c, storage_bricked.c (bricked, sparse),
  * storage_compressed.c. */
 extern const vxl_storage_ops vxl_storage_dense, vxl_storage_bricked, vxl_storage_sparse, vxl_storage_compressed;
+/* storage_streamed.c: sparse storage of a streamed volume (v->source), whose
+ * bricks come from the source on demand; the storage every streamed volume gets. */
+extern const vxl_storage_ops vxl_storage_streamed;
 
 
 /* The storage subsystem's state: the volume on the GL side and what holds
@@ -154,6 +157,9 @@ struct vxl_storage_state {
     uint32_t code_slots[3];
     uint64_t code_bytes;          /* code pool + palettes */
     double decode_ms;             /* the decode of this frame, 0 if none */
+    /* Streamed volumes (issue 21, storage_streamed.c): the pool is a cache
+     * of bricks of every level read on demand by a loader thread. */
+    struct vxl_stream *stream;
 };
 
 /* storage.c: starts the state on g; it reports its bytes to g's budget. */
@@ -167,6 +173,8 @@ int vxl_storage_bind_sampling(vxl_storage_state *st, GLuint prog);
 /* storage.c: the table of a mode (AUTO: the bricked table, whose plan
  * decides), NULL for an unknown mode. */
 const vxl_storage_ops *vxl_storage_ops_for(uint32_t mode);
+/* The table that serves v in `mode`: the streamed one for a streamed volume. */
+const vxl_storage_ops *vxl_storage_ops_for_volume(const vxl_volume *v, uint32_t mode);
 /* DENSE when asked, or (AUTO) when one texture fits the limit and budget;
  * else what was asked (AUTO: the bricked plan picks bricked or sparse). */
 uint32_t vxl_storage_choose(const vxl_storage_state *st, const vxl_volume *v);

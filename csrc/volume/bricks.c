@@ -137,19 +137,22 @@ int vxl_bricks_classify(vxl_bricks *b, const vxl_occupancy_rule *f)
     if (b->distance && b->tf_key == key) return 0;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     if (!b->distance && !(b->distance = malloc(n))) return -1;
-    uint32_t maxdim = b->dims[0] > b->dims[1] ? b->dims[0] : b->dims[1];
-    maxdim = maxdim > b->dims[2] ? maxdim : b->dims[2];
-    uint8_t *scratch = malloc(2 * (size_t)maxdim);
-    if (!scratch) return -1;
     if (f->iso) classify_iso(b, f);
-    else if (classify_table(b, f)) {
-        free(scratch);
-        return -1;
-    }
-    for (int axis = 0; axis < 3; axis++) chebyshev_axis(b->distance, b->dims, axis, scratch, scratch + maxdim);
-    free(scratch);
+    else if (classify_table(b, f)) return -1;
+    if (vxl_bricks_chebyshev(b->distance, b->dims)) return -1;
     b->tf_key = key;
     return 1;
+}
+
+int vxl_bricks_chebyshev(uint8_t *d, const uint32_t dims[3])
+{
+    uint32_t maxdim = dims[0] > dims[1] ? dims[0] : dims[1];
+    maxdim = maxdim > dims[2] ? maxdim : dims[2];
+    uint8_t *scratch = malloc(2 * (size_t)maxdim);
+    if (!scratch) return -1;
+    for (int axis = 0; axis < 3; axis++) chebyshev_axis(d, dims, axis, scratch, scratch + maxdim);
+    free(scratch);
+    return 0;
 }
 
 void vxl_bricks_free(vxl_bricks *b)

@@ -44,6 +44,10 @@ uint32_t vxl_skip_brick_size(void);
  * caller re-uploads), 0 if the cached one still holds, -1 out of memory. */
 int vxl_bricks_classify(vxl_bricks *b, const vxl_occupancy_rule *c);
 void vxl_bricks_free(vxl_bricks *b);
+/* In place: an occupancy grid (0 occupied, 255 empty) of dims becomes its
+ * Chebyshev distance map (bricks.distance's meaning); -1 out of memory.
+ * Also the label bricks' (labels/label_bricks.c). */
+int vxl_bricks_chebyshev(uint8_t *d, const uint32_t dims[3]);
 /* Voxels around a brick that gradient taps sample_distance apart (filter
  * VXL_FILTER_*) and their trilinear footprint reach, when the filter's
  * |gradient| is bounded by the adjacent differences there (central,

@@ -58,21 +58,6 @@ int vxl_volume_check_limits(const uint32_t dims[3], uint32_t bytes_per_voxel,
     return VXL_OK;
 }
 
-static double raw_value(const void *raw, uint32_t dtype, uint64_t i)
-{
-    switch (dtype) {
-    case VXL_DTYPE_U8: return ((const uint8_t *)raw)[i];
-    case VXL_DTYPE_I8: return ((const int8_t *)raw)[i];
-    case VXL_DTYPE_U16: return ((const uint16_t *)raw)[i];
-    case VXL_DTYPE_I16: return ((const int16_t *)raw)[i];
-    case VXL_DTYPE_U32: return ((const uint32_t *)raw)[i];
-    case VXL_DTYPE_I32: return ((const int32_t *)raw)[i];
-    case VXL_DTYPE_F32: return ((const float *)raw)[i];
-    case VXL_DTYPE_F64: return ((const double *)raw)[i];
-    default: return 0.0;
-    }
-}
-
 /* Integer types of 8/16 bits: stored t = (raw - type_min) / type_span, which
  * is exact; the data value is then affine in t. */
 static void int_type_range(uint32_t dtype, double *lo, double *span)
@@ -83,6 +68,142 @@ static void int_type_range(uint32_t dtype, double *lo, double *span)
     case VXL_DTYPE_U16: *lo = 0; *span = 65535; break;
     default: *lo = -32768; *span = 65535; break; /* I16 */
     }
+}
+
+/* The loops below run over every voxel of volumes of billions, so each is
+ * written once per raw type (RAW_TYPES expands a statement per type) rather
+ * than through a switch per voxel; every value is the same double
+ * expression as a per-voxel read would give. */
+#define RAW_TYPES(X)                                                                   \
+    switch (dtype) {                                                                   \
+    case VXL_DTYPE_U8: X(uint8_t); break;                                              \
+    case VXL_DTYPE_I8: X(int8_t); break;                                               \
+    case VXL_DTYPE_U16: X(uint16_t); break;                                            \
+    case VXL_DTYPE_I16: X(int16_t); break;                                             \
+    case VXL_DTYPE_U32: X(uint32_t); break;                                            \
+    case VXL_DTYPE_I32: X(int32_t); break;                                             \
+    case VXL_DTYPE_F32: X(float); break;                                               \
+    case VXL_DTYPE_F64: X(double); break;                                              \
+    default: break;                                                                    \
+    }
+
+void vxl_raw_range(uint32_t dtype, const void *raw, uint64_t n, double slope, double inter, double *mn, double *mx,
+                   uint64_t *nan_count, uint64_t *inf_count)
+{
+    double lo = *mn, hi = *mx;
+    uint64_t nans = 0, infs = 0;
+    if (n && dtype != VXL_DTYPE_F32 && dtype != VXL_DTYPE_F64) {
+        /* Integers: raw * slope + inter is monotonic in raw (as rounded too),
+         * so the extremes come from the raw extremes, unless scaling
+         * overflows somewhere (then the per-voxel loop counts the Inf). */
+        double rlo = INFINITY, rhi = -INFINITY;
+#define RAW_EXTREMES(T)                                                   \
+    {                                                                     \
+        const T *r = raw;                                                 \
+        T a = r[0], b = r[0];                                             \
+        for (uint64_t i = 1; i < n; i++) {                                \
+            a = r[i] < a ? r[i] : a;                                      \
+            b = r[i] > b ? r[i] : b;                                      \
+        }                                                                 \
+        rlo = (double)a;                                                  \
+        rhi = (double)b;                                                  \
+    }
+        RAW_TYPES(RAW_EXTREMES)
+#undef RAW_EXTREMES
+        const double x0 = rlo * slope + inter, x1 = rhi * slope + inter;
+        if (isfinite(x0) && isfinite(x1)) {
+            const double a = x0 < x1 ? x0 : x1, b = x0 < x1 ? x1 : x0;
+            *mn = a < lo ? a : lo;
+            *mx = b > hi ? b : hi;
+            return;
+        }
+    }
+#define RANGE_LOOP(T)                                                     \
+    {                                                                     \
+        const T *r = raw;                                                 \
+        for (uint64_t i = 0; i < n; i++) {                                \
+            double x = r[i] * slope + inter;                              \
+            if (isnan(x)) nans++;                                         \
+            else if (isinf(x)) infs++;                                    \
+            else {                                                        \
+                if (x < lo) lo = x;                                       \
+                if (x > hi) hi = x;                                       \
+            }                                                             \
+        }                                                                 \
+    }
+    RAW_TYPES(RANGE_LOOP)
+#undef RANGE_LOOP
+    *mn = lo;
+    *mx = hi;
+    *nan_count += nans;
+    *inf_count += infs;
+}
+
+void vxl_texel_map_init(vxl_texel_map *m, uint32_t dtype, double slope, double inter, double mn, double mx)
+{
+    memset(m, 0, sizeof *m);
+    if (slope == 0.0) { slope = 1.0; inter = 0.0; } /* NIfTI: slope 0 means unscaled */
+    if (!(mn <= mx)) mn = mx = 0.0; /* nothing finite at all */
+    m->dtype = dtype;
+    m->bits = vxl_texture_bits_for(dtype);
+    m->slope = slope;
+    m->inter = inter;
+    m->mn = mn;
+    m->mx = mx;
+    if (m->bits < 32) {
+        double tspan;
+        int_type_range(dtype, &m->type_lo, &tspan);
+        /* integer data is never NaN; scaled endpoints of the type range */
+        m->tex_lo = m->type_lo * slope + inter;
+        m->tex_hi = (m->type_lo + tspan) * slope + inter;
+    } else {
+        double span = mx - mn;
+        m->tex_lo = mn;
+        m->tex_hi = span > 0 ? mx : mn + 1.0;
+        m->inv = span > 0 ? 1.0 / span : 0.0;
+    }
+}
+
+void vxl_texels_from_raw(const vxl_texel_map *m, const void *raw, uint64_t n, void *texels)
+{
+    const uint32_t dtype = m->dtype;
+    if (m->bits < 32) { /* code = raw - type minimum, exact */
+        const int32_t tlo = (int32_t)m->type_lo;
+#define CODE_LOOP(T)                                                                          \
+    {                                                                                         \
+        const T *r = raw;                                                                     \
+        if (m->bits == 8)                                                                     \
+            for (uint64_t i = 0; i < n; i++) ((uint8_t *)texels)[i] = (uint8_t)(r[i] - tlo);  \
+        else                                                                                  \
+            for (uint64_t i = 0; i < n; i++) ((uint16_t *)texels)[i] = (uint16_t)(r[i] - tlo); \
+    }
+        switch (dtype) { /* 8/16-bit types only have 8/16-bit texels */
+        case VXL_DTYPE_U8: CODE_LOOP(uint8_t); break;
+        case VXL_DTYPE_I8: CODE_LOOP(int8_t); break;
+        case VXL_DTYPE_U16: CODE_LOOP(uint16_t); break;
+        case VXL_DTYPE_I16: CODE_LOOP(int16_t); break;
+        default: break;
+        }
+#undef CODE_LOOP
+        return;
+    }
+    /* Normalise in double so +-1e30 and denormals land safely in [0,1]. */
+    float *t = texels;
+    const double slope = m->slope, inter = m->inter, mn = m->mn, mx = m->mx, inv = m->inv;
+#define NORM_LOOP(T)                                                      \
+    {                                                                     \
+        const T *r = raw;                                                 \
+        for (uint64_t i = 0; i < n; i++) {                                \
+            double x = r[i] * slope + inter;                              \
+            if (isnan(x)) x = mn;                                         \
+            else if (x > mx) x = mx;                                      \
+            else if (x < mn) x = mn;                                      \
+            double s = (x - mn) * inv;                                    \
+            t[i] = (float)(s < 0 ? 0 : s > 1 ? 1 : s);                    \
+        }                                                                 \
+    }
+    RAW_TYPES(NORM_LOOP)
+#undef NORM_LOOP
 }
 
 int vxl_volume_build(const void *raw, uint32_t dtype, const uint32_t dims[3], const double spacing[3],
@@ -108,10 +229,26 @@ int vxl_volume_build(const void *raw, uint32_t dtype, const uint32_t dims[3], co
         free(v);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for %llu voxels", (unsigned long long)n);
     }
+    vxl_volume_set_geometry(v, dims, dtype, spacing, affine);
+
+    /* Pass 1: finite range of the scaled values, NaN/Inf counts; pass 2: texels. */
+    double mn = INFINITY, mx = -INFINITY;
+    vxl_raw_range(dtype, raw, n, slope, inter, &mn, &mx, &v->nan_count, &v->inf_count);
+    vxl_texel_map m;
+    vxl_texel_map_init(&m, dtype, slope, inter, mn, mx);
+    vxl_volume_set_values(v, &m);
+    vxl_texels_from_raw(&m, raw, n, v->texels);
+    *out = v;
+    return VXL_OK;
+}
+
+void vxl_volume_set_geometry(vxl_volume *v, const uint32_t dims[3], uint32_t dtype, const double spacing[3],
+                             const double *affine)
+{
     memcpy(v->dims, dims, sizeof v->dims);
     v->src_dtype = dtype;
-    v->texture_bits = bits;
-    v->storage_bytes = n * (bits / 8);
+    v->texture_bits = vxl_texture_bits_for(dtype);
+    v->storage_bytes = (uint64_t)dims[0] * dims[1] * dims[2] * (v->texture_bits / 8);
     for (int a = 0; a < 3; a++)
         v->spacing[a] = (spacing && isfinite(spacing[a]) && spacing[a] > 0) ? spacing[a] : 1.0;
     memset(v->affine, 0, sizeof v->affine);
@@ -121,51 +258,14 @@ int vxl_volume_build(const void *raw, uint32_t dtype, const uint32_t dims[3], co
         for (int a = 0; a < 3; a++) v->affine[a * 4 + a] = v->spacing[a];
         v->affine[15] = 1.0;
     }
+}
 
-    /* Pass 1: finite range of the scaled values, NaN/Inf counts. */
-    double mn = INFINITY, mx = -INFINITY;
-    for (uint64_t i = 0; i < n; i++) {
-        double x = raw_value(raw, dtype, i) * slope + inter;
-        if (isnan(x)) v->nan_count++;
-        else if (isinf(x)) v->inf_count++;
-        else {
-            if (x < mn) mn = x;
-            if (x > mx) mx = x;
-        }
-    }
-    if (!(mn <= mx)) mn = mx = 0.0; /* nothing finite at all */
-    v->value_min = mn;
-    v->value_max = mx;
-
-    if (bits < 32) {
-        double tlo, tspan;
-        int_type_range(dtype, &tlo, &tspan);
-        /* integer data is never NaN; scaled endpoints of the type range */
-        v->tex_lo = tlo * slope + inter;
-        v->tex_hi = (tlo + tspan) * slope + inter;
-        for (uint64_t i = 0; i < n; i++) {
-            double t = raw_value(raw, dtype, i) - tlo;
-            if (bits == 8) ((uint8_t *)v->texels)[i] = (uint8_t)t;
-            else ((uint16_t *)v->texels)[i] = (uint16_t)t;
-        }
-    } else {
-        /* Normalise in double so +-1e30 and denormals land safely in [0,1]. */
-        double span = mx - mn;
-        v->tex_lo = mn;
-        v->tex_hi = span > 0 ? mx : mn + 1.0;
-        double inv = span > 0 ? 1.0 / span : 0.0;
-        float *t = v->texels;
-        for (uint64_t i = 0; i < n; i++) {
-            double x = raw_value(raw, dtype, i) * slope + inter;
-            if (isnan(x)) x = mn;
-            else if (x > mx) x = mx;
-            else if (x < mn) x = mn;
-            double s = (x - mn) * inv;
-            t[i] = (float)(s < 0 ? 0 : s > 1 ? 1 : s);
-        }
-    }
-    *out = v;
-    return VXL_OK;
+void vxl_volume_set_values(vxl_volume *v, const vxl_texel_map *m)
+{
+    v->value_min = m->mn;
+    v->value_max = m->mx;
+    v->tex_lo = m->tex_lo;
+    v->tex_hi = m->tex_hi;
 }
 
 int vxl_volume_create(const vxl_volume_desc *d, const vxl_load_options *opt, vxl_volume **out)
@@ -199,6 +299,15 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
     o->affine_source = v->affine_source;
     o->frame_count = v->frame_count ? v->frame_count : 1;
     o->frame = v->frame;
+    if (v->source) {
+        o->streamed = 1;
+        o->level_count = v->source->n_levels;
+        o->resident_bytes = v->source->resident_bytes;
+        o->bytes_read = __atomic_load_n(&v->source->bytes_read, __ATOMIC_RELAXED);
+    } else {
+        o->level_count = 1;
+        o->resident_bytes = v->storage_bytes;
+    }
     memcpy(out, o, have);
     return VXL_OK;
 }
@@ -210,6 +319,42 @@ double vxl_volume_texel(const vxl_volume *v, size_t i)
     return ((const float *)v->texels)[i];
 }
 
+/* Bins n texels of bits (the stored t in [0,1] maps to tex_lo + t * span). */
+static void bin_texels(const vxl_volume *v, uint32_t bits, const void *texels, size_t n, uint32_t bins, double lo,
+                       double scale, uint64_t *counts)
+{
+    const double span = v->tex_hi - v->tex_lo;
+    for (size_t i = 0; i < n; i++) {
+        double t = bits == 8 ? ((const uint8_t *)texels)[i] / 255.0
+                   : bits == 16 ? ((const uint16_t *)texels)[i] / 65535.0
+                                : ((const float *)texels)[i];
+        double b = (v->tex_lo + t * span - lo) * scale;
+        if (b >= 0 && b <= bins) counts[b >= bins ? bins - 1 : (uint32_t)b]++;
+    }
+}
+
+/* A streamed volume's texels, read through its source a z slab at a time
+ * (about 16 MiB, at least one slice), so the histogram never holds the volume. */
+static int bin_streamed(const vxl_volume *v, uint32_t bins, double lo, double scale, uint64_t *counts)
+{
+    vxl_brick_source *s = v->source;
+    const size_t slice = (size_t)v->dims[0] * v->dims[1] * (s->texture_bits / 8);
+    uint32_t depth = (uint32_t)((16u << 20) / slice);
+    depth = depth < 1 ? 1 : depth > v->dims[2] ? v->dims[2] : depth;
+    void *buf = malloc(slice * depth);
+    if (!buf) return vxl_fail(NULL, VXL_ERR_NO_MEMORY, "out of memory for a histogram slab of %u slices", depth);
+    vxl_err e = {0};
+    int rc = VXL_OK;
+    for (uint32_t z = 0; z < v->dims[2] && !rc; z += depth) {
+        const uint32_t lo3[3] = {0, 0, z}, size[3] = {v->dims[0], v->dims[1], depth < v->dims[2] - z ? depth : v->dims[2] - z};
+        rc = s->ops->read(s, 0, lo3, size, buf, &e);
+        if (rc) rc = vxl_fail(NULL, rc, "histogram: %s", e.msg);
+        else bin_texels(v, s->texture_bits, buf, (size_t)size[0] * size[1] * size[2], bins, lo, scale, counts);
+    }
+    free(buf);
+    return rc;
+}
+
 int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double hi, uint64_t *counts)
 {
     if (!v || !counts || bins == 0)
@@ -219,12 +364,13 @@ int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double h
         return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "histogram range [%g, %g] is empty or not finite", lo, hi);
     memset(counts, 0, bins * sizeof *counts);
     /* Stored t in [0,1] maps to tex_lo + t*(tex_hi - tex_lo): bin by t directly. */
-    const double span = v->tex_hi - v->tex_lo, scale = bins / (hi - lo);
-    const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
-    for (uint64_t i = 0; i < n; i++) {
-        double t = vxl_volume_texel(v, (size_t)i);
-        double b = (v->tex_lo + t * span - lo) * scale;
-        if (b >= 0 && b <= bins) counts[b >= bins ? bins - 1 : (uint32_t)b]++;
+    const double scale = bins / (hi - lo);
+    if (v->source) {
+        int rc = bin_streamed(v, bins, lo, scale, counts);
+        if (rc) return rc;
+    } else {
+        bin_texels(v, v->texture_bits, v->texels, (size_t)v->dims[0] * v->dims[1] * v->dims[2], bins, lo, scale,
+                   counts);
     }
     if (v->nan_count) { /* NaN voxels were stored as value_min: take them back out */
         double b = (v->value_min - lo) * scale;

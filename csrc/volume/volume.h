@@ -55,6 +55,31 @@ int vxl_volume_build(const void *raw, uint32_t dtype, const uint32_t dims[3], co
                      const double *affine_colmajor, double slope, double inter,
                      const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 
+/* The conversion vxl_volume_build makes, in pieces, for sources that see a
+ * volume a slab at a time (issue 21, io/raw_source.c): the range of raw
+ * values first (accumulated over calls into *mn, *mx and the counts; start
+ * with mn = +inf, mx = -inf), then the map it fixes, then texels. raw is
+ * native-endian dtype; slope 0 = unscaled. */
+typedef struct vxl_texel_map {
+    uint32_t dtype, bits;
+    double slope, inter;    /* slope 0 already replaced by 1 (inter 0) */
+    double mn, mx;          /* the finite range (0, 0 when nothing was finite): value_min/max */
+    double inv;             /* 32-bit texels: 1 / (mx - mn), 0 for a flat volume */
+    double type_lo;         /* 8/16-bit texels: the type's minimum (code = raw - type_lo) */
+    double tex_lo, tex_hi;  /* as vxl_volume's */
+} vxl_texel_map;
+
+void vxl_raw_range(uint32_t dtype, const void *raw, uint64_t n, double slope, double inter, double *mn, double *mx,
+                   uint64_t *nan_count, uint64_t *inf_count);
+void vxl_texel_map_init(vxl_texel_map *m, uint32_t dtype, double slope, double inter, double mn, double mx);
+void vxl_texels_from_raw(const vxl_texel_map *m, const void *raw, uint64_t n, void *texels);
+/* dims, dtype, texture_bits, storage_bytes, spacing (0 -> 1) and affine
+ * (NULL: diag(spacing)) of v, as vxl_volume_build sets them. */
+void vxl_volume_set_geometry(vxl_volume *v, const uint32_t dims[3], uint32_t dtype, const double spacing[3],
+                             const double *affine);
+/* value_min/max and tex_lo/hi from a map. */
+void vxl_volume_set_values(vxl_volume *v, const vxl_texel_map *m);
+
 /* The loaders that build volumes from files are declared in loaders.h:
  * they call this file, never the reverse. */
 

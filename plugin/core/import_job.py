@@ -1,11 +1,13 @@
 """A volume import running on a worker thread (no bpy), so Blender's UI
 stays live, shows progress and can cancel with Esc.
 
-The library's load call itself cannot be interrupted. Cancelling therefore
-returns control at once and lets the worker finish its current step in the
-background; the worker sees the flag between steps (runtime.open_volume
-asks) and closes whatever it made, and a result that arrives after the
-cancel is closed too. Nothing of a cancelled import is registered or kept.
+Cancelling returns control at once and lets the worker finish its current
+step in the background; the worker sees the flag between steps
+(runtime.open_volume asks) and closes whatever it made, and a result that
+arrives after the cancel is closed too. The library's first pass over a
+file (a .nii.gz streamed into its bricked cache, issue 21) reports progress
+and stops at the flag, leaving no partial cache; other loads run to their
+end. Nothing of a cancelled import is registered or kept.
 """
 
 import os
@@ -51,6 +53,7 @@ class ImportJob:
         self.storage = storage
         self.memory_budget = memory_budget
         self.progress = 0.0
+        self.stage = ""  # what the library's first pass over the file is doing ("" = none)
         self.entry = None
         self.error = None
         self._cancelled = threading.Event()
@@ -71,13 +74,23 @@ class ImportJob:
 
     def _set_progress(self, f):
         self.progress = f
+        self.stage = ""
+
+    # The library's pass over the file is the load step, the first 40 % of
+    # open_volume's progress (it reports 0.4 once the volume is open).
+    LOAD_SHARE = 0.4
+
+    def _set_load_progress(self, fraction, stage):
+        self.progress = self.LOAD_SHARE * min(max(fraction, 0.0), 1.0)
+        self.stage = stage
 
     def run(self):
         """The work; called on the thread, or directly for a blocking import."""
         try:
             entry = runtime.open_volume(self.path, self.backend, self._set_progress, self.voxel_size,
                                         cancelled=self._cancelled.is_set, series=self.series,
-                                        storage=self.storage, memory_budget=self.memory_budget)
+                                        storage=self.storage, memory_budget=self.memory_budget,
+                                        load_progress=self._set_load_progress)
         except (native.VoxlightError, OSError) as e:
             self.error = str(e)
             entry = None

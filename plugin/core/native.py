@@ -22,6 +22,7 @@ of the add-on and the tests say `native.X`:
   native_tiles         tile_params, params_digest
   native_renderer      make_params, Renderer
   native_cutaway       issue 19's cutaway, MatCap and slice structs from plain data
+  native_overlays      issue 20's overlay styles (params.overlays) from plain data
 """
 
 import sys
@@ -41,6 +42,7 @@ from .native_private_copy import (CACHE_DIR, HELPER_PREFIX, OLD_VDB_HELPER_NAME,
                                   VDB_HELPER_NAME, cache_roots, clean_stale_copies, helper_names,
                                   private_copy, restore_execute_bit)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct  # noqa: F401
+from .native_overlays import overlay_array  # noqa: F401
 from .native_renderer import Renderer, make_params  # noqa: F401
 from .native_tiles import params_digest, tile_params  # noqa: F401
 from .native_volume import Volume, list_dicom_series, load_label_table, voxel_box_corners  # noqa: F401

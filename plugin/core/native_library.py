@@ -62,6 +62,7 @@ def _declare(lib):
         "vxl_renderer_get_info": (ctypes.c_int, [vp, P(RendererInfo)]),
         "vxl_renderer_set_volume": (ctypes.c_int, [vp, vp]),
         "vxl_renderer_set_labels": (ctypes.c_int, [vp, vp]),  # issue 20
+        "vxl_renderer_set_overlay": (ctypes.c_int, [vp, ctypes.c_uint32, vp]),  # issue 20
         "vxl_renderer_label_uploads": (ctypes.c_int, [vp, P(ctypes.c_uint64), P(ctypes.c_uint64)]),
         "vxl_render": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                       P(ctypes.c_float)]),

@@ -9,10 +9,11 @@ import time
 
 import numpy as np
 
-from .native_abi import (LabelEntry, LabelStyle, LibraryObject, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
+from .native_abi import (LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
                          RendererInfo, RendererOptions, SceneShadows, VoxlightError, matrix_from_cm, _fptr,
                          _matrix_cm, _sized)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct
+from .native_overlays import overlay_array
 from .native_library import load_library
 from .native_tiles import _empty_stats, _merge_stats, tile_params
 
@@ -45,7 +46,7 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 gradient_exp=0.0, iso_value=0.0, iso_thickness=0.0, preint_size=0,
                 shading_model=0, ambient_occlusion=0.0, occlusion_strength=0.0, anisotropy=0.0,
                 illumination_size=0, mode="dvr", matcap=None, matcap_key=0, cutaway=None,
-                scene_shadows=None, labels=None, lib=None):
+                scene_shadows=None, labels=None, overlays=None, lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -65,7 +66,9 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     Issue 18: `scene_shadows` is (vertices (n, 3) world, triangles (m, 3)
     vertex indices, key[, shadow_map_size]), the scene's opaque meshes that
     shadow the volume; key 0 lets the library hash the arrays, a nonzero key
-    names this version of them (the same key: no shadow map is rebuilt)."""
+    names this version of them (the same key: no shadow map is rebuilt).
+    Issue 20: `overlays` is a list of dicts or OverlayStyles
+    (native_overlays.py), each naming a slot filled by Renderer.set_overlay."""
     lib = lib or load_library()
     p = _sized(RenderParams)
     p.width, p.height = int(width), int(height)
@@ -147,6 +150,11 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     _issue19_inputs(p, lib, mode, matcap, matcap_key, cutaway)
     if labels is not None:
         _set_labels(p, lib, *labels)
+    if overlays:  # issue 20: the struct array and its tables live as long as p
+        p._overlays, p._overlay_tables, digest = overlay_array(overlays, lib)
+        p._keep.extend(digest)
+        p.overlay_count = len(overlays)
+        p.overlays = ctypes.cast(p._overlays, ctypes.POINTER(OverlayStyle))
     if scene_shadows is not None:
         _set_scene_shadows(p, *scene_shadows)
     return p
@@ -249,6 +257,13 @@ class Renderer(LibraryObject):
         """The label volume (issue 20): a Volume of integer ids, or None to remove it."""
         self._check(self.lib.cdll.vxl_renderer_set_labels(self.handle, volume.handle if volume is not None else None),
                     "set labels")
+
+    def set_overlay(self, slot, volume):
+        """Overlay slot `slot` (< MAX_OVERLAYS, issue 20): a Volume in any
+        grid (its affine places it), or None to empty the slot."""
+        self._check(self.lib.cdll.vxl_renderer_set_overlay(self.handle, int(slot),
+                                                           volume.handle if volume is not None else None),
+                    "set overlay %d" % slot)
 
     def label_uploads(self):
         """(label volumes, label tables) uploaded so far (voxlight_dev.h)."""

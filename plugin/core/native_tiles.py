@@ -37,6 +37,7 @@ def params_digest(params, *extra):
     # shares c's memory, is cleared).
     labels = _label_style_bytes(c.labels.contents) if c.labels else b""
     c.labels = None
+    c.overlays = None  # issue 20: their contents are in _keep
     h = hashlib.blake2b(bytes(c), digest_size=16)
     h.update(labels)
     for a in getattr(params, "_keep", ()):
@@ -83,7 +84,7 @@ def tile_params(params, x0, y0, x1, y1):
     if shapes is not None:  # the same light shapes
         t._keep.append(shapes)
         t._shapes = shapes
-    for name in ("_cutaway", "_matcap", "_scene_shadows", "_occluders"):  # the copy points at the same structs (holding their arrays)
+    for name in ("_cutaway", "_matcap", "_scene_shadows", "_occluders", "_overlays", "_overlay_tables"):  # the copy points at the same structs (holding their arrays)
         if hasattr(params, name):
             setattr(t, name, getattr(params, name))
     t.width, t.height = x1 - x0, y1 - y0
@@ -111,7 +112,8 @@ def _empty_stats():
             "effective_step": 0.0, "bricks_total": 0, "bricks_occupied": 0,
             "brick_size": 0, "calls": 0, "seconds": 0.0, "storage_name": "", "resident_bytes": 0,
             "pages_total": 0, "pages_resident": 0, "pages_constant": 0, "lod_level": 0,
-            "lod_wanted_bytes": 0, "decode_ms": 0.0}
+            "lod_wanted_bytes": 0, "decode_ms": 0.0,
+            "refine_pending": 0, "stream_level": 0, "bytes_read": 0, "load_ms": 0.0}  # issue 21
 
 
 def _merge_stats(acc, s):
@@ -123,4 +125,9 @@ def _merge_stats(acc, s):
               "resident_bytes", "pages_total", "pages_resident", "pages_constant", "lod_level",
               "lod_wanted_bytes", "decode_ms"):
         acc[k] = s[k]
+    # Issue 21 (streamed volumes): every band's pending bricks and reads
+    # count, and the frame is as coarse as its coarsest band.
+    for k in ("refine_pending", "bytes_read", "load_ms"):
+        acc[k] += s.get(k, 0)
+    acc["stream_level"] = max(acc["stream_level"], s.get("stream_level", 0))
     return acc

@@ -9,9 +9,28 @@ import os
 
 import numpy as np
 
-from .native_abi import (DicomSeries, LabelEntry, LibraryObject, LoadOptions, PhantomDesc, VolumeDesc,
-                         VolumeInfo, VoxlightError, matrix_from_cm, _DTYPES, _sized)
+from .native_abi import (PROGRESS_CALLBACK, DicomSeries, LabelEntry, LibraryObject, LoadOptions, PhantomDesc,
+                         VolumeDesc, VolumeInfo, VoxlightError, matrix_from_cm, _DTYPES, _sized)
 from .native_library import load_library
+
+
+ERR_CANCELLED = 10  # VXL_ERR_CANCELLED: a progress callback asked to stop
+
+
+def _progress_callback(progress, raised):
+    """progress(fraction, stage) as the library's callback: nonzero (cancel)
+    when it returns something true, or when it raises; the exception goes
+    into `raised` for the caller to raise once the library has returned
+    (an exception cannot cross the C frames)."""
+    def call(_user, fraction, stage):
+        if raised:
+            return 1
+        try:
+            return 1 if progress(float(fraction), stage.decode("utf-8", "replace") if stage else "") else 0
+        except BaseException as e:  # noqa: B902 - KeyboardInterrupt too: it must not be lost in C
+            raised.append(e)
+            return 1
+    return PROGRESS_CALLBACK(call)
 
 
 class Volume(LibraryObject):
@@ -24,12 +43,21 @@ class Volume(LibraryObject):
         self.info = self._read_info()
 
     @classmethod
-    def load(cls, path, max_dim=0, memory_budget=0, voxel_size=None, lib=None, frame=0, series=None):
+    def load(cls, path, max_dim=0, memory_budget=0, voxel_size=None, lib=None, frame=0, series=None,
+             streaming="auto", cache_dir=None, progress=None):
         """voxel_size (x, y, z) mm is for inputs without geometry (TIFF/PNG
         stacks); None or 0 = 1 mm. Files with geometry ignore it.
         frame: the volume of a 4D file (only it is read); series: for a
         DICOM folder of several series, an index (int or its string) or a
-        SeriesInstanceUID, as list_dicom_series() gives them."""
+        SeriesInstanceUID, as list_dicom_series() gives them.
+        Issue 21: streaming is "auto", "off" or "on" (vxl_streaming_name, or
+        VXL_STREAMING_*): whether the voxels are read on demand instead of
+        whole; cache_dir is where the bricked cache of a .nii.gz goes (None:
+        beside the file). progress(fraction, stage) is called on this thread
+        during the first pass over a file; a true return cancels the load,
+        which then raises VoxlightError with code ERR_CANCELLED and leaves no
+        partial cache. An exception raised by progress cancels the load too
+        and is raised again here."""
         lib = lib or load_library()
         opt = _sized(LoadOptions)
         opt.max_dim = max_dim
@@ -39,9 +67,22 @@ class Volume(LibraryObject):
         opt.frame = int(frame)
         if series is not None and str(series) != "":
             opt.series = str(series).encode()
+        opt.streaming = streaming if isinstance(streaming, int) else lib.index("streaming", streaming)
+        if cache_dir:
+            opt.cache_dir = os.fsencode(cache_dir)
+        raised = []
+        if progress is not None:
+            # opt holds the only C pointer to the callback, and opt lives
+            # until this function returns, after the library's last call.
+            opt.progress = _progress_callback(progress, raised)
         h = ctypes.c_void_p()
+        code = lib.cdll.vxl_volume_load(os.fsencode(path), ctypes.byref(opt), ctypes.byref(h))
+        if raised:
+            if code == 0:
+                lib.cdll.vxl_volume_destroy(h)
+            raise raised[0]
         # The library's message already names the file.
-        lib.check(lib.cdll.vxl_volume_load(os.fsencode(path), ctypes.byref(opt), ctypes.byref(h)))
+        lib.check(code)
         return cls(lib, h)
 
     @classmethod
@@ -124,6 +165,11 @@ class Volume(LibraryObject):
             if info.affine_source < 3 else str(info.affine_source),
             "frame_count": max(1, info.frame_count),
             "frame": info.frame,
+            # issue 21: read on demand, its resolution levels, CPU bytes held, bytes read so far
+            "streamed": bool(info.streamed),
+            "level_count": max(1, info.level_count),
+            "resident_bytes": info.resident_bytes,
+            "bytes_read": info.bytes_read,
         }
 
     def histogram(self, bins=32, lo=None, hi=None):

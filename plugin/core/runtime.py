@@ -19,7 +19,8 @@ import os
 import threading
 import time
 
-from . import frames, label_runtime, native, tf_fit
+from . import budget_split, frames, label_runtime, native, tf_fit
+from .native_volume import ERR_CANCELLED
 
 _lock = threading.Lock()
 render_count = 0
@@ -170,6 +171,20 @@ class Worker:
 # Frames of 4D volumes, shared by every entry (frames.py).
 frame_cache = frames.FrameCache()
 
+# Issue 21: how files are opened, from the add-on preferences (preferences.py
+# keeps this current): VXL_STREAMING_* by name, and where bricked caches go
+# ("" = beside the file).
+stream_settings = {"streaming": "auto", "cache_dir": ""}
+
+
+def load_kwargs(memory_budget=0):
+    """Volume.load's memory and streaming arguments for a total budget
+    (bytes, 0 = the library's default): the volume's share of it
+    (budget_split) and the preferences' streaming mode and cache folder."""
+    return {"memory_budget": budget_split.volume_share(memory_budget),
+            "streaming": stream_settings.get("streaming") or "auto",
+            "cache_dir": stream_settings.get("cache_dir") or None}
+
 
 def options_of(settings):
     """Renderer options from the scene's Voxlight settings (duck-typed, so
@@ -191,6 +206,7 @@ class VolumeEntry:
         self.pending_frame = None  # 4D: the loaded frame, cached by adopt()
         self.frame_count = info.get("frame_count", 1)
         self.last_frame = None   # stats of the last frame rendered (panel)
+        self.load_kwargs = load_kwargs(self.options.get("memory_budget", 0))  # issue 21: other frames alike
         self._worker = None
         renderer.on_render = _count_call
 
@@ -198,7 +214,8 @@ class VolumeEntry:
     def identity(self):
         """Part of every frame key: which data this renderer holds."""
         return (self.path, self.series, self.mtime, id(self), self.frame,
-                getattr(self, "label_key", None))  # issue 20: label_runtime
+                getattr(self, "label_key", None),  # issue 20: label_runtime
+                getattr(self, "overlay_key", None))  # issue 20: overlay_runtime
 
     def _frame_key(self, frame):
         return (self.path, self.series, self.mtime, frame)
@@ -211,7 +228,8 @@ class VolumeEntry:
         if frame == self.frame:
             return False
         vol = frame_cache.get(self._frame_key(frame),
-                              lambda: native.Volume.load(self.path, frame=frame, series=self.series or None))
+                              lambda: native.Volume.load(self.path, frame=frame, series=self.series or None,
+                                                         **self.load_kwargs))
         self.renderer.set_volume(vol)
         self.frame = frame
         return True
@@ -255,8 +273,24 @@ def _mtime(path):
         return None
 
 
+def _load_file(path, lib, stop, load_progress, **kw):
+    """Volume.load with the library's progress reported to
+    load_progress(fraction, stage) and cancelled when stop() says so (the
+    library then keeps no partial cache); None when cancelled."""
+    def report(fraction, stage):
+        if load_progress is not None:
+            load_progress(fraction, stage)
+        return stop()
+    try:
+        return native.Volume.load(path, lib=lib, progress=report, **kw)
+    except native.VoxlightError as e:
+        if e.code == ERR_CANCELLED and stop():
+            return None
+        raise
+
+
 def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=None, series="", frame=0,
-                storage="auto", memory_budget=0):
+                storage="auto", memory_budget=0, load_progress=None):
     """Load `path` (frame `frame` of a 4D file; series `series` of a DICOM
     folder; "phantom:NAME[:WxHxD]" a generated volume) into a fresh renderer
     with the given storage and memory budget, not registered yet (safe on a
@@ -265,7 +299,11 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
     between them too, and when it says yes everything made so far is closed
     and None returned. voxel_size (mm) is for inputs without geometry; it only
     changes info["affine"], which the importer bakes into the object, so later
-    reloads need not repeat it."""
+    reloads need not repeat it.
+    Issue 21: memory_budget bounds the volume and its renderer together
+    (budget_split); the file is opened as stream_settings say, and the
+    library's first pass over it (a .nii.gz cached brick by brick) reports
+    load_progress(fraction, stage) and stops when cancelled() says so."""
     path = _key(path)
     series = series or ""
     stop = cancelled or (lambda: False)
@@ -273,7 +311,10 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
     if is_phantom(path):
         vol = native.Volume.phantom(path, lib=lib)
     else:
-        vol = native.Volume.load(path, voxel_size=voxel_size, lib=lib, frame=frame, series=series or None)
+        vol = _load_file(path, lib, stop, load_progress, voxel_size=voxel_size, frame=frame,
+                         series=series or None, **load_kwargs(memory_budget))
+        if vol is None:
+            return None
     keep = vol.info.get("frame_count", 1) > 1  # 4D: adopt() puts the frame shown into the cache
     renderer = entry = None
     try:
@@ -281,7 +322,9 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
             return None
         if progress:
             progress(0.4)
-        renderer = native.Renderer(backend=backend, lib=lib, storage=storage, memory_budget=memory_budget)
+        renderer = native.Renderer(backend=backend, lib=lib, storage=storage,
+                                   memory_budget=budget_split.renderer_share(memory_budget,
+                                                                             vol.info.get("streamed")))
         if progress:
             progress(0.6)
         if stop():

@@ -140,6 +140,9 @@ bool add_sample(inout Compositing s, RaySetup r, int i, float t, vec3 p, float v
 #ifdef LABELS
 #include "lib/labels.glsl" // issue 20 label maps: label_mask, label_march
 #endif
+#ifdef OVERLAYS
+#include "lib/overlays.glsl" // issue 20 overlays: overlay_span, overlay_march
+#endif
 
 // One ray from t0 to t1 (o + t * dir in voxels): premultiplied colour, the
 // depth where it reached u_depth_threshold, the samples taken.
@@ -161,6 +164,10 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
     float v_prev = sample_value(o + t_start * dir);
 #endif
     taken = 0u;
+#if defined(LABELS) && LABELS > 1
+    LabelRay lr = label_ray(o, dir, t_start, u_step); // issue 20: the label bricks along the ray
+    uint no_label = LABEL_NONE;
+#endif
     // Two loops: the inner one walks over the samples that add nothing
     // (skipped or transparent), the outer one does the work of a sample that
     // adds something. On 8-wide SIMD (llvmpipe) every lane runs a branch that
@@ -209,6 +216,13 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
 #endif
                 }
             }
+#if defined(LABELS) && LABELS > 1 && !defined(CLASSIFY_PREINT)
+            int label_next = label_leap(lr, i, t, label_q(p), no_label); // issue 20: no visible label here
+            if (label_next >= 0) {
+                i = label_next - 1;
+                continue;
+            }
+#endif
             taken++;
             v = sample_value(p);
 #if GOPACITY == 2
@@ -234,7 +248,7 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
             c = classify(v);
 #endif
 #if defined(LABELS) && LABELS > 1
-            if (c.a > 0.0) c = label_mask(p, c); // issue 20: only inside visible labels
+            if (c.a > 0.0) c = label_mask(lr, p, c); // issue 20: only inside visible labels
 #endif
             if (c.a <= 0.0) continue;
 #ifdef DEFER_VISIBLE
@@ -258,6 +272,9 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
 #if defined(LABELS) && LABELS == 1
 #define march label_march // issue 20: labels as surfaces
 #endif
+#ifdef OVERLAYS
+#define march overlay_march // issue 20: several volumes in one march
+#endif
 
 void main()
 {
@@ -277,6 +294,9 @@ void main()
     // lies on a slab plane would otherwise give 0 * inf = NaN.
     vec3 lo = vec3(-0.5), hi = u_dims - 0.5;
     float t0 = 0.0, t1 = t_far;
+#ifdef OVERLAYS
+    if (!overlay_span(o, dir, t_far, t0, t1)) { emit_nothing(); return; } // issue 20: the union of all boxes
+#else
     for (int a = 0; a < 3; a++) {
         if (abs(dir[a]) < 1e-12) {
             if (o[a] < lo[a] || o[a] > hi[a]) { emit_nothing(); return; }
@@ -287,6 +307,7 @@ void main()
             t1 = min(t1, max(ta, tb));
         }
     }
+#endif
     // View-space planar distance along the ray is affine in t.
     vec4 row2 = vec4(u_mv[0][2], u_mv[1][2], u_mv[2][2], u_mv[3][2]);
     float z0 = dot(row2, vec4(o, 1.0)), dz = dot(row2.xyz, dir);

@@ -111,3 +111,16 @@ class Capture:
         fb.read_color(0, 0, w, h, 4, 0, "FLOAT", data=buf)
         self.img = np.array(buf, np.float32).reshape(h, w, 4)
         self.want = False
+
+    def settled(self, vx, area, tries=40):
+        """Steps (yield from it) that grab until the add-on `vx` has nothing
+        in flight and stops rendering: the refined frame renders in the
+        background after the view settles. self.img is then the still frame."""
+        last = -1
+        for _ in range(tries):
+            self.request()
+            area.tag_redraw()
+            yield 0.5
+            if self.img is not None and not vx.viewport.busy() and vx.core.runtime.render_count == last:
+                return
+            last = vx.core.runtime.render_count

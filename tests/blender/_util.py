@@ -11,6 +11,7 @@ import sys
 import tempfile
 import time
 import traceback
+import types
 
 import bpy
 import numpy as np
@@ -252,3 +253,30 @@ def load_png(path):
         return px.reshape(h, w, 4)
     finally:
         bpy.data.images.remove(img)
+
+
+class Layout:
+    """Stands in for a UILayout in panel tests (its rows, columns and boxes
+    are itself): `drawn` lists the properties, operators, lists and texts
+    drawn."""
+
+    def __init__(self):
+        self.drawn = []
+
+    def prop(self, data, name, **kw):
+        self.drawn.append(name)
+
+    def operator(self, idname, **kw):
+        self.drawn.append(idname)
+        return types.SimpleNamespace()
+
+    def label(self, text="", **kw):
+        self.drawn.append(text)
+
+    def template_list(self, list_type, *args, **kw):
+        self.drawn.append(list_type)
+
+    def row(self, **kw):
+        return self
+
+    column = box = row

@@ -53,15 +53,7 @@ def steps():
     sun.rotation_euler = (0.0, 0.9, 0.0)
 
     def settled():
-        last = -1
-        for _ in range(40):
-            capture.request()
-            area.tag_redraw()
-            yield 0.5
-            if capture.img is not None and not vx.viewport.busy() and \
-                    vx.core.runtime.render_count == last:
-                return
-            last = vx.core.runtime.render_count
+        return capture.settled(vx, area)
 
     yield from settled()
     before = capture.img

@@ -233,30 +233,7 @@ def labels_attach_to_the_active_volume():
     assert np.abs(_f12(scene, "attach_off") - plain).max() < 0.02
 
 
-class _Layout:
-    """Stands in for a UILayout (its rows, columns and boxes are itself):
-    `drawn` lists the properties, operators, lists and texts drawn."""
-
-    def __init__(self):
-        self.drawn = []
-
-    def prop(self, data, name, **kw):
-        self.drawn.append(name)
-
-    def operator(self, idname, **kw):
-        self.drawn.append(idname)
-        return types.SimpleNamespace()
-
-    def label(self, text="", **kw):
-        self.drawn.append(text)
-
-    def template_list(self, list_type, *args, **kw):
-        self.drawn.append(list_type)
-
-    def row(self, **kw):
-        return self
-
-    column = box = row
+_Layout = u.Layout  # a stand-in UILayout that lists what a panel draws
 
 
 def _draw_panel(ob):

@@ -50,7 +50,9 @@ def test_info_level_channel_time_and_affine(tmp_path):
     lines = r.stdout.splitlines()
     row = lines.index(next(l for l in lines if l.startswith("affine:")))
     affine = np.array([[float(v) for v in l.strip(" []").split()] for l in lines[row + 1:row + 5]])
-    assert np.allclose(affine, [[0.25, 0, 0, 30], [0, 0.5, 0, 20], [0, 0, 2, 10], [0, 0, 0, 1]])
+    # the store's micrometers in mm
+    mm = np.diag([1e-3, 1e-3, 1e-3, 1]) @ [[0.25, 0, 0, 30], [0, 0.5, 0, 20], [0, 0, 2, 10], [0, 0, 0, 1]]
+    assert np.allclose(affine, mm, rtol=1e-6, atol=1e-12)
     r = run("info", str(store) + "#level=1&c=1", "--frame", "2")
     assert r.returncode == 0, r.stderr
     assert field(r.stdout, "dimensions") == "6 x 5 x 4"

@@ -6,7 +6,9 @@
  *   4     one stored chunk: bytes 1..6 give the codec, dtype, byte order and
  *         chunk shape (1..8 per axis), the rest is the chunk, decoded;
  *   5     a whole Zarr v2 store: .zattrs NUL .zarray NUL chunk 0.0.0, written
- *         to a folder and read by vxl_zarr_read under the fuzz limits.
+ *         to a folder and read by vxl_zarr_read under the fuzz limits, then
+ *         opened as a brick source (zarr_source.c: its level choice, value
+ *         range and chunk-by-chunk index) and every small level read.
  * Seeds: tests/fuzz/zarr_seeds.py. */
 #include <sys/stat.h>
 
@@ -21,6 +23,27 @@ static void write_file(const char *path, const uint8_t *p, size_t n)
     if (!f) abort();
     if (n && fwrite(p, 1, n, f) != n) abort();
     fclose(f);
+}
+
+/* The store as a brick source: open (index pass), then every level whose
+ * voxels are few enough to read whole here. */
+static void stream_store(const char *root)
+{
+    vxl_brick_source *s = NULL;
+    vxl_zarr_source_info info;
+    vxl_err e = {0};
+    int rc = vxl_zarr_open_source(root, &vxl_fuzz_options, &s, &info, &e);
+    if ((rc == VXL_OK) != (s != NULL) || (rc && !e.msg[0])) abort();
+    for (uint32_t k = 0; s && k < s->n_levels; k++) {
+        const uint32_t *d = s->level_dims[k], lo[3] = {0, 0, 0};
+        const uint64_t n = (uint64_t)d[0] * d[1] * d[2];
+        if (n > (1u << 20)) continue;
+        void *buf = malloc((size_t)n * (s->texture_bits / 8));
+        if (!buf) abort();
+        if (s->ops->read(s, k, lo, d, buf, &e) && !e.msg[0]) abort();
+        free(buf);
+    }
+    vxl_brick_source_free(s);
 }
 
 static void whole_store(const uint8_t *data, size_t size)
@@ -46,6 +69,7 @@ static void whole_store(const uint8_t *data, size_t size)
     int rc = vxl_zarr_read(root, &vxl_fuzz_options, &v, &e);
     if ((rc == VXL_OK) != (v != NULL) || (rc && !e.msg[0])) abort();
     vxl_volume_destroy(v);
+    stream_store(root);
     snprintf(p, sizeof p, "%s/0/0.0.0", root);
     unlink(p);
     snprintf(p, sizeof p, "%s/0/.zarray", root);
@@ -73,7 +97,9 @@ static void one_chunk(const uint8_t *data, size_t size)
     void *out = malloc((size_t)nbytes);
     if (!out) abort();
     vxl_err e = {0};
-    if (vxl_zarr_decode(&a, data + 6, size - 6, out, nbytes, "chunk", &e) && !e.msg[0]) abort();
+    static vxl_zarr_codecs *codecs; /* one table for the run: libzstd/libblosc opened once */
+    if (!codecs && !(codecs = vxl_zarr_codecs_new())) abort();
+    if (vxl_zarr_decode(&a, codecs, data + 6, size - 6, out, nbytes, "chunk", &e) && !e.msg[0]) abort();
     free(out);
 }
 

@@ -24,7 +24,7 @@ replay_only=0
 [ "$secs" = replay ] && replay_only=1
 targets=("$@")
 # vdb fuzzes in fork mode: see fuzz_contained_vdb below.
-[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom vdb label_table zarr)
+[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom vdb label_table zarr brick_cache)
 
 # The corpus first: every target needs at least one input to replay (dot
 # files such as .keep do not count).
@@ -52,6 +52,10 @@ if [ $replay_only -eq 0 ]; then
     build/fuzz/make_seeds build/fuzz/seeds || { echo "fuzz: seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
     /usr/bin/python3 tests/fuzz/vdb_seeds.py build/fuzz/seeds/vdb || { echo "fuzz: vdb seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
     /usr/bin/python3 tests/fuzz/zarr_seeds.py build/fuzz/seeds/zarr || { echo "fuzz: zarr seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
+    # brick caches of .nii.gz files, written by the cache's own test (the format's one writer)
+    rm -rf build/fuzz/seeds/brick_cache
+    { make -s -j"$(nproc)" build/tests/test_brick_cache && build/tests/test_brick_cache --write-seeds build/fuzz/seeds/brick_cache; } ||
+        { echo "fuzz: brick cache seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
 fi
 
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

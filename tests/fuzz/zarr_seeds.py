@@ -33,6 +33,22 @@ def main(out):
                     store = ((one / ".zattrs").read_bytes() + b"\0" + (one / "0" / ".zarray").read_bytes() + b"\0"
                              + (one / "0" / "0.0.0").read_bytes())
                     (out / f"store_{codec}").write_bytes(bytes([5]) + store)
+    # a group with an omero window per channel and axes in other units (the
+    # streamed source's value range and the mm conversion), and a float
+    # store whose source normalises over that window
+    omero = (b'{"multiscales": [{"version": "0.4", "axes": [{"name": "c", "type": "channel"}, '
+             b'{"name": "z", "type": "space", "unit": "nanometer"}, {"name": "y", "type": "space", "unit": "inch"}, '
+             b'{"name": "x", "type": "space", "unit": "parsec"}], "datasets": [{"path": "0", '
+             b'"coordinateTransformations": [{"type": "scale", "scale": [1, 2, 3, 4]}]}]}], '
+             b'"omero": {"channels": [{"window": {"min": -5, "max": 7.5}}, {"window": {"start": 1, "end": 0}}]}}')
+    (out / "group_v2_omero_units").write_bytes(bytes([0]) + omero)
+    with tempfile.TemporaryDirectory() as tmp:
+        f = (np.arange(24, dtype=np.float32) - 7).reshape(2, 3, 4)
+        one = write_store(Path(tmp) / "float", [f], "zyx", 2, "zlib", [2, 3, 4], ".")
+        window = b', "omero": {"channels": [{"window": {"min": -3, "max": 9}}]}}'
+        attrs = (one / ".zattrs").read_bytes().rstrip(b"}") + window
+        store = attrs + b"\0" + (one / "0" / ".zarray").read_bytes() + b"\0" + (one / "0" / "0.0.0").read_bytes()
+        (out / "store_float_window").write_bytes(bytes([5]) + store)
     # single chunks: codec, dtype, byte order, shape 2x3x4
     for ci, codec in enumerate(CODECS):
         for di, dt in enumerate(DTYPES):

@@ -369,11 +369,13 @@ def test_render_params_tail_matches_header():
     import ctypes
     P = native.RenderParams
     assert P.shading_model.offset + 4 == 624
-    # 688 bytes up to the reserved room's end; issue 20 appended a pointer
-    assert P.labels.offset == 688 and ctypes.sizeof(P) == 696
+    # 688 bytes up to the reserved room's end; issue 20 appended the labels'
+    # pointer, then overlay_count and (issue 21) progressive before the
+    # overlays' pointer, which keeps it on its 8-byte alignment
+    assert P.labels.offset == 688 and P.overlays.offset == 704 and ctypes.sizeof(P) == 712
     assert P.labels.offset == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
-    names = [n for n, _t in P._fields_][-19:]
+    names = [n for n, _t in P._fields_][-22:-3]
     assert names == ["preint_size", "gradient_opacity", "gradient_ref", "gradient_exp",
                      "iso_value", "iso_thickness", "shading_model", "light_shapes",
                      "ambient_occlusion", "occlusion_strength", "anisotropy", "illumination_size",

@@ -1,0 +1,526 @@
+/* brick_cache_write.c - streams a gzip-compressed source once into a
+ * bricked cache (brick_cache.h, format in brick_cache_format.h).
+ *
+ * Memory stays bounded by a slab of `brick` slices per level (the slab of
+ * level k+1 is a quarter of level k's), one slice of raw values and the
+ * index, never the volume: slices are converted to texels exactly as
+ * vxl_volume_build converts a whole volume, a full slab is cut into bricks
+ * and written, then averaged 2x2x2 into the next level's slab exactly as
+ * vxl_volume_downsample2 averages a whole level.
+ *
+ * 32-bit and 64-bit types are normalised by the volume's finite range, which
+ * is only known at the end: for them a first pass inflates the file for the
+ * range alone, and the second writes. The cache then holds final texels, so
+ * reading it is decompression only, and its pyramid and index are those of
+ * the normalised volume, bit for bit. 8- and 16-bit types need no range and
+ * take one pass.
+ *
+ * The file is written under a temporary name in the cache's folder, synced
+ * and renamed into place; a failure or a cancel unlinks it. */
+#define _FILE_OFFSET_BITS 64
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include "brick_cache.h"
+#include "brick_cache_format.h"
+#include "brick_levels.h"
+
+#define GZ_CHUNK (1u << 30) /* gzread takes an unsigned and returns an int */
+
+typedef struct slab {
+    uint8_t *buf;        /* `brick` slices of the level */
+    uint32_t z0, filled; /* first slice held, slices held */
+} slab;
+
+typedef struct writer {
+    const vxl_raw_layout *l;
+    const vxl_load_options *opt;
+    vxl_err *e;
+    vxl_cache_grid g;
+    vxl_cache_header h;
+    uint32_t tb;          /* texel bytes */
+    slab lv[VXL_SOURCE_MAX_LEVELS];
+    vxl_cache_entry *table;
+    uint8_t *brick_buf, *zbuf;
+    uLong zcap;
+    FILE *f;
+    uint64_t pos;
+    /* raw slice and its values */
+    uint8_t *raw;
+    double *row;
+    vxl_index_build index; /* built slice by slice (brick_source.h) */
+    double inv;           /* 32-bit texels: 1 / span of the range */
+    /* progress */
+    double frac0, fracw;
+    const char *stage;
+} writer;
+
+static int fail_io(writer *w, const char *what)
+{
+    return vxl_fail(w->e, VXL_ERR_IO, "writing the brick cache of %s: %s: %s", w->l->path, what, strerror(errno));
+}
+
+static int report(writer *w, double done)
+{
+    return vxl_source_progress(w->opt, w->frac0 + w->fracw * done, w->stage, w->e);
+}
+
+/* ---------------------------------------------------------- the source */
+
+static int open_source(writer *w, gzFile *gz)
+{
+    *gz = gzopen(w->l->path, "rb");
+    if (!*gz) return vxl_fail(w->e, VXL_ERR_IO, "cannot open %s: %s", w->l->path, strerror(errno));
+    gzbuffer(*gz, 1u << 18);
+    /* skip to the chosen frame (gzseek inflates forward) */
+    if (w->l->offset && gzseek(*gz, (z_off_t)w->l->offset, SEEK_SET) != (z_off_t)w->l->offset) {
+        gzclose(*gz);
+        *gz = NULL;
+        return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends before its voxels (offset %llu)", w->l->path,
+                        (unsigned long long)w->l->offset);
+    }
+    return VXL_OK;
+}
+
+static int read_slice(writer *w, gzFile gz, uint32_t z, size_t bytes)
+{
+    size_t got = 0;
+    while (got < bytes) {
+        unsigned want = bytes - got > GZ_CHUNK ? GZ_CHUNK : (unsigned)(bytes - got);
+        int r = gzread(gz, w->raw + got, want);
+        if (r <= 0) {
+            int zerr = 0;
+            const char *msg = gzerror(gz, &zerr);
+            if (r < 0 || zerr)
+                return vxl_fail(w->e, VXL_ERR_FORMAT, "%s: the compressed stream is damaged at slice %u: %s",
+                                w->l->path, z, msg);
+            return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends at slice %u of %u: the file is shorter than its header says",
+                            w->l->path, z, w->l->dims[2]);
+        }
+        got += (size_t)r;
+    }
+    if (w->l->swap) {
+        const uint32_t n = vxl_dtype_size(w->l->dtype);
+        for (size_t i = 0; i < bytes; i += n)
+            for (uint32_t a = 0; a < n / 2; a++) {
+                uint8_t t = w->raw[i + a];
+                w->raw[i + a] = w->raw[i + n - 1 - a];
+                w->raw[i + n - 1 - a] = t;
+            }
+    }
+    return VXL_OK;
+}
+
+/* Raw values of row y of the slice, as doubles (vxl_volume_build's raw_value). */
+static void row_values(const writer *w, uint32_t y, double *out)
+{
+    const uint32_t nx = w->l->dims[0];
+    const size_t i0 = (size_t)y * nx;
+    switch (w->l->dtype) {
+#define ROW(T) for (uint32_t x = 0; x < nx; x++) { T v; memcpy(&v, w->raw + (i0 + x) * sizeof(T), sizeof v); out[x] = v; } break
+    case VXL_DTYPE_U8: ROW(uint8_t);
+    case VXL_DTYPE_I8: ROW(int8_t);
+    case VXL_DTYPE_U16: ROW(uint16_t);
+    case VXL_DTYPE_I16: ROW(int16_t);
+    case VXL_DTYPE_U32: ROW(uint32_t);
+    case VXL_DTYPE_I32: ROW(int32_t);
+    case VXL_DTYPE_F32: ROW(float);
+    default: ROW(double);
+#undef ROW
+    }
+}
+
+/* The finite range and the NaN/Inf counts of one slice, into the header. */
+static void slice_range(writer *w)
+{
+    const double slope = w->h.slope, inter = w->h.inter;
+    for (uint32_t y = 0; y < w->l->dims[1]; y++) {
+        row_values(w, y, w->row);
+        for (uint32_t x = 0; x < w->l->dims[0]; x++) {
+            double v = w->row[x] * slope + inter;
+            if (isnan(v)) w->h.nan_count++;
+            else if (isinf(v)) w->h.inf_count++;
+            else {
+                if (v < w->h.value_min) w->h.value_min = v;
+                if (v > w->h.value_max) w->h.value_max = v;
+            }
+        }
+    }
+}
+
+/* 8- and 16-bit types: the texel is the code raw - type minimum (exact, as
+ * vxl_volume_build stores it), a copy or a flip of the sign bit, done in
+ * typed loops since this runs over every voxel. The slice's value range
+ * comes from its lowest and highest code: raw * slope + inter is monotone
+ * in raw (rounding included), so they give the same range and NaN/Inf
+ * counts as a pass over every voxel, unless an end overflows, where that
+ * pass is taken. */
+static void int_slice_texels(writer *w, uint8_t *dst)
+{
+    const size_t n = (size_t)w->l->dims[0] * w->l->dims[1];
+    const uint32_t dt = w->l->dtype;
+    uint32_t lo = UINT32_MAX, hi = 0;
+    if (w->tb == 1) {
+        const uint8_t flip = dt == VXL_DTYPE_I8 ? 0x80 : 0;
+        uint8_t a = 0xff, b = 0;
+        for (size_t i = 0; i < n; i++) {
+            const uint8_t t = w->raw[i] ^ flip;
+            dst[i] = t;
+            a = t < a ? t : a;
+            b = t > b ? t : b;
+        }
+        lo = a, hi = b;
+    } else {
+        const uint16_t flip = dt == VXL_DTYPE_I16 ? 0x8000 : 0;
+        const uint16_t *r = (const uint16_t *)w->raw;
+        uint16_t *d = (uint16_t *)dst, a = 0xffff, b = 0;
+        for (size_t i = 0; i < n; i++) {
+            const uint16_t t = r[i] ^ flip;
+            d[i] = t;
+            a = t < a ? t : a;
+            b = t > b ? t : b;
+        }
+        lo = a, hi = b;
+    }
+    const double t0 = dt == VXL_DTYPE_I8 ? -128 : dt == VXL_DTYPE_I16 ? -32768 : 0;
+    const double va = (lo + t0) * w->h.slope + w->h.inter, vb = (hi + t0) * w->h.slope + w->h.inter;
+    if (!isfinite(va) || !isfinite(vb)) {
+        slice_range(w);
+        return;
+    }
+    const double mn = va < vb ? va : vb, mx = va < vb ? vb : va;
+    if (mn < w->h.value_min) w->h.value_min = mn;
+    if (mx > w->h.value_max) w->h.value_max = mx;
+}
+
+/* Texels of the slice (raw values already read) into slot `slot` of level
+ * 0's slab; for 8/16-bit types the range too. */
+static void slice_texels(writer *w, uint32_t slot)
+{
+    const uint32_t nx = w->l->dims[0], ny = w->l->dims[1];
+    uint8_t *dst = w->lv[0].buf + (size_t)slot * nx * ny * w->tb;
+    if (w->tb < 4) {
+        int_slice_texels(w, dst);
+        return;
+    }
+    const double lo = w->h.value_min, hi = w->h.value_max;
+    float *d = (float *)dst;
+    for (uint32_t y = 0; y < ny; y++) {
+        row_values(w, y, w->row);
+        const size_t i0 = (size_t)y * nx;
+        for (uint32_t x = 0; x < nx; x++) {
+            double v = w->row[x] * w->h.slope + w->h.inter;
+            if (isnan(v)) v = lo;
+            else if (v > hi) v = hi;
+            else if (v < lo) v = lo;
+            double s = (v - lo) * w->inv;
+            d[i0 + x] = (float)(s < 0 ? 0 : s > 1 ? 1 : s);
+        }
+    }
+}
+
+/* ---------------------------------------------------------- the bricks */
+
+static int write_bytes(writer *w, const void *p, size_t n)
+{
+    if (n && fwrite(p, 1, n, w->f) != n) return fail_io(w, "write");
+    w->pos += n;
+    return VXL_OK;
+}
+
+/* Stores brick_buf (n texels) as brick `id`: one value when constant, zlib
+ * when that shrinks it, else raw. */
+static int store_brick(writer *w, uint64_t id, size_t n)
+{
+    const size_t bytes = n * w->tb;
+    vxl_cache_entry *en = &w->table[id];
+    const uint8_t *data = w->brick_buf;
+    /* every texel equals the one before it: one value */
+    if (memcmp(w->brick_buf, w->brick_buf + w->tb, bytes - w->tb) == 0) {
+        en->kind = VXL_CACHE_CONSTANT;
+        en->size = w->tb;
+    } else {
+        uLongf zlen = w->zcap;
+        if (compress2(w->zbuf, &zlen, w->brick_buf, (uLong)bytes, Z_BEST_SPEED) == Z_OK && zlen < bytes) {
+            en->kind = VXL_CACHE_ZLIB;
+            en->size = (uint32_t)zlen;
+            data = w->zbuf;
+        } else {
+            en->kind = VXL_CACHE_RAW;
+            en->size = (uint32_t)bytes;
+        }
+    }
+    en->offset = w->pos;
+    en->crc = (uint32_t)crc32(crc32(0L, Z_NULL, 0), data, en->size);
+    return write_bytes(w, data, en->size);
+}
+
+static int push_slice(writer *w, uint32_t level);
+
+/* Averages level L's slice pair (2z, 2z+1, the last repeated at an odd
+ * end) of its slab into the next level's slab, as vxl_volume_downsample2
+ * averages a whole level (brick_levels.h). */
+static void downsample_slice(writer *w, uint32_t L, uint32_t z)
+{
+    const uint32_t *d = w->g.dims[L], *o = w->g.dims[L + 1];
+    const size_t plane = (size_t)d[0] * d[1] * w->tb;
+    const uint32_t za = 2 * z - w->lv[L].z0, zb = (2 * z + 1 < d[2] ? 2 * z + 1 : d[2] - 1) - w->lv[L].z0;
+    vxl_downsample2_slice(w->tb * 8, w->lv[L].buf + za * plane, w->lv[L].buf + zb * plane, d[0], d[1],
+                          w->lv[L + 1].buf + (size_t)(z - w->lv[L + 1].z0) * o[0] * o[1] * w->tb);
+}
+
+/* Level L's slab is full (or the level ends): cut it into bricks, write
+ * them, average it into level L+1. */
+static int flush_slab(writer *w, uint32_t L)
+{
+    slab *sl = &w->lv[L];
+    const uint32_t *d = w->g.dims[L], *nb = w->g.bricks[L], B = w->g.brick;
+    const uint32_t bz = sl->z0 / B;
+    for (uint32_t by = 0; by < nb[1]; by++)
+        for (uint32_t bx = 0; bx < nb[0]; bx++) {
+            const uint32_t x0 = bx * B, y0 = by * B;
+            const uint32_t sx = d[0] - x0 < B ? d[0] - x0 : B, sy = d[1] - y0 < B ? d[1] - y0 : B;
+            uint8_t *p = w->brick_buf;
+            for (uint32_t z = 0; z < sl->filled; z++)
+                for (uint32_t y = 0; y < sy; y++) {
+                    size_t row = (size_t)sx * w->tb;
+                    memcpy(p, sl->buf + ((size_t)z * d[1] * d[0] + (size_t)(y0 + y) * d[0] + x0) * w->tb, row);
+                    p += row;
+                }
+            int rc = store_brick(w, w->g.first[L] + bx + (uint64_t)nb[0] * (by + (uint64_t)nb[1] * bz),
+                                 (size_t)sx * sy * sl->filled);
+            if (rc) return rc;
+        }
+    if (L + 1 < w->g.n_levels) {
+        for (uint32_t z = sl->z0 / 2; z <= (sl->z0 + sl->filled - 1) / 2; z++) {
+            downsample_slice(w, L, z);
+            int rc = push_slice(w, L + 1);
+            if (rc) return rc;
+        }
+    }
+    sl->z0 += sl->filled;
+    sl->filled = 0;
+    return VXL_OK;
+}
+
+/* A slice was written at the end of level L's slab: flush when full. */
+static int push_slice(writer *w, uint32_t L)
+{
+    slab *sl = &w->lv[L];
+    sl->filled++;
+    if (sl->filled == w->g.brick || sl->z0 + sl->filled == w->g.dims[L][2]) return flush_slab(w, L);
+    return VXL_OK;
+}
+
+/* ------------------------------------------------------------ the passes */
+
+static int range_pass(writer *w, size_t slice_bytes)
+{
+    gzFile gz;
+    int rc = open_source(w, &gz);
+    w->stage = "reading the value range";
+    for (uint32_t z = 0; !rc && z < w->l->dims[2]; z++) {
+        rc = read_slice(w, gz, z, slice_bytes);
+        if (!rc) slice_range(w);
+        if (!rc) rc = report(w, (z + 1.0) / w->l->dims[2]);
+    }
+    if (gz) gzclose(gz);
+    return rc;
+}
+
+static int write_pass(writer *w, size_t slice_bytes)
+{
+    gzFile gz;
+    int rc = open_source(w, &gz);
+    w->stage = "writing the brick cache";
+    const size_t l0_plane = (size_t)w->l->dims[0] * w->l->dims[1] * w->tb;
+    for (uint32_t z = 0; !rc && z < w->l->dims[2]; z++) {
+        rc = read_slice(w, gz, z, slice_bytes);
+        if (rc) break;
+        slice_texels(w, w->lv[0].filled);
+        vxl_index_build_slice(&w->index, z, w->lv[0].buf + (size_t)w->lv[0].filled * l0_plane);
+        rc = push_slice(w, 0);
+        if (!rc) rc = report(w, (z + 1.0) / w->l->dims[2]);
+    }
+    if (gz) gzclose(gz);
+    return rc;
+}
+
+/* Index, table and header after the bricks, then sync. */
+static int finish(writer *w)
+{
+    vxl_cache_header *h = &w->h;
+    const uLong crc0 = crc32(0L, Z_NULL, 0);
+    h->index_offset = w->pos;
+    h->index_bytes = w->g.index_count * 8;
+    h->index_crc = (uint32_t)crc32(crc0, (const Bytef *)w->index.minmax, (uInt)h->index_bytes);
+    int rc = write_bytes(w, w->index.minmax, h->index_bytes);
+    h->table_offset = w->pos;
+    h->table_bytes = h->brick_count * VXL_CACHE_ENTRY_BYTES;
+    uLong crc = crc0;
+    for (uint64_t i = 0; !rc && i < h->brick_count; i++) {
+        uint8_t en[VXL_CACHE_ENTRY_BYTES];
+        vxl_cache_entry_encode(&w->table[i], en);
+        crc = crc32(crc, en, VXL_CACHE_ENTRY_BYTES);
+        rc = write_bytes(w, en, VXL_CACHE_ENTRY_BYTES);
+    }
+    if (rc) return rc;
+    h->table_crc = (uint32_t)crc;
+    uint8_t head[VXL_CACHE_HEADER_BYTES];
+    vxl_cache_header_encode(h, head);
+    if (fflush(w->f) != 0 || fseeko(w->f, 0, SEEK_SET) != 0) return fail_io(w, "seek");
+    if (fwrite(head, 1, sizeof head, w->f) != sizeof head || fflush(w->f) != 0) return fail_io(w, "write");
+    if (fsync(fileno(w->f)) != 0) return fail_io(w, "fsync");
+    return VXL_OK;
+}
+
+/* ---------------------------------------------------------- the layout */
+
+/* Brick edge and level count for this volume under the tuning. */
+static int plan(writer *w, const vxl_brick_cache_tuning *t)
+{
+    const vxl_raw_layout *l = w->l;
+    const uint32_t bits = vxl_texture_bits_for(l->dtype);
+    w->tb = bits / 8;
+    const uint64_t plane = (uint64_t)l->dims[0] * l->dims[1] * w->tb;
+    uint32_t B = t->brick;
+    while (B > 8 && B * plane > t->slab_bytes) B /= 2;
+    if (B * plane > 4 * t->slab_bytes)
+        return vxl_fail(w->e, VXL_ERR_LIMIT,
+                        "%s: slices of %ux%u voxels are too large to stream into a brick cache (%llu MiB per %u slices)",
+                        l->path, l->dims[0], l->dims[1], (unsigned long long)(B * plane >> 20), B);
+    uint32_t levels = t->coarsest_bytes ? 1 : vxl_source_level_count(l->dims);
+    while (t->coarsest_bytes) {
+        uint64_t n = w->tb;
+        for (int a = 0; a < 3; a++) n *= ((uint64_t)l->dims[a] + (1ull << (levels - 1)) - 1) >> (levels - 1);
+        if (n <= t->coarsest_bytes || levels == VXL_SOURCE_MAX_LEVELS) break;
+        levels++;
+    }
+    const uint32_t index_brick = vxl_source_index_brick(l->dims);
+    if (vxl_cache_grid_make(l->dims, bits, B, levels, index_brick, &w->g) != 0)
+        return vxl_fail(w->e, VXL_ERR_LIMIT, "%s: %ux%ux%u voxels need too many bricks for a brick cache", l->path,
+                        l->dims[0], l->dims[1], l->dims[2]);
+    vxl_cache_header *h = &w->h;
+    h->src_size = l->file_size;
+    h->src_mtime_ns = l->mtime_ns;
+    h->src_header_hash = l->header_hash;
+    h->src_offset = l->offset;
+    h->src_dtype = l->dtype;
+    h->src_swap = l->swap != 0;
+    h->src_frame = l->frame;
+    memcpy(h->dims, l->dims, sizeof h->dims);
+    h->slope = l->slope;
+    h->inter = l->inter;
+    h->texture_bits = bits;
+    h->brick = B;
+    h->n_levels = levels;
+    h->index_brick = index_brick;
+    h->brick_count = w->g.first[levels];
+    h->value_min = INFINITY;
+    h->value_max = -INFINITY;
+    return VXL_OK;
+}
+
+static int allocate(writer *w)
+{
+    const uint32_t B = w->g.brick;
+    const size_t brick_bytes = (size_t)B * B * B * w->tb;
+    int ok = 1;
+    for (uint32_t L = 0; L < w->g.n_levels; L++)
+        ok &= (w->lv[L].buf = malloc((size_t)B * w->g.dims[L][0] * w->g.dims[L][1] * w->tb)) != NULL;
+    w->table = calloc((size_t)w->g.first[w->g.n_levels], sizeof *w->table);
+    w->brick_buf = malloc(brick_bytes);
+    w->zcap = compressBound((uLong)brick_bytes);
+    w->zbuf = malloc(w->zcap);
+    w->raw = malloc((size_t)w->l->dims[0] * w->l->dims[1] * vxl_dtype_size(w->l->dtype));
+    w->row = malloc((size_t)w->l->dims[0] * sizeof *w->row);
+    if (!ok || !w->table || !w->brick_buf || !w->zbuf || !w->raw || !w->row)
+        return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "out of memory for the brick cache writer of %s", w->l->path);
+    return vxl_index_build_begin(&w->index, w->l->dims, w->tb * 8, w->h.index_brick, w->e);
+}
+
+static void release(writer *w)
+{
+    for (uint32_t L = 0; L < VXL_SOURCE_MAX_LEVELS; L++) free(w->lv[L].buf);
+    free(w->table);
+    free(w->brick_buf);
+    free(w->zbuf);
+    free(w->raw);
+    free(w->row);
+    vxl_index_build_free(&w->index);
+}
+
+/* The range the texels are normalised by, as vxl_volume_build sets it. */
+static void settle_range(writer *w)
+{
+    vxl_cache_header *h = &w->h;
+    if (!(h->value_min <= h->value_max)) h->value_min = h->value_max = 0.0;
+    if (w->tb < 4) {
+        const double t0 = (w->l->dtype == VXL_DTYPE_I8 ? -128 : w->l->dtype == VXL_DTYPE_I16 ? -32768 : 0);
+        const double span = w->tb == 1 ? 255 : 65535;
+        h->tex_lo = t0 * h->slope + h->inter;
+        h->tex_hi = (t0 + span) * h->slope + h->inter;
+    } else {
+        const double span = h->value_max - h->value_min;
+        h->tex_lo = h->value_min;
+        h->tex_hi = span > 0 ? h->value_max : h->value_min + 1.0;
+        w->inv = span > 0 ? 1.0 / span : 0.0;
+    }
+}
+
+int vxl_brick_cache_write(const vxl_raw_layout *l, const vxl_load_options *opt, const vxl_brick_cache_tuning *t,
+                          const char *cache_path, vxl_err *e)
+{
+    writer w;
+    memset(&w, 0, sizeof w);
+    w.l = l;
+    w.opt = opt;
+    w.e = e;
+    int rc = plan(&w, t);
+    if (!rc) rc = allocate(&w);
+    if (rc) {
+        release(&w);
+        return rc;
+    }
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.tmp-XXXXXX", cache_path);
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        rc = vxl_fail(e, VXL_ERR_IO, "cannot create the brick cache %s: %s", tmp, strerror(errno));
+        release(&w);
+        return rc;
+    }
+    fchmod(fd, 0644);
+    w.f = fdopen(fd, "wb");
+    if (!w.f) {
+        rc = fail_io(&w, "fdopen");
+        close(fd);
+    } else {
+        setvbuf(w.f, NULL, _IOFBF, 1u << 20);
+        static const uint8_t zero[VXL_CACHE_HEADER_BYTES];
+        rc = write_bytes(&w, zero, sizeof zero); /* the header, written last */
+        const size_t slice_bytes = (size_t)l->dims[0] * l->dims[1] * vxl_dtype_size(l->dtype);
+        const int ranged = w.tb == 4;
+        w.fracw = ranged ? 0.5 : 1.0;
+        if (!rc) rc = report(&w, 0);
+        if (!rc && ranged) rc = range_pass(&w, slice_bytes);
+        if (!rc) settle_range(&w);
+        w.frac0 = ranged ? 0.5 : 0.0;
+        if (!rc) rc = write_pass(&w, slice_bytes);
+        if (!rc && !ranged) settle_range(&w);
+        if (!rc) rc = finish(&w);
+        if (fclose(w.f) != 0 && !rc) rc = fail_io(&w, "close");
+    }
+    if (!rc && rename(tmp, cache_path) != 0) rc = vxl_fail(e, VXL_ERR_IO, "cannot rename %s to %s: %s", tmp, cache_path, strerror(errno));
+    if (rc) unlink(tmp); /* never a half cache */
+    release(&w);
+    return rc;
+}

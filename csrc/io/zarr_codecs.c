@@ -1,0 +1,120 @@
+/* zarr_codecs.c - libzstd and libblosc opened on demand (zarr.h).
+ *
+ * libvoxlight.so links only the C runtime (it loads inside Blender), so the
+ * two decoders Zarr chunks may need are opened by SONAME with dlopen the
+ * first time a chunk compressed with them is met, and their few functions
+ * are looked up on that handle (RTLD_LOCAL: nothing of theirs is added to
+ * the process' global namespace, and dlsym on the handle binds to that very
+ * library, not to another copy Blender may carry). A missing library fails
+ * that chunk with a message naming the library, the codec and the Debian
+ * package; stores with gzip/zlib or raw chunks never open either library.
+ * The function types come from the libraries' own headers (__typeof__), so
+ * a signature slip is a compile error, yet nothing of them is linked.
+ * VOXLIGHT_ZARR_LIBZSTD / VOXLIGHT_ZARR_LIBBLOSC name other files to open
+ * (the tests name a missing one to see the message). */
+#include <dlfcn.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "zarr_codecs.h"
+
+struct vxl_zarr_codecs {
+    pthread_mutex_t lock; /* the first use of a library, from any reader thread */
+    void *zstd, *blosc;   /* dlopen handles; NULL until needed */
+    vxl_zstd_api zstd_api;
+    vxl_blosc_api blosc_api;
+};
+
+vxl_zarr_codecs *vxl_zarr_codecs_new(void)
+{
+    vxl_zarr_codecs *c = calloc(1, sizeof *c);
+    if (c && pthread_mutex_init(&c->lock, NULL)) {
+        free(c);
+        return NULL;
+    }
+    return c;
+}
+
+void vxl_zarr_codecs_free(vxl_zarr_codecs *c)
+{
+    if (!c) return;
+    if (c->zstd) dlclose(c->zstd);
+    if (c->blosc) dlclose(c->blosc);
+    pthread_mutex_destroy(&c->lock);
+    free(c);
+}
+
+static const char *library(const char *soname, const char *env)
+{
+    const char *o = getenv(env);
+    return o && *o ? o : soname;
+}
+
+/* One library: its SONAME, the variable that overrides it, what it
+ * decodes, its package, and the functions to look up into its table. */
+typedef struct codec_library {
+    const char *soname, *env, *codec, *package;
+    const char *const *symbols;
+    size_t count;
+} codec_library;
+
+static const char *const zstd_symbols[] = {"ZSTD_getFrameContentSize", "ZSTD_decompress", "ZSTD_isError",
+                                           "ZSTD_getErrorCode", "ZSTD_getErrorName"};
+static const char *const blosc_symbols[] = {"blosc_cbuffer_validate", "blosc_cbuffer_sizes", "blosc_decompress_ctx"};
+static const codec_library zstd_library = {VXL_ZSTD_SO, "VOXLIGHT_ZARR_LIBZSTD", "zstd", "libzstd1", zstd_symbols,
+                                           sizeof zstd_symbols / sizeof zstd_symbols[0]};
+static const codec_library blosc_library = {VXL_BLOSC_SO, "VOXLIGHT_ZARR_LIBBLOSC", "blosc", "libblosc1",
+                                            blosc_symbols, sizeof blosc_symbols / sizeof blosc_symbols[0]};
+
+/* Opens lib into *handle and fills table (lib->count function pointers, in
+ * the order of lib->symbols) on the first call; under c->lock. The cast of
+ * dlsym's void * to a function pointer is what POSIX guarantees. */
+static int open_library(vxl_zarr_codecs *c, const codec_library *lib, void **handle, void (**table)(void),
+                        const char *chunk, vxl_err *e)
+{
+    pthread_mutex_lock(&c->lock);
+    if (*handle) {
+        pthread_mutex_unlock(&c->lock);
+        return VXL_OK;
+    }
+    const char *so = library(lib->soname, lib->env);
+    void *h = dlopen(so, RTLD_NOW | RTLD_LOCAL);
+    char why[256];
+    snprintf(why, sizeof why, "%s", h ? "a function is missing" : dlerror());
+    for (size_t i = 0; h && i < lib->count; i++) {
+        void *p = dlsym(h, lib->symbols[i]);
+        if (!p) {
+            snprintf(why, sizeof why, "%s lacks %s", so, lib->symbols[i]);
+            dlclose(h);
+            h = NULL;
+        } else {
+            memcpy(&table[i], &p, sizeof p);
+        }
+    }
+    *handle = h;
+    pthread_mutex_unlock(&c->lock);
+    if (!h)
+        return vxl_fail(e, VXL_ERR_IO, "'%s': a %s-compressed chunk needs %s, which cannot be loaded (%s): apt-get "
+                        "install %s", chunk, lib->codec, so, why, lib->package);
+    return VXL_OK;
+}
+
+int vxl_zarr_zstd(vxl_zarr_codecs *c, const char *chunk, const vxl_zstd_api **api, vxl_err *e)
+{
+    _Static_assert(sizeof(vxl_zstd_api) == sizeof zstd_symbols / sizeof zstd_symbols[0] * sizeof(void (*)(void)),
+                   "one pointer per symbol");
+    int rc = open_library(c, &zstd_library, &c->zstd, (void (**)(void))&c->zstd_api, chunk, e);
+    *api = &c->zstd_api;
+    return rc;
+}
+
+int vxl_zarr_blosc(vxl_zarr_codecs *c, const char *chunk, const vxl_blosc_api **api, vxl_err *e)
+{
+    _Static_assert(sizeof(vxl_blosc_api) == sizeof blosc_symbols / sizeof blosc_symbols[0] * sizeof(void (*)(void)),
+                   "one pointer per symbol");
+    int rc = open_library(c, &blosc_library, &c->blosc, (void (**)(void))&c->blosc_api, chunk, e);
+    *api = &c->blosc_api;
+    return rc;
+}

@@ -325,8 +325,8 @@ static int push_slice(writer *w, uint32_t L)
 static int range_pass(writer *w, size_t slice_bytes)
 {
     gzFile gz;
+    w->stage = "reading the value range"; /* before open_source, which reports too */
     int rc = open_source(w, &gz);
-    w->stage = "reading the value range";
     for (uint32_t z = 0; !rc && z < w->l->dims[2]; z++) {
         rc = read_slice(w, gz, z, slice_bytes);
         if (!rc) slice_range(w);
@@ -339,8 +339,8 @@ static int range_pass(writer *w, size_t slice_bytes)
 static int write_pass(writer *w, size_t slice_bytes)
 {
     gzFile gz;
-    int rc = open_source(w, &gz);
     w->stage = "writing the brick cache";
+    int rc = open_source(w, &gz);
     const size_t l0_plane = (size_t)w->l->dims[0] * w->l->dims[1] * w->tb;
     for (uint32_t z = 0; !rc && z < w->l->dims[2]; z++) {
         rc = read_slice(w, gz, z, slice_bytes);

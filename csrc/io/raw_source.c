@@ -163,6 +163,7 @@ static const vxl_brick_source_ops raw_ops = {raw_read, raw_close};
 typedef struct slab {
     uint8_t *raw;
     uint8_t *hole;          /* per slice: 1 = no data byte in it */
+    uint8_t *row_data;      /* per row of each slice: 1 = it holds data bytes (0: a hole throughout) */
     uint32_t z0, n;
 } slab;
 
@@ -173,8 +174,10 @@ static int read_slab(vxl_brick_source *s, slab *sb, vxl_err *e)
     const raw_ctx *c = s->ctx;
     const uint64_t slice = (uint64_t)c->l.dims[0] * c->l.dims[1] * c->es;
     const uint64_t start = c->l.offset + slice * sb->z0, end = start + slice * sb->n;
+    const uint64_t row = (uint64_t)c->l.dims[0] * c->es;
     memset(sb->raw, 0, (size_t)(end - start));
     memset(sb->hole, 1, sb->n);
+    memset(sb->row_data, 0, (size_t)sb->n * c->l.dims[1]);
     uint64_t pos = start;
     while (pos < end) {
         off_t data = lseek(c->fd, (off_t)pos, SEEK_DATA);
@@ -187,6 +190,7 @@ static int read_slab(vxl_brick_source *s, slab *sb, vxl_err *e)
         int rc = read_at(s, sb->raw + ((uint64_t)data - start), (size_t)(stop - (uint64_t)data), (uint64_t)data, e);
         if (rc) return rc;
         for (uint64_t z = ((uint64_t)data - start) / slice; z <= (stop - 1 - start) / slice; z++) sb->hole[z] = 0;
+        memset(sb->row_data + ((uint64_t)data - start) / row, 1, (size_t)((stop - 1 - start) / row - ((uint64_t)data - start) / row + 1));
         pos = stop;
     }
     return VXL_OK;
@@ -199,6 +203,7 @@ typedef struct pass {
     const vxl_load_options *opt;
     slab sb;
     uint8_t *texels;        /* one slice */
+    uint8_t *hole_row;      /* one row of the texel a hole stores */
     double mn, mx;
     int any_hole;
     vxl_index_build index;
@@ -217,6 +222,8 @@ static int run_stage(pass *p, int texels, vxl_err *e)
         uint8_t zero[8] = {0}, t[4];
         vxl_texels_from_raw(&c->map, zero, 1, t);
         hole_value = vxl_texel_at(p->s->texture_bits, t, 0);
+        const size_t tb = p->s->texture_bits / 8;
+        for (uint32_t x = 0; x < d[0]; x++) memcpy(p->hole_row + (size_t)x * tb, t, tb);
     }
     for (uint32_t z0 = 0; z0 < d[2]; z0 += per) {
         p->sb.z0 = z0;
@@ -234,13 +241,25 @@ static int run_stage(pass *p, int texels, vxl_err *e)
                 }
                 continue;
             }
-            if (c->l.swap) vxl_swap_elements(raw, n_slice, c->es);
-            if (!texels || p->stages == 1)
-                vxl_raw_range(c->l.dtype, raw, n_slice, c->map.slope, c->map.inter, &p->mn, &p->mx, &c->nan_count,
-                              &c->inf_count);
+            /* Row by row, so the holes inside a slice of a sparse file cost
+             * O(bricks), not O(voxels): the rows without data hold raw zero. */
+            const uint8_t *rows = p->sb.row_data + (size_t)i * d[1];
+            const size_t tb = p->s->texture_bits / 8, row_t = (size_t)d[0] * tb, row_r = (size_t)d[0] * c->es;
+            for (uint32_t y = 0; y < d[1]; y++) {
+                uint8_t *rr = raw + row_r * y;
+                if (!rows[y]) {
+                    p->any_hole = 1;
+                    if (texels) memcpy(p->texels + row_t * y, p->hole_row, row_t);
+                    continue;
+                }
+                if (c->l.swap) vxl_swap_elements(rr, d[0], c->es);
+                if (!texels || p->stages == 1)
+                    vxl_raw_range(c->l.dtype, rr, d[0], c->map.slope, c->map.inter, &p->mn, &p->mx, &c->nan_count,
+                                  &c->inf_count);
+                if (texels) vxl_texels_from_raw(&c->map, rr, d[0], p->texels + row_t * y);
+            }
             if (texels) {
-                vxl_texels_from_raw(&c->map, raw, n_slice, p->texels);
-                vxl_index_build_slice(&p->index, z, p->texels);
+                vxl_index_build_slice_rows(&p->index, z, p->texels, rows, hole_value);
                 vxl_level_build_slice(&p->levels, p->texels, 0, 0);
             }
         }
@@ -279,9 +298,11 @@ static int make_pass(vxl_brick_source *s, const vxl_load_options *opt, vxl_err *
     const uint32_t n = per < d[2] ? per : d[2];
     p.sb.raw = malloc((size_t)(slice * n));
     p.sb.hole = malloc(n);
+    p.sb.row_data = malloc((size_t)n * d[1]);
+    p.hole_row = malloc((size_t)d[0] * (s->texture_bits / 8));
     p.texels = malloc((size_t)d[0] * d[1] * (s->texture_bits / 8));
     int rc = VXL_OK;
-    if (!p.sb.raw || !p.sb.hole || !p.texels)
+    if (!p.sb.raw || !p.sb.hole || !p.sb.row_data || !p.hole_row || !p.texels)
         rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for a slab of %u slices", c->l.path, n);
     if (!rc) rc = vxl_index_build_begin(&p.index, d, s->texture_bits, vxl_source_index_brick(d), e);
     if (!rc)
@@ -308,6 +329,8 @@ static int make_pass(vxl_brick_source *s, const vxl_load_options *opt, vxl_err *
     vxl_level_build_free(&p.levels);
     free(p.sb.raw);
     free(p.sb.hole);
+    free(p.sb.row_data);
+    free(p.hole_row);
     free(p.texels);
     return rc;
 }

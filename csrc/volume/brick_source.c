@@ -66,7 +66,8 @@ int vxl_source_progress(const vxl_load_options *opt, double fraction, const char
     const size_t need = offsetof(vxl_load_options, progress_user) + sizeof opt->progress_user;
     if (!opt || (opt->struct_size && opt->struct_size < need) || !opt->progress) return VXL_OK;
     if (opt->progress(opt->progress_user, fraction < 0 ? 0 : fraction > 1 ? 1 : fraction, stage))
-        return vxl_fail(e, VXL_ERR_CANCELLED, "cancelled by the progress callback during %s", stage);
+        return vxl_fail(e, VXL_ERR_CANCELLED, "cancelled by the progress callback during %s",
+                        stage ? stage : "a long pass");
     return VXL_OK;
 }
 
@@ -144,7 +145,8 @@ static void run_range(uint32_t bits, const void *row, uint32_t x0, uint32_t x1, 
     }
 }
 
-void vxl_index_build_slice(vxl_index_build *b, uint32_t z, const void *texels)
+void vxl_index_build_slice_rows(vxl_index_build *b, uint32_t z, const void *texels, const uint8_t *data,
+                                double value)
 {
     const uint32_t B = b->brick, gx = b->grid[0], w = b->dims[0];
     const size_t layer = (size_t)gx * b->grid[1], bpv = b->texture_bits / 8;
@@ -152,18 +154,24 @@ void vxl_index_build_slice(vxl_index_build *b, uint32_t z, const void *texels)
         b->slice[2 * i] = 1e30f;
         b->slice[2 * i + 1] = -1e30f;
     }
+    const float v = (float)value;
     for (uint32_t y = 0; y < b->dims[1]; y++) {
         const uint8_t *row = (const uint8_t *)texels + (size_t)w * y * bpv;
         uint32_t y0, y1;
         bricks_holding(y, B, b->grid[1], &y0, &y1);
         for (uint32_t bx = 0; bx < gx; bx++) {
             const uint32_t x0 = bx * B > 0 ? bx * B - 1 : 0, x1 = bx * B + B < w ? bx * B + B : w - 1;
-            float lo, hi;
-            run_range(b->texture_bits, row, x0, x1, &lo, &hi);
+            float lo = v, hi = v;
+            if (!data || data[y]) run_range(b->texture_bits, row, x0, x1, &lo, &hi);
             for (uint32_t by = y0; by <= y1; by++) fold(b->slice + 2 * (bx + (size_t)gx * by), lo, hi);
         }
     }
     fold_slice(b, z);
+}
+
+void vxl_index_build_slice(vxl_index_build *b, uint32_t z, const void *texels)
+{
+    vxl_index_build_slice_rows(b, z, texels, NULL, 0);
 }
 
 void vxl_index_build_const(vxl_index_build *b, uint32_t z, double value)

@@ -103,6 +103,11 @@ int vxl_index_build_begin(vxl_index_build *b, const uint32_t dims[3], uint32_t t
                           vxl_err *e);
 /* Slice z: dims[0] x dims[1] texels, x fastest. */
 void vxl_index_build_slice(vxl_index_build *b, uint32_t z, const void *texels);
+/* The same where only the rows y with data[y] != 0 are read: the others
+ * hold `value` throughout (holes of a sparse file), costing O(bricks) per
+ * row instead of O(voxels). */
+void vxl_index_build_slice_rows(vxl_index_build *b, uint32_t z, const void *texels, const uint8_t *data,
+                                double value);
 /* Slice z holds one value throughout (a hole of a sparse file): as
  * vxl_index_build_slice on a slice of that texel, in O(bricks). value: the
  * texel as vxl_index_build reads it (code / (2^bits - 1), or the float). */

@@ -10,7 +10,7 @@ changes only the params, so the library re-uploads a small table."""
 import os
 
 import bpy
-from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatVectorProperty,
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
 from .core import label_runtime, native
@@ -48,6 +48,16 @@ class VoxlightLabel(bpy.types.PropertyGroup):
                                description="Colour; alpha is the opacity")
     visible: BoolProperty(name="Visible", default=True, update=tag_redraw,
                           description="Show this label (hidden labels are not drawn)")
+    use_material: BoolProperty(name="Own Material", default=False, update=tag_redraw,
+                               description="Light this label with its own material instead of the volume's")
+    ambient: FloatProperty(name="Ambient", default=0.3, min=0.0, soft_max=1.0, update=tag_redraw,
+                           description="The label's ambient light")
+    diffuse: FloatProperty(name="Diffuse", default=0.7, min=0.0, soft_max=1.0, update=tag_redraw,
+                           description="The label's diffuse reflection")
+    specular: FloatProperty(name="Specular", default=0.3, min=0.0, soft_max=1.0, update=tag_redraw,
+                            description="The label's specular highlight")
+    shininess: FloatProperty(name="Shininess", default=24.0, min=0.01, soft_max=128.0, update=tag_redraw,
+                             description="How sharp the label's highlight is")
 
 
 class VoxlightLabelSettings(bpy.types.PropertyGroup):
@@ -135,8 +145,15 @@ def look_kwargs(props):
     s = getattr(ob, "voxlight_labels", None)
     if s is None or not s.active_path or not label_runtime.usable(s.active_path):
         return {}
-    return {"labels": (s.mode, [(lab.label_id, tuple(lab.color), bool(lab.visible))
+    return {"labels": (s.mode, [(lab.label_id, tuple(lab.color), bool(lab.visible), label_material(lab))
                                 for lab in s.labels])}
+
+
+def label_material(lab):
+    """The label's own (ambient, diffuse, specular, shininess), or None for the volume's."""
+    if not lab.use_material:
+        return None
+    return (lab.ambient, lab.diffuse, lab.specular, lab.shininess)
 
 
 class VOXLIGHT_OT_load_label_lookup(OnActiveVolume, bpy.types.Operator):

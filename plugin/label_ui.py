@@ -61,6 +61,15 @@ class VOXLIGHT_PT_volume_labels(_VolumePanel, bpy.types.Panel):
         row.operator("voxlight.label_visibility", text="Show All", icon="HIDE_OFF").visible = True
         row.operator("voxlight.label_visibility", text="Hide All", icon="HIDE_ON").visible = False
         layout.label(text="%d of %d labels visible" % (visible_count(s), len(s.labels)))
+        if 0 <= s.active_index < len(s.labels):  # the active label's own material
+            lab = s.labels[s.active_index]
+            box = layout.box()
+            box.use_property_split = True
+            box.prop(lab, "use_material", text="Own Material (%s)" % (lab.name or lab.label_id))
+            col = box.column(align=True)
+            col.active = lab.use_material
+            for name in ("ambient", "diffuse", "specular", "shininess"):
+                col.prop(lab, name)
 
 
 _classes = (VOXLIGHT_UL_labels, VOXLIGHT_PT_volume_labels)

@@ -10,6 +10,7 @@
  * shifted by -15.5 (the grid spans [-16, 16]), seen by an orthographic
  * camera on world +z looking down -z, so pixel (i, j) looks along x = X(i),
  * y = Y(j) and the depth output is EYE_Z - z. */
+#include <stddef.h>
 #include <stdio.h>
 
 #include "harness.h"
@@ -430,6 +431,88 @@ TEST(mask_and_tint_apply_the_transfer_function_inside_visible_labels)
     CHECKF(bad == 0 && inside > 200, "%d bad of %d inside", bad, inside);
 }
 
+/* Each label's own material: on the shaded sphere, a label whose material
+ * is pure ambient (1, 0, 0, 1) renders flat at its colour, while the same
+ * label without one is lit by the frame's material (its pixels vary); in
+ * MASK mode too; an old entry struct (without the fields) and a bad material
+ * behave as documented. */
+TEST(each_label_lit_with_its_own_material)
+{
+    sphere_labels();
+    REQUIRE(set_lab() == VXL_OK);
+    const int w = 64;
+    vxl_label_entry e[1] = {entry(7, 0.8f, 0.4f, 0.2f, 1, 1)};
+    vxl_label_style s = style(VXL_LABEL_MODE_SURFACE, e, 1);
+    vxl_render_params p = scene(w, 12);
+    p.shading_off = 0;
+    p.labels = &s;
+    static const float tf[8] = {1, 1, 1, 1, 1, 1, 1, 1};
+    for (int mode = 0; mode < 2; mode++) {
+        s.mode = mode ? VXL_LABEL_MODE_MASK : VXL_LABEL_MODE_SURFACE;
+        static uint8_t ramp[N * N * N]; /* MASK lights the intensity volume's gradient: give it one */
+        if (mode) {
+            p.tf_rgba = tf;
+            p.tf_size = 2;
+            for (int i = 0; i < N * N * N; i++) ramp[i] = (uint8_t)(4 * (i % N));
+            double a[16];
+            grid_affine(a, 1, 15.5, NULL);
+            vxl_volume *v = make_volume(VXL_DTYPE_U8, ramp, N, a);
+            REQUIRE(v && vxl_renderer_set_volume(R, v) == VXL_OK);
+            vxl_volume_destroy(v);
+        }
+        e[0].has_material = 0;
+        REQUIRE(render(&p, IMG, NULL) == VXL_OK);
+        e[0].has_material = 1;
+        e[0].material[0] = 1;
+        e[0].material[1] = e[0].material[2] = 0;
+        e[0].material[3] = 1;
+        REQUIRE(render(&p, IMG2, NULL) == VXL_OK);
+        const float want[3] = {mode ? 1.0f : 0.8f, mode ? 1.0f : 0.4f, mode ? 1.0f : 0.2f};
+        double lit_lo = 1e9, lit_hi = -1e9, flat_err = 0;
+        int n = 0;
+        for (int i = 0; i < w * w; i++) {
+            const float *a = IMG + 4 * i, *b = IMG2 + 4 * i;
+            if (a[3] < 0.999f || b[3] < 0.999f) continue; /* the sphere's inside, away from its edge */
+            n++;
+            lit_lo = fmin(lit_lo, a[0]);
+            lit_hi = fmax(lit_hi, a[0]);
+            for (int c = 0; c < 3; c++) flat_err = fmax(flat_err, fabs(b[c] - want[c]));
+        }
+        CHECKF(n > 500, "mode %d: %d covered pixels", mode, n);
+        CHECKF(flat_err < 1e-5, "mode %d: the ambient-only label is off its colour by %g", mode, flat_err);
+        if (mode == 0) /* the sphere's normals vary: so does its lit colour */
+            CHECKF(lit_hi - lit_lo > 0.2, "surface: the frame's material lit it from %g to %g", lit_lo, lit_hi);
+        else /* the ramp's normal is across the view: the frame's material leaves mostly its ambient */
+            CHECKF(lit_hi < 0.8, "mask: the frame's material lit it from %g to %g", lit_lo, lit_hi);
+    }
+    {
+        static uint8_t zero[N * N * N];
+        double a[16];
+        grid_affine(a, 1, 15.5, NULL);
+        vxl_volume *v = make_volume(VXL_DTYPE_U8, zero, N, a);
+        REQUIRE(v && vxl_renderer_set_volume(R, v) == VXL_OK);
+        vxl_volume_destroy(v);
+    }
+    /* an entry struct from before the material fields: the frame's material */
+    vxl_label_entry old[1] = {entry(7, 0.8f, 0.4f, 0.2f, 1, 1)};
+    old[0].struct_size = (uint32_t)offsetof(vxl_label_entry, has_material);
+    old[0].has_material = 1; /* beyond its struct_size: not read */
+    s.entries = old;
+    s.mode = VXL_LABEL_MODE_SURFACE;
+    p.tf_rgba = NULL;
+    p.tf_size = 0;
+    REQUIRE(render(&p, IMG2, NULL) == VXL_OK);
+    s.entries = e;
+    e[0].has_material = 0;
+    REQUIRE(render(&p, IMG, NULL) == VXL_OK);
+    CHECK(memcmp(IMG, IMG2, sizeof(float) * 4 * w * w) == 0);
+    /* a bad material is refused with a message naming it */
+    e[0].has_material = 1;
+    e[0].material[3] = 0;
+    CHECK(render(&p, IMG, NULL) == VXL_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(vxl_renderer_error(R), "material") != NULL);
+}
+
 TEST(bad_labels_fail_with_a_message)
 {
     three_boxes();
@@ -683,6 +766,7 @@ int main(void)
     RUN(recolouring_and_hiding_re_upload_only_the_table);
     RUN(two_hundred_fifty_six_labels_across_the_id_range);
     RUN(mask_and_tint_apply_the_transfer_function_inside_visible_labels);
+    RUN(each_label_lit_with_its_own_material);
     RUN(bad_labels_fail_with_a_message);
     RUN(over_the_budget_a_label_volume_is_refused);
     RUN(no_nan_with_labels_in_odd_cameras);

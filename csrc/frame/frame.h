@@ -4,6 +4,7 @@
 #ifndef VXL_FRAME_H
 #define VXL_FRAME_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "bricks.h"
@@ -164,6 +165,13 @@ int vxl_frame_resolve_mode(vxl_frame *f, const vxl_render_params *p, vxl_err *e)
  * intensity volume's occupancy says nothing of the labels'. Part of
  * vxl_frame_resolve (frame_labels.c). */
 int vxl_frame_resolve_labels(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+/* The label's own material (4 floats) of an entry read with `stride`, or
+ * NULL when the entry has none (has_material 0, or a struct from before it). */
+static inline const float *vxl_label_material(const vxl_label_entry *en, uint32_t stride)
+{
+    if (stride < offsetof(vxl_label_entry, material) + sizeof en->material || !en->has_material) return NULL;
+    return en->material;
+}
 
 /* issue 20 overlays: validates p->overlays (count <= VXL_MAX_OVERLAYS, the
  * stride, each slot in range, listed once and set (geoms[slot] non-NULL:

@@ -51,6 +51,16 @@ int vxl_frame_resolve_labels(vxl_frame *f, const vxl_render_params *p, vxl_err *
             break;
         }
         seen[en->id >> 3] |= (uint8_t)(1u << (en->id & 7));
+        const float *m = vxl_label_material(en, stride);
+        if (m && !(m[0] >= 0 && m[1] >= 0 && m[2] >= 0 && m[3] > 0 && m[0] < 1e6f && m[1] < 1e6f && m[2] < 1e6f &&
+                   m[3] < 1e6f)) {
+            rc = vxl_fail(e, VXL_ERR_INVALID_ARGUMENT,
+                          "labels.entries[%u] (id %d): material (%g, %g, %g, %g) needs ambient, diffuse, specular "
+                          ">= 0 and shininess > 0, all finite",
+                          i, en->id, (double)m[0], (double)m[1], (double)m[2], (double)m[3]);
+            break;
+        }
+        if (m) h = vxl_fnv(h, m, 4 * sizeof(float));
         const uint32_t vis = en->visible != 0;
         h = vxl_fnv(h, &en->id, sizeof en->id);
         h = vxl_fnv(h, en->color, sizeof en->color);

@@ -289,6 +289,13 @@ typedef struct vxl_label_entry {
     float color[4];             /* straight RGBA in [0, 1]; alpha 1 unless the file gives one */
     uint32_t visible;           /* 1 unless the file hides it (ITK-SNAP's VIS column) */
     char name[64];              /* UTF-8, NUL-terminated, cut to fit; "" when the file names none */
+    /* Appended (issue 20), read only when struct_size covers them: the
+     * label's own material when has_material is 1 (ambient, diffuse,
+     * specular, shininess as params' material: >= 0 each, shininess > 0),
+     * used wherever the label's samples are lit (SURFACE, and MASK/TINT
+     * samples inside it); 0: the frame's. The table files set none. */
+    uint32_t has_material;
+    float material[4];
 } vxl_label_entry;
 
 /* Reads a label lookup table: FreeSurfer's LUT.txt, ITK-SNAP label

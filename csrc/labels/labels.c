@@ -147,8 +147,9 @@ static void bind_for_upload(vxl_labels_state *s, GLuint *tex, GLenum target)
 static int upload_table(vxl_labels_state *s, const vxl_frame *f)
 {
     vxl_gpu *g = s->gpu;
+    /* rows 0 .. SIDE-1: colours; rows SIDE .. 2 SIDE-1: materials (x -1: the frame's) */
     const uint64_t texels = (uint64_t)VXL_LABEL_TABLE_SIDE * VXL_LABEL_TABLE_SIDE;
-    const uint64_t bytes = texels * 4 * sizeof(float);
+    const uint64_t bytes = 2 * texels * 4 * sizeof(float);
     if (!s->table_tex) {
         int rc = vxl_holdings_ask(g, VXL_HOLD_LABELS, bytes + s->volume_bytes, NULL, "the label table");
         if (rc) return rc;
@@ -158,15 +159,21 @@ static int upload_table(vxl_labels_state *s, const vxl_frame *f)
     for (uint64_t i = 0; i < texels; i++) {
         table[4 * i] = table[4 * i + 1] = table[4 * i + 2] = 0.0f;
         table[4 * i + 3] = -1.0f; /* unlisted: hidden */
+        float *m = table + 4 * (texels + i);
+        m[0] = -1.0f; /* the frame's material */
+        m[1] = m[2] = m[3] = 0.0f;
     }
     for (uint32_t i = 0; i < f->labels.count; i++) {
         const vxl_label_entry *en = frame_entry(f, i);
         float *t = table + 4 * (size_t)en->id;
         memcpy(t, en->color, 4 * sizeof(float));
         if (!en->visible) t[3] = -1.0f;
+        const float *m = vxl_label_material(en, f->labels.stride);
+        if (m) memcpy(table + 4 * (texels + (size_t)en->id), m, 4 * sizeof(float));
     }
     bind_for_upload(s, &s->table_tex, GL_TEXTURE_2D);
-    g->gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, VXL_LABEL_TABLE_SIDE, VXL_LABEL_TABLE_SIDE, 0, GL_RGBA, GL_FLOAT, table);
+    g->gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, VXL_LABEL_TABLE_SIDE, 2 * VXL_LABEL_TABLE_SIDE, 0, GL_RGBA, GL_FLOAT,
+                     table);
     free(table);
     int rc = vxl_gl_check(g, "uploading the label table");
     if (rc) {

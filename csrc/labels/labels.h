@@ -16,7 +16,8 @@
 #include "gpu.h"
 #include "label_bricks.h"
 
-#define VXL_LABEL_TABLE_SIDE 256 /* the table is SIDE x SIDE texels: every id in [0, VXL_MAX_LABEL_ID] */
+#define VXL_LABEL_TABLE_SIDE 256 /* the table is SIDE x 2 SIDE texels: every id in [0, VXL_MAX_LABEL_ID],
+                                    its colour in the first SIDE rows, its material in the next */
 
 typedef struct vxl_labels_state {
     vxl_gpu *gpu;

@@ -173,7 +173,9 @@ class LabelEntry(ctypes.Structure):
                 ("id", ctypes.c_int32),
                 ("color", ctypes.c_float * 4),
                 ("visible", ctypes.c_uint32),
-                ("name", ctypes.c_char * 64)]
+                ("name", ctypes.c_char * 64),
+                ("has_material", ctypes.c_uint32),  # appended (issue 20): the label's own material
+                ("material", ctypes.c_float * 4)]
 
 
 class LabelStyle(ctypes.Structure):

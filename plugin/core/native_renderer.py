@@ -182,16 +182,23 @@ def _set_scene_shadows(p, vertices, triangles, key=0, shadow_map_size=0):
 
 def _set_labels(p, lib, mode, entries):
     """params.labels (issue 20) from `mode` (a label mode's name or number)
-    and entries, a sequence of (id, rgba, visible); the struct and its
-    entries live as long as p, and _keep holds their bytes for the digest."""
+    and entries, a sequence of (id, rgba, visible[, material]) where
+    material, when given and not None, is the label's own (ambient,
+    diffuse, specular, shininess); the struct and its entries live as long
+    as p, and _keep holds their bytes for the digest."""
     entries = list(entries)
     arr = (LabelEntry * max(1, len(entries)))()
-    for e, (ident, rgba, visible) in zip(arr, entries):
+    for e, entry in zip(arr, entries):
+        ident, rgba, visible = entry[:3]
+        material = entry[3] if len(entry) > 3 else None
         e.struct_size = ctypes.sizeof(LabelEntry)
         e.id = int(ident)
         rgba = tuple(float(c) for c in rgba)
         e.color[:] = rgba if len(rgba) == 4 else rgba + (1.0,)
         e.visible = 1 if visible else 0
+        if material is not None:
+            e.has_material = 1
+            e.material[:] = tuple(float(m) for m in material)
     s = _sized(LabelStyle)
     s.mode = mode if isinstance(mode, int) else lib.index("label_mode", mode)
     s.entry_count = len(entries)

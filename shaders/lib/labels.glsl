@@ -28,6 +28,14 @@ vec4 label_entry(uint id)
     return texelFetch(u_label_table, ivec2(int(id & 255u), int(id >> 8u)), 0);
 }
 
+// The label's own material (ambient, diffuse, specular, shininess), x -1
+// for the frame's: the table's second half (labels.c).
+vec4 label_material(uint id)
+{
+    if (id == LABEL_NONE) return vec4(-1.0);
+    return texelFetch(u_label_table, ivec2(int(id & 255u), 256 + int(id >> 8u)), 0);
+}
+
 // Intensity voxel p in label voxels.
 vec3 label_q(vec3 p)
 {
@@ -392,6 +400,7 @@ vec4 label_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float dep
             label_indicator(cell, label_q(p), h.id, g);
             vec3 rgb = h.color.rgb;
 #ifdef SHADING
+            g_label_material = label_material(h.id);
             rgb = shade_at(rgb, g, th, p, r);
 #endif
             acc += (1.0 - acc.a) * h.color.a * vec4(rgb, 1.0);
@@ -411,6 +420,7 @@ vec4 label_mask(inout LabelRay lr, vec3 p, vec4 c)
 {
     LabelHit h = label_at(lr, label_q(p));
     if (h.id == LABEL_NONE) return vec4(0.0);
+    g_label_material = label_material(h.id); // the sample, if shaded next, is lit with its label's material
 #if LABELS == 3
     c.rgb *= h.color.rgb;
 #endif

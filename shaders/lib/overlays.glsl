@@ -235,6 +235,9 @@ vec4 overlay_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
             od = ov_depth(a);
             od_rgb = od * rgb;
         }
+#if defined(LABELS) && LABELS > 1
+        g_label_material = vec4(-1.0); // the overlays are lit with the frame's material, not the base's label's
+#endif
         float a_step = 0.0;
         vec3 rgb_step = vec3(0.0), emission = vec3(0.0);
         bool over_done = false;

@@ -1,6 +1,14 @@
 // shading.glsl - Phong shading with gradient normals, in view space.
 uniform mat3 u_normal_matrix; // voxel-space gradient -> view-space normal
 uniform vec4 u_material;      // ambient, diffuse, specular, shininess
+#ifdef LABELS
+// issue 20: the material of the label whose sample is being lit, set by
+// lib/labels.glsl before shading it; x < 0: the frame's (u_material).
+vec4 g_label_material = vec4(-1.0);
+#define SHADE_MATERIAL (g_label_material.x >= 0.0 ? g_label_material : u_material)
+#else
+#define SHADE_MATERIAL u_material
+#endif
 uniform int u_light_count;
 uniform vec4 u_light_pos[8];  // view space; w = 0 direction towards light (unit, frame.c), 1 point
 uniform vec3 u_light_color[8];// colour * intensity
@@ -28,8 +36,8 @@ RayLighting ray_lighting(vec3 v)
 vec3 light_term(int i, vec3 rgb, vec3 n, vec3 l, vec3 h)
 {
     float ndl = dot(n, l);
-    float spec = pow(max(dot(n, h), 0.0), u_material.w);
-    return ndl > 0.0 ? u_light_color[i] * (u_material.y * ndl * rgb + u_material.z * spec) : vec3(0.0);
+    float spec = pow(max(dot(n, h), 0.0), SHADE_MATERIAL.w);
+    return ndl > 0.0 ? u_light_color[i] * (SHADE_MATERIAL.y * ndl * rgb + SHADE_MATERIAL.z * spec) : vec3(0.0);
 }
 
 vec3 point_light_term(int i, vec3 rgb, vec3 n, vec3 pos, vec3 v)
@@ -49,7 +57,7 @@ vec3 shade(vec3 rgb, vec3 g, vec3 pos, RayLighting r, bool one_directional)
     if (!(len > 1e-20)) return rgb;
     n /= len;
     if (dot(n, r.v) < 0.0) n = -n; // two-sided: a boundary faces the viewer
-    vec3 acc = u_material.x * rgb;
+    vec3 acc = SHADE_MATERIAL.x * rgb;
     if (one_directional) {
         acc += light_term(0, rgb, n, r.l0, r.h0);
     } else {
@@ -111,7 +119,7 @@ vec3 lit_term(int i, vec3 rgb, vec3 n, bool has_normal, float w, vec3 l, vec3 h,
     return light_term(i, rgb, n, l, h);
 #else
     vec3 surface = has_normal && w > 0.0 ? w * light_term(i, rgb, n, l, h) : vec3(0.0);
-    return surface + (1.0 - w) * u_light_color[i] * u_material.y * rgb * phase_4pi(l, v);
+    return surface + (1.0 - w) * u_light_color[i] * SHADE_MATERIAL.y * rgb * phase_4pi(l, v);
 #endif
 }
 
@@ -133,7 +141,7 @@ vec3 shade_lit(vec3 rgb, vec3 g, vec3 pos, vec3 p, RayLighting r, bool one_direc
         n /= len;
         if (dot(n, r.v) < 0.0) n = -n;
     }
-    vec3 acc = u_material.x * rgb * (1.0 - u_ao_strength * (1.0 - ambient_occlusion(p)));
+    vec3 acc = SHADE_MATERIAL.x * rgb * (1.0 - u_ao_strength * (1.0 - ambient_occlusion(p)));
     if (one_directional) {
         acc += light_transmittance(0, p) * lit_term(0, rgb, n, has_normal, w, r.l0, r.h0, r.v);
     } else {

@@ -130,6 +130,30 @@ def hiding_a_region_in_f12_changes_exactly_its_pixels():
 
 
 @test
+def a_labels_own_material_relights_only_its_region_in_f12():
+    scene, ob = _scene()
+    before = _f12(scene, "material_before")
+    lit = before.max(axis=2) > 0.05
+    hue = before.argmax(axis=2)
+    regions = [lit & (hue == c) for c in range(3)]
+    lab = ob.voxlight_labels.labels[0]  # Left-Red
+    lab.use_material = True
+    lab.ambient, lab.diffuse, lab.specular, lab.shininess = 1.0, 0.0, 0.0, 1.0
+    lab.keyframe_insert("ambient", frame=1)  # animatable like every setting
+    kw = _mod("params").look_kwargs(ob.voxlight)
+    assert kw["labels"][1][0][3] == (1.0, 0.0, 0.0, 1.0), kw["labels"][1][0]
+    after = _f12(scene, "material_flat")
+    red = after[regions[0]][:, 0]
+    # pure ambient: every pixel of the red ball at its colour, no shading left
+    assert red.min() > 0.9 and red.max() - red.min() < 0.1, (red.min(), red.max())
+    assert before[regions[0]][:, 0].max() - before[regions[0]][:, 0].min() > 0.2  # it was lit before
+    for c in (1, 2):  # the other labels keep the volume's material
+        assert np.abs(after[regions[c]] - before[regions[c]]).max() < 0.02
+    lab.use_material = False
+    ob.animation_data_clear()
+
+
+@test
 def labels_survive_save_and_reopen():
     scene, ob = _scene()
     ob.voxlight_labels.labels[0].visible = False

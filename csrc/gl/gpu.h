@@ -83,6 +83,14 @@ int vxl_program_get(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, 
 void vxl_uniform_i(vxl_gpu *g, GLuint prog, const char *name, int v);
 void vxl_uniform_f(vxl_gpu *g, GLuint prog, const char *name, float v);
 GLuint vxl_texture_new(vxl_gpu *g, GLenum target, GLint filter);
+/* The GL internal format and pixel type of one-channel texels of `bytes`
+ * per voxel (1, 2: unsigned normalised; 4: float), as every volume texture
+ * (dense, pool, overlay) stores vxl_volume texels. */
+static inline GLenum vxl_texel_internal_format(uint32_t bytes) { return bytes == 1 ? GL_R8 : bytes == 2 ? GL_R16 : GL_R32F; }
+static inline GLenum vxl_texel_type(uint32_t bytes)
+{
+    return bytes == 1 ? GL_UNSIGNED_BYTE : bytes == 2 ? GL_UNSIGNED_SHORT : GL_FLOAT;
+}
 int vxl_gl_check(vxl_gpu *g, const char *what);
 void vxl_programs_delete(vxl_gpu *g);
 

@@ -48,22 +48,15 @@ void vxl_overlays_release(vxl_overlays_state *s)
  * cubic reads 8 trilinear fetches; nearest reads texels). */
 static int upload_volume(vxl_gpu *g, const vxl_volume *v, GLuint *out)
 {
-    GLenum internal = GL_R32F, type = GL_FLOAT;
-    if (v->texture_bits == 8) {
-        internal = GL_R8;
-        type = GL_UNSIGNED_BYTE;
-    } else if (v->texture_bits == 16) {
-        internal = GL_R16;
-        type = GL_UNSIGNED_SHORT;
-    }
+    const uint32_t bpv = v->texture_bits / 8;
     vxl_gl *gl = &g->gl;
     gl->GetError();
     GLuint tex = vxl_texture_new(g, GL_TEXTURE_3D, GL_LINEAR);
     /* rows are tightly packed: alignment 1, as the renderer keeps it (renderer.c), set
      * again here because not every upload elsewhere leaves it so */
     gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal, (GLsizei)v->dims[0], (GLsizei)v->dims[1], (GLsizei)v->dims[2], 0,
-                   GL_RED, type, v->texels);
+    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)vxl_texel_internal_format(bpv), (GLsizei)v->dims[0], (GLsizei)v->dims[1],
+                   (GLsizei)v->dims[2], 0, GL_RED, vxl_texel_type(bpv), v->texels);
     int rc = vxl_gl_check(g, "uploading an overlay volume");
     if (rc) {
         gl->DeleteTextures(1, &tex);

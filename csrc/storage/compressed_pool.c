@@ -87,7 +87,6 @@ int vxl_compressed_decode(vxl_storage_state *st, const int32_t *source, uint32_t
     vxl_gl *gl = &st->gpu->gl;
     const vxl_pages *pg = &st->levels[0];
     const uint32_t e = vxl_page_edge(pg);
-    static const GLenum image_formats[] = {GL_R8, GL_R16, 0, GL_R32F};
     GLuint prog;
     int rc = vxl_program_get(st->gpu, VXL_PROG_DECODE_BRICKS, 0, pg->bytes_per_voxel - 1, &prog);
     if (rc) return rc;
@@ -109,7 +108,7 @@ int vxl_compressed_decode(vxl_storage_state *st, const int32_t *source, uint32_t
     gl->Uniform3i(gl->GetUniformLocation(prog, "u_cache_slots"), (GLint)slots[0], (GLint)slots[1], (GLint)slots[2]);
     gl->Uniform3i(gl->GetUniformLocation(prog, "u_code_slots"), (GLint)st->code_slots[0], (GLint)st->code_slots[1],
                   (GLint)st->code_slots[2]);
-    gl->BindImageTexture(VXL_IMAGE_OUT, st->pool_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, image_formats[pg->bytes_per_voxel - 1]);
+    gl->BindImageTexture(VXL_IMAGE_OUT, st->pool_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, vxl_texel_internal_format(pg->bytes_per_voxel));
     vxl_dispatch_bricks(st, prog, 0, count, e);
     gl->MemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     gl->Finish(); /* the decode time is a reported number */

@@ -17,8 +17,6 @@
 #include "budget.h"
 #include "storage.h"
 
-static const GLenum internal_formats[] = {GL_R8, GL_R16, 0, GL_R32F};
-static const GLenum texel_types[] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_SHORT, 0, GL_FLOAT};
 
 void vxl_paged_release(vxl_storage_state *st)
 {
@@ -74,7 +72,7 @@ static int upload_pool(vxl_storage_state *st, uint32_t level, const uint8_t *nee
                                     st->mode == VXL_STORAGE_BRICKED ? " (sparse storage keeps only visible bricks)" : NULL,
                                     "%u resident bricks", count);
     if (over) return over;
-    const uint32_t e = vxl_page_edge(pg), fi = pg->bytes_per_voxel - 1;
+    const uint32_t e = vxl_page_edge(pg), bpv = pg->bytes_per_voxel;
     const size_t brick_bytes = (size_t)e * e * e * pg->bytes_per_voxel;
     int32_t *source = coded ? malloc((count ? count : 1) * sizeof *source) : NULL;
     if (coded && !source) return vxl_fail(&st->gpu->err, VXL_ERR_NO_MEMORY, "out of memory for the decode list");
@@ -85,8 +83,8 @@ static int upload_pool(vxl_storage_state *st, uint32_t level, const uint8_t *nee
     } else {
         if (st->pool_tex) gl->DeleteTextures(1, &st->pool_tex);
         st->pool_tex = vxl_texture_new(st->gpu, GL_TEXTURE_3D, GL_LINEAR);
-        gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)(slots[0] * e), (GLsizei)(slots[1] * e),
-                       (GLsizei)(slots[2] * e), 0, GL_RED, texel_types[fi], NULL);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)vxl_texel_internal_format(bpv), (GLsizei)(slots[0] * e), (GLsizei)(slots[1] * e),
+                       (GLsizei)(slots[2] * e), 0, GL_RED, vxl_texel_type(bpv), NULL);
     }
     for (int a = 0; a < 3; a++) st->pool_dims[a] = slots[a] * e;
     uint32_t k = 0, constant = 0;
@@ -106,7 +104,7 @@ static int upload_pool(vxl_storage_state *st, uint32_t level, const uint8_t *nee
             source[k] = pg->data_index[i];
         else
             gl->TexSubImage3D(GL_TEXTURE_3D, 0, (GLint)o[0], (GLint)o[1], (GLint)o[2], (GLsizei)e, (GLsizei)e,
-                              (GLsizei)e, GL_RED, texel_types[fi], pg->data + (size_t)pg->data_index[i] * brick_bytes);
+                              (GLsizei)e, GL_RED, vxl_texel_type(bpv), pg->data + (size_t)pg->data_index[i] * brick_bytes);
         for (int a = 0; a < 3; a++) pe[a] = (float)(o[a] + VXL_PAGE_GHOST);
         pe[3] = -1;
         k++;

@@ -6,8 +6,6 @@
 #include "budget.h"
 #include "storage.h"
 
-static const GLenum internal_formats[] = {GL_R8, GL_R16, GL_R32F};
-static const GLenum texel_types[] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_SHORT, GL_FLOAT};
 
 static int plan(vxl_storage_state *st, const vxl_volume *v, uint32_t asked, vxl_storage_plan *out)
 {
@@ -33,11 +31,11 @@ static void release(vxl_storage_state *st)
 static int install(vxl_storage_state *st, const vxl_volume *v, vxl_storage_plan *pl)
 {
     (void)pl; /* nothing planned beyond the checks */
-    int fi = v->texture_bits == 8 ? 0 : v->texture_bits == 16 ? 1 : 2;
+    const uint32_t bpv = v->texture_bits / 8;
     st->gpu->gl.GetError();
     st->volume_tex = vxl_texture_new(st->gpu, GL_TEXTURE_3D, GL_LINEAR);
-    st->gpu->gl.TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)v->dims[0], (GLsizei)v->dims[1],
-                     (GLsizei)v->dims[2], 0, GL_RED, texel_types[fi], v->texels);
+    st->gpu->gl.TexImage3D(GL_TEXTURE_3D, 0, (GLint)vxl_texel_internal_format(bpv), (GLsizei)v->dims[0], (GLsizei)v->dims[1],
+                     (GLsizei)v->dims[2], 0, GL_RED, vxl_texel_type(bpv), v->texels);
     int rc = vxl_gl_check(st->gpu, "uploading the volume");
     if (rc) release(st);
     st->mode = VXL_STORAGE_DENSE;

@@ -28,8 +28,6 @@
 
 #define STREAM_QUEUE_BYTES (64ull << 20) /* the loader's staging queue at most (or a 16th of the budget) */
 
-static const GLenum internal_formats[] = {GL_R8, GL_R16, 0, GL_R32F};
-static const GLenum texel_types[] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_SHORT, 0, GL_FLOAT};
 
 typedef struct vxl_stream {
     vxl_brick_source *src;   /* retained: the caller may destroy the volume */
@@ -345,12 +343,12 @@ static void upload_brick(vxl_storage_state *st, const vxl_loaded_brick *b)
     const int64_t slot = take_slot(st);
     if (slot < 0) return;
     const vxl_pages *pg = &st->levels[b->key.level];
-    const uint32_t e = vxl_page_edge(pg), fi = pg->bytes_per_voxel - 1;
+    const uint32_t e = vxl_page_edge(pg), bpv = pg->bytes_per_voxel;
     uint32_t o[3];
     vxl_slot_origin((uint32_t)slot, s->slots, e, o);
     vxl_gl *gl = &st->gpu->gl;
     gl->TexSubImage3D(GL_TEXTURE_3D, 0, (GLint)o[0], (GLint)o[1], (GLint)o[2], (GLsizei)e, (GLsizei)e, (GLsizei)e, GL_RED,
-                      texel_types[fi], b->texels);
+                      vxl_texel_type(bpv), b->texels);
     float *pe = s->entries + 4 * flat;
     for (int a = 0; a < 3; a++) pe[a] = (float)(o[a] + VXL_PAGE_GHOST);
     pe[3] = -1;
@@ -418,9 +416,9 @@ static int ensure_pool(vxl_storage_state *st, uint32_t required, uint64_t fixed)
     gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
     const GLuint old = st->pool_tex;
     st->pool_tex = vxl_texture_new(st->gpu, GL_TEXTURE_3D, GL_LINEAR);
-    const uint32_t e = vxl_page_edge(pg), fi = pg->bytes_per_voxel - 1;
-    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)internal_formats[fi], (GLsizei)(slots[0] * e), (GLsizei)(slots[1] * e),
-                   (GLsizei)(slots[2] * e), 0, GL_RED, texel_types[fi], NULL);
+    const uint32_t e = vxl_page_edge(pg), bpv = pg->bytes_per_voxel;
+    gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)vxl_texel_internal_format(bpv), (GLsizei)(slots[0] * e), (GLsizei)(slots[1] * e),
+                   (GLsizei)(slots[2] * e), 0, GL_RED, vxl_texel_type(bpv), NULL);
     for (uint32_t i = 0; i < s->capacity; i++) { /* slot i stays slot i, at its place in the new layout */
         if (!(sb[i] = s->slot_brick[i])) continue;
         uint32_t o[3], n[3];

@@ -196,7 +196,7 @@ TOTAL_FAIL=0
 run_suite() {
     local name=$1; shift
     echo "=== $name"
-    local log
+    local log started=$SECONDS
     log=$(mktemp)
     set +e
     "$@" 2>&1 | tee "$log"
@@ -217,6 +217,8 @@ run_suite() {
     if [ "$rc" -ne 0 ] && [ "$nf" -eq 0 ]; then nf=1; fi # a crash counts as a failure
     TOTAL_PASS=$((TOTAL_PASS + np))
     TOTAL_FAIL=$((TOTAL_FAIL + nf))
+    # the suite's wall time, so CI's 30-minute budget can be watched per suite
+    echo "=== $name: $((SECONDS - started)) s"
     rm -f "$log"
 }
 
@@ -224,7 +226,7 @@ run_c_tests() {
     local dir=$1 fails=0 p=0 f=0
     for t in "$dir"/tests/test_*; do
         [ -x "$t" ] || continue
-        local out
+        local out t0=$SECONDS
         set +e
         out=$("$t" 2>&1)
         local rc=$?
@@ -236,7 +238,7 @@ run_c_tests() {
         line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1 || true)
         # a crash: show the end of its output (the sanitizer's report and stack)
         [ -n "$line" ] || echo "$out" | tail -n 60
-        echo "$(basename "$t"): ${line:-crashed (exit $rc)}"
+        echo "$(basename "$t"): ${line:-crashed (exit $rc)} ($((SECONDS - t0)) s)"
         if [ -n "$line" ]; then
             p=$((p + $(echo "$line" | grep -oE '^[0-9]+')))
             f=$((f + $(echo "$line" | sed -E 's/^[0-9]+ passed, ([0-9]+) failed.*/\1/')))

@@ -87,9 +87,10 @@ finish_blender "python tests (no Blender)"
 run_script() {  # tag, label, command...
     local tag=$1 label=$2
     shift 2
-    local out=$SANDBOX/$tag-$label.log
+    local out=$SANDBOX/$tag-$label.log started=$SECONDS
     (cd "$SANDBOX" && timeout 600 "$@") >"$out" 2>&1
     local rc=$?
+    echo "TIME $tag $label: $((SECONDS - started)) s"  # CI's 30-minute budget, per script
     grep -E '^(PASS|FAIL|RESULT)|^install_addon:|^enable:|Error|Traceback' "$out"
     [ -n "$b_enable" ] || b_enable=$(sed -n 's/^enable: //p' "$out" | head -n 1)
     local line

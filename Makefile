@@ -155,7 +155,7 @@ $(BUILD)/voxlight-sceneshadowbench: bench/scene_shadow_study.c bench/bench_util.
 # test_brick_cache calls the cache's internals (csrc/io/brick_cache.h), so it
 # links their objects and those its checks compare against, as well as the library.
 BRICK_CACHE_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,brick_cache brick_cache_read brick_cache_write \
-	brick_cache_format brick_source brick_levels bricks volume error paging lod)
+	brick_cache_format brick_source brick_levels bricks volume error paging lod brick_loader)
 $(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wildcard tests/*.h) $(BRICK_CACHE_TEST_OBJ) \
 		$(BUILD)/libvoxlight.so | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(BRICK_CACHE_TEST_OBJ) -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
@@ -179,9 +179,10 @@ FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc
 # in-process by their targets: libFuzzer sees coverage in its own process only)
 FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
 	reader_spawn.c remote_readers.c label_table.c zarr_detect.c $(notdir $(ZARR_C)) zarr_source.c brick_source.c
-# the brick cache of .nii.gz files (issue 21): opened by the loaders, read by fuzz_brick_cache
+# the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
+# fuzz_brick_cache and fuzz_tiff_layout
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
-	brick_levels.c raw_source.c stream_load.c)
+	brick_levels.c raw_source.c stream_load.c tiff_layout.c)
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))

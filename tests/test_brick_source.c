@@ -383,8 +383,9 @@ TEST(formats_without_random_access_load_whole_or_say_streaming_is_unavailable)
     char p[512];
     uint8_t px[8 * 8 * 4];
     for (size_t i = 0; i < sizeof px; i++) px[i] = (uint8_t)(i * 7);
-    /* a TIFF stack (read whole by its helper), an attached gzip NRRD, a zlib MetaImage */
-    REQUIRE(tw_write_tiff(tmp(p, sizeof p, "w.tif"), 8, 8, 4, 1, 8, 1, px) == 0);
+    /* a colour TIFF (read whole by its helper: only single-sample pages stream,
+     * test_tiff_stream.c), an attached gzip NRRD, a zlib MetaImage */
+    REQUIRE(tw_write_tiff(tmp(p, sizeof p, "w.tif"), 8, 8, 1, 3, 8, 1, px) == 0);
     char nrrd[512], mha[512];
     REQUIRE(tw_write_header_data(tmp(nrrd, sizeof nrrd, "w.nrrd"),
                                  "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 8 8 4\nencoding: gzip\n\n", px, sizeof px,

@@ -25,6 +25,15 @@ typedef struct vxl_raw_layout {
                                header claims: a file shorter than its voxels is an error naming it) */
     int64_t mtime_ns;       /* the cache key */
     uint64_t header_hash;   /* hash of the header bytes: the cache key */
+    /* Slices that do not follow each other (a multi-page TIFF, tiff_layout.h):
+     * dims[2] byte offsets, slice z's first stored byte at slice_offsets[z]
+     * (owned by the loader; vxl_raw_source_open copies it). NULL: slice z at
+     * offset + z * slice bytes, as NIfTI, NRRD and MetaImage store them. */
+    const uint64_t *slice_offsets;
+    int rows_top_first;     /* 1: a slice stores its top row (voxel y = dims[1]-1) first, as images do */
+    uint64_t compressed_start; /* compressed: file byte where the gzip/zlib stream begins (0: the file's start;
+                                  after the text header of attached NRRD/MetaImage data); offset counts from
+                                  the start of what it inflates to */
 } vxl_raw_layout;
 
 #endif

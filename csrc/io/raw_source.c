@@ -32,13 +32,26 @@ typedef struct raw_ctx {
     vxl_texel_map map;
     uint64_t nan_count, inf_count;
     uint8_t *levels[VXL_SOURCE_MAX_LEVELS];   /* coarse levels kept whole (NULL: averaged from level 0) */
+    uint64_t *slices;                         /* the layout's slice_offsets, copied (NULL: contiguous) */
 } raw_ctx;
+
+/* Where voxel (x, y, z) of level 0 is stored: the one place that knows how
+ * slices (contiguous from the offset, or a table) and rows (bottom or top
+ * first) lie in the file. */
+static uint64_t voxel_at(const raw_ctx *c, uint32_t x, uint32_t y, uint32_t z)
+{
+    const uint32_t *d = c->l.dims;
+    const uint64_t row = c->l.rows_top_first ? d[1] - 1 - y : y;
+    const uint64_t slice = c->slices ? c->slices[z] : c->l.offset + (uint64_t)d[0] * d[1] * z * c->es;
+    return slice + (row * d[0] + x) * c->es;
+}
 
 static void raw_close(vxl_brick_source *s)
 {
     raw_ctx *c = s->ctx;
     if (!c) return;
     if (c->fd >= 0) close(c->fd);
+    free(c->slices);
     for (int k = 0; k < VXL_SOURCE_MAX_LEVELS; k++) free(c->levels[k]);
     free(c);
     s->ctx = NULL;
@@ -69,13 +82,16 @@ static void to_texels(const raw_ctx *c, void *raw, size_t n, void *out)
     vxl_texels_from_raw(&c->map, raw, n, out);
 }
 
-/* Level-0 box, read row by row (whole rows or slices in one pread where the box spans them). */
+/* Level-0 box, read row by row (whole rows or slices in one pread where the
+ * box spans them and they follow each other; rows stored top first are read
+ * as one run too, converted in reverse). */
 static int read_level0(vxl_brick_source *s, const uint32_t lo[3], const uint32_t size[3], void *out, vxl_err *e)
 {
     const raw_ctx *c = s->ctx;
     const uint32_t *d = c->l.dims;
     const size_t es = c->es, bpv = s->texture_bits / 8;
-    const int rows = size[0] == d[0], slices = rows && size[1] == d[1];
+    const int flip = c->l.rows_top_first;
+    const int rows = size[0] == d[0], slices = rows && size[1] == d[1] && !flip && !c->slices;
     const size_t run = slices ? (size_t)size[0] * size[1] * size[2] : rows ? (size_t)size[0] * size[1] : size[0];
     uint8_t *raw = malloc(run * es);
     if (!raw) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory reading a box of '%s'", c->l.path);
@@ -83,10 +99,15 @@ static int read_level0(vxl_brick_source *s, const uint32_t lo[3], const uint32_t
     uint8_t *o = out;
     for (uint32_t z = 0; z < size[2] && !rc; z++)
         for (uint32_t y = 0; y < size[1] && !rc; y++) {
-            const uint64_t voxel = lo[0] + (uint64_t)d[0] * ((lo[1] + y) + (uint64_t)d[1] * (lo[2] + z));
-            rc = read_at(s, raw, run * es, c->l.offset + voxel * es, e);
+            /* a run of flipped rows starts at the box's top row */
+            const uint32_t y0 = rows && flip ? lo[1] + size[1] - 1 : lo[1] + y;
+            rc = read_at(s, raw, run * es, voxel_at(c, lo[0], y0, lo[2] + z), e);
             if (rc) break;
-            to_texels(c, raw, run, o);
+            if (rows && flip)
+                for (uint32_t r = 0; r < size[1]; r++) /* stored row r is the box's row size[1]-1-r */
+                    to_texels(c, raw + (size_t)r * size[0] * es, size[0], o + (size_t)(size[1] - 1 - r) * size[0] * bpv);
+            else
+                to_texels(c, raw, run, o);
             o += run * bpv;
             if (slices) z = size[2];
             if (rows) y = size[1];
@@ -167,17 +188,16 @@ typedef struct slab {
     uint32_t z0, n;
 } slab;
 
-/* Reads the slab's data extents (SEEK_DATA / SEEK_HOLE; a file system
- * without them is all data), zero-filling the holes. */
-static int read_slab(vxl_brick_source *s, slab *sb, vxl_err *e)
+/* Reads the data extents (SEEK_DATA / SEEK_HOLE; a file system without them
+ * is all data) of the file bytes [start, start + len), which hold slab
+ * slices first.. in file order, into raw; marks those slices and their
+ * voxel rows that hold data. raw, hole and row_data are cleared by the caller. */
+static int read_extent(vxl_brick_source *s, slab *sb, uint8_t *raw, uint64_t start, uint64_t len, uint32_t first,
+                       vxl_err *e)
 {
     const raw_ctx *c = s->ctx;
-    const uint64_t slice = (uint64_t)c->l.dims[0] * c->l.dims[1] * c->es;
-    const uint64_t start = c->l.offset + slice * sb->z0, end = start + slice * sb->n;
-    const uint64_t row = (uint64_t)c->l.dims[0] * c->es;
-    memset(sb->raw, 0, (size_t)(end - start));
-    memset(sb->hole, 1, sb->n);
-    memset(sb->row_data, 0, (size_t)sb->n * c->l.dims[1]);
+    const uint32_t h = c->l.dims[1];
+    const uint64_t row = (uint64_t)c->l.dims[0] * c->es, end = start + len;
     uint64_t pos = start;
     while (pos < end) {
         off_t data = lseek(c->fd, (off_t)pos, SEEK_DATA);
@@ -187,11 +207,38 @@ static int read_slab(vxl_brick_source *s, slab *sb, vxl_err *e)
         off_t hole = lseek(c->fd, data, SEEK_HOLE);
         uint64_t stop = hole < 0 || (uint64_t)hole > end ? end : (uint64_t)hole;
         if (stop <= (uint64_t)data) stop = end;
-        int rc = read_at(s, sb->raw + ((uint64_t)data - start), (size_t)(stop - (uint64_t)data), (uint64_t)data, e);
+        int rc = read_at(s, raw + ((uint64_t)data - start), (size_t)(stop - (uint64_t)data), (uint64_t)data, e);
         if (rc) return rc;
-        for (uint64_t z = ((uint64_t)data - start) / slice; z <= (stop - 1 - start) / slice; z++) sb->hole[z] = 0;
-        memset(sb->row_data + ((uint64_t)data - start) / row, 1, (size_t)((stop - 1 - start) / row - ((uint64_t)data - start) / row + 1));
+        /* stored rows a .. b (counted from start) hold data */
+        const uint64_t a = ((uint64_t)data - start) / row, b = (stop - 1 - start) / row;
+        for (uint64_t z = a / h; z <= b / h; z++) {
+            uint64_t r0 = z == a / h ? a % h : 0, r1 = z == b / h ? b % h : h - 1;
+            if (c->l.rows_top_first) { /* stored row r is voxel row h-1-r */
+                const uint64_t t = r0;
+                r0 = h - 1 - r1;
+                r1 = h - 1 - t;
+            }
+            sb->hole[first + z] = 0;
+            memset(sb->row_data + (first + z) * (uint64_t)h + r0, 1, (size_t)(r1 - r0 + 1));
+        }
         pos = stop;
+    }
+    return VXL_OK;
+}
+
+/* Reads the slab's slices: one extent when slices follow each other, else
+ * one per slice (slice_offsets), holes as zeros. */
+static int read_slab(vxl_brick_source *s, slab *sb, vxl_err *e)
+{
+    const raw_ctx *c = s->ctx;
+    const uint64_t slice = (uint64_t)c->l.dims[0] * c->l.dims[1] * c->es;
+    memset(sb->raw, 0, (size_t)(slice * sb->n));
+    memset(sb->hole, 1, sb->n);
+    memset(sb->row_data, 0, (size_t)sb->n * c->l.dims[1]);
+    if (!c->slices) return read_extent(s, sb, sb->raw, c->l.offset + slice * sb->z0, slice * sb->n, 0, e);
+    for (uint32_t i = 0; i < sb->n; i++) {
+        int rc = read_extent(s, sb, sb->raw + slice * i, c->slices[sb->z0 + i], slice, i, e);
+        if (rc) return rc;
     }
     return VXL_OK;
 }
@@ -246,7 +293,7 @@ static int run_stage(pass *p, int texels, vxl_err *e)
             const uint8_t *rows = p->sb.row_data + (size_t)i * d[1];
             const size_t tb = p->s->texture_bits / 8, row_t = (size_t)d[0] * tb, row_r = (size_t)d[0] * c->es;
             for (uint32_t y = 0; y < d[1]; y++) {
-                uint8_t *rr = raw + row_r * y;
+                uint8_t *rr = raw + row_r * (c->l.rows_top_first ? d[1] - 1 - y : y); /* stored order */
                 if (!rows[y]) {
                     p->any_hole = 1;
                     if (texels) memcpy(p->texels + row_t * y, p->hole_row, row_t);
@@ -357,7 +404,20 @@ static int check_layout(const vxl_raw_layout *l, const vxl_load_options *opt, ui
         end > (uint64_t)INT64_MAX)
         return vxl_fail(e, VXL_ERR_LIMIT, "'%s': %ux%ux%u voxels at offset %llu overflow any file size", l->path,
                         l->dims[0], l->dims[1], l->dims[2], (unsigned long long)l->offset);
-    if (file_size < end) /* the whole read's words (nifti.c, loader_util.c) */
+    if (l->slice_offsets) { /* each slice within the file */
+        const uint64_t slice = (uint64_t)l->dims[0] * l->dims[1] * es;
+        for (uint32_t z = 0; z < l->dims[2]; z++) {
+            const uint64_t at = l->slice_offsets[z];
+            if (at > (uint64_t)INT64_MAX - slice)
+                return vxl_fail(e, VXL_ERR_LIMIT, "'%s': slice %u at offset %llu overflows any file size", l->path,
+                                z, (unsigned long long)at);
+            if (file_size < at + slice)
+                return vxl_fail(e, VXL_ERR_FORMAT,
+                                "'%s': truncated file: expected %llu bytes of slice %u at offset %llu, got %llu",
+                                l->path, (unsigned long long)slice, z, (unsigned long long)at,
+                                (unsigned long long)(file_size > at ? file_size - at : 0));
+        }
+    } else if (file_size < end) /* the whole read's words (nifti.c, loader_util.c) */
         return vxl_fail(e, VXL_ERR_FORMAT,
                         "'%s': truncated file: expected %llu bytes of voxel data at offset %llu, got %llu", l->path,
                         (unsigned long long)bytes, (unsigned long long)l->offset,
@@ -389,13 +449,24 @@ int vxl_raw_source_open(const vxl_raw_layout *l, const vxl_load_options *opt, vx
     }
     c->fd = fd;
     c->l = *l;
+    if (l->slice_offsets) { /* the loader's table is its own: keep a copy (dims[2] <= max_dim entries) */
+        c->slices = malloc((size_t)l->dims[2] * sizeof *c->slices);
+        if (!c->slices) {
+            free(s);
+            free(c);
+            close(fd);
+            return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", l->path);
+        }
+        memcpy(c->slices, l->slice_offsets, (size_t)l->dims[2] * sizeof *c->slices);
+        c->l.slice_offsets = c->slices;
+    }
     c->es = vxl_dtype_size(l->dtype);
     /* slope and intercept as vxl_volume_build takes them; the range comes with the pass */
     vxl_texel_map_init(&c->map, l->dtype, l->slope, l->inter, 0, 0);
     s->ops = &raw_ops;
     s->ctx = c;
     s->texture_bits = vxl_texture_bits_for(l->dtype);
-    s->resident_bytes = sizeof *c;
+    s->resident_bytes = sizeof *c + (c->slices ? (uint64_t)l->dims[2] * sizeof *c->slices : 0);
     vxl_brick_source_set_levels(s, l->dims, vxl_source_level_count(l->dims));
     rc = make_pass(s, opt, e);
     if (rc) {

@@ -1,6 +1,7 @@
 /* volume_load.c - vxl_volume_load: picks the loader for a path. NIfTI,
  * NRRD and MetaImage are read in this process; TIFF/PNG stacks, OpenVDB and
- * DICOM in helper processes (remote_readers.c, reader_stream.h). */
+ * DICOM in helper processes (remote_readers.c, reader_stream.h), except an
+ * uncompressed multi-page TIFF that streams (tiff_layout.h). */
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
@@ -8,6 +9,48 @@
 
 #include "loaders.h"
 #include "stream_load.h"
+#include "tiff_layout.h"
+
+/* A single TIFF file (issue 21): its pages are read by offset when its
+ * directories allow it (tiff_layout.h) and the plan streams (ON, or AUTO
+ * over half the budget); otherwise the OpenImageIO helper reads it whole,
+ * as before, and over the budget the error says why it could not stream. */
+static int vxl_tiff_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+{
+    const uint32_t mode = vxl_load_streaming(opt);
+    if (mode == VXL_STREAMING_OFF) return vxl_image_stack_load(path, opt, out, e);
+    vxl_tiff_layout t;
+    vxl_err probe = {0};
+    int rc = vxl_tiff_layout_probe(path, opt, &t, &probe);
+    /* a file shorter than its directories claim: under ON the error names it;
+     * under AUTO the whole read answers as it always has */
+    if (rc == VXL_ERR_FORMAT && mode == VXL_STREAMING_ON) {
+        vxl_tiff_layout_free(&t);
+        return vxl_fail(e, rc, "%s", probe.msg);
+    }
+    if (rc == VXL_OK && t.page_offsets) {
+        int stream = 0;
+        uint64_t nbytes = 0;
+        rc = vxl_stream_plan(path, t.dims, t.dtype, opt, NULL, &stream, &nbytes, e);
+        if (rc || stream) {
+            vxl_raw_layout l;
+            if (!rc) rc = vxl_tiff_raw_layout(path, &t, opt, &l, e);
+            if (!rc) rc = vxl_stream_load(&l, opt, out, e); /* the source copies the page table */
+            vxl_tiff_layout_free(&t);
+            return rc;
+        }
+    }
+    char why[sizeof t.why];
+    snprintf(why, sizeof why, "%s", rc == VXL_OK && !t.page_offsets ? t.why : "");
+    vxl_tiff_layout_free(&t);
+    rc = vxl_image_stack_load(path, opt, out, e);
+    if (rc == VXL_ERR_LIMIT && why[0] && e) {
+        char msg[sizeof e->msg];
+        snprintf(msg, sizeof msg, "%s", e->msg);
+        return vxl_fail(e, rc, "%s (streaming is not available for %s)", msg, why);
+    }
+    return rc;
+}
 
 static int has_suffix(const char *s, const char *suffix)
 {
@@ -31,7 +74,7 @@ static vxl_loader_fn vxl_loader_for(const char *path)
         {".img", vxl_nifti_load}, {".hdr.gz", vxl_nifti_load}, {".img.gz", vxl_nifti_load},
         {".nrrd", vxl_nrrd_load}, {".nhdr", vxl_nrrd_load},
         {".mha", vxl_metaimage_load}, {".mhd", vxl_metaimage_load},
-        {".tif", vxl_image_stack_load}, {".tiff", vxl_image_stack_load}, {".png", vxl_image_stack_load},
+        {".tif", vxl_tiff_load}, {".tiff", vxl_tiff_load}, {".png", vxl_image_stack_load},
         {".vdb", vxl_vdb_load},
         {".dcm", vxl_dicom_load}, {".dicom", vxl_dicom_load}, {"DICOMDIR", vxl_dicom_load},
     };
@@ -45,7 +88,9 @@ static vxl_loader_fn vxl_loader_for(const char *path)
         if (n >= 4 && !memcmp(m, "NRRD", 4)) return vxl_nrrd_load;
         if (n >= 4 && !memcmp(m, " BDV", 4)) return vxl_vdb_load; /* OpenVDB magic 0x56444220, little-endian */
         if (n >= 8 && !memcmp(m, "\x89PNG\r\n\x1a\n", 8)) return vxl_image_stack_load;
-        if (n >= 4 && (!memcmp(m, "II*\0", 4) || !memcmp(m, "MM\0*", 4))) return vxl_image_stack_load;
+        if (n >= 4 && (!memcmp(m, "II*\0", 4) || !memcmp(m, "MM\0*", 4) || !memcmp(m, "II+\0", 4) ||
+                       !memcmp(m, "MM\0+", 4)))
+            return vxl_tiff_load; /* classic TIFF or BigTIFF */
         if (n >= 5 && (!strncasecmp((const char *)m, "ObjectType", 10) || !strncasecmp((const char *)m, "NDims", 5)))
             return vxl_metaimage_load;
     }

@@ -24,7 +24,7 @@ replay_only=0
 [ "$secs" = replay ] && replay_only=1
 targets=("$@")
 # vdb fuzzes in fork mode: see fuzz_contained_vdb below.
-[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom vdb label_table zarr brick_cache)
+[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom vdb label_table zarr brick_cache tiff_layout)
 
 # The corpus first: every target needs at least one input to replay (dot
 # files such as .keep do not count).
@@ -56,6 +56,12 @@ if [ $replay_only -eq 0 ]; then
     rm -rf build/fuzz/seeds/brick_cache
     { make -s -j"$(nproc)" build/tests/test_brick_cache && build/tests/test_brick_cache --write-seeds build/fuzz/seeds/brick_cache; } ||
         { echo "fuzz: brick cache seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
+    # the TIFF directory walk: the stack reader's seeds plus big-endian, BigTIFF and many-strip files
+    # written by the streaming test
+    rm -rf build/fuzz/seeds/tiff_layout
+    { make -s -j"$(nproc)" build/tests/test_tiff_stream && build/tests/test_tiff_stream --write-seeds build/fuzz/seeds/tiff_layout &&
+        cp build/fuzz/seeds/tiff/* build/fuzz/seeds/tiff_layout/; } ||
+        { echo "fuzz: tiff layout seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
 fi
 
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

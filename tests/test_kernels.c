@@ -214,16 +214,20 @@ static int read_grid(vxl_renderer *r, float *out, size_t n, uint32_t *brick)
  * (every voxel a trilinear sample inside the brick's box reaches). The
  * check against that rule, computed here from the source values, is what
  * fails if both kernels drift together (no apron, a wider one, unclamped). */
-TEST(brick_minmax_cpu_equals_glsl_bit_for_bit)
+/* One brick edge B (both storages are told it through VOXLIGHT_BRICK_SIZE). */
+static void check_minmax_kernels_agree(vxl_test_ctx *T_, const int B)
 {
     const uint32_t dtypes[3] = {VXL_DTYPE_U8, VXL_DTYPE_I16, VXL_DTYPE_F32};
-    enum { B = 8, BX = (GX + B - 1) / B, BY = (GY + B - 1) / B, BZ = (GZ + B - 1) / B, NG = 2 * BX * BY * BZ };
+    const int BX = (GX + B - 1) / B, BY = (GY + B - 1) / B, BZ = (GZ + B - 1) / B, NG = 2 * BX * BY * BZ;
     static double norm[GX * GY * GZ];
+    char edge[8];
+    snprintf(edge, sizeof edge, "%d", B);
+    setenv("VOXLIGHT_BRICK_SIZE", edge, 1);
     for (int t = 0; t < 3; t++) {
         vxl_renderer *rs[2] = {make_stored(VXL_STORAGE_DENSE), make_stored(VXL_STORAGE_BRICKED)};
         vxl_volume *v = make_typed(dtypes[t], norm);
         REQUIRE(rs[0] && rs[1] && v);
-        float grid[2][NG];
+        float grid[2][2 * ((GX + 3) / 4) * ((GY + 3) / 4) * ((GZ + 3) / 4)]; /* room for B >= 4 */
         uint32_t brick[2] = {0, 0};
         vxl_render_params p = phantom_scene(16, 16, VXL_FILTER_CENTRAL, VXL_CLASSIFY_POST);
         for (int i = 0; i < 2; i++) {
@@ -232,7 +236,7 @@ TEST(brick_minmax_cpu_equals_glsl_bit_for_bit)
             CHECKF(read_grid(rs[i], grid[i], NG, &brick[i]), "%s", vxl_renderer_error(rs[i]));
         }
         vxl_volume_destroy(v);
-        CHECK(brick[0] == B && brick[1] == B);
+        CHECK(brick[0] == (uint32_t)B && brick[1] == (uint32_t)B);
         int differ = 0, first = -1;
         for (int i = 0; i < NG; i++)
             if (memcmp(&grid[0][i], &grid[1][i], sizeof(float)) && differ++ == 0) first = i;
@@ -264,6 +268,41 @@ TEST(brick_minmax_cpu_equals_glsl_bit_for_bit)
         vxl_renderer_destroy(rs[0]);
         vxl_renderer_destroy(rs[1]);
     }
+    unsetenv("VOXLIGHT_BRICK_SIZE");
+}
+
+TEST(brick_minmax_cpu_equals_glsl_bit_for_bit)
+{
+    check_minmax_kernels_agree(T_, 8); /* the paged storages' edge */
+    check_minmax_kernels_agree(T_, 4); /* dense storage's edge for volumes up to 512^3 */
+}
+
+/* Without the override, dense storage (its grid built on the GPU) takes 4^3
+ * bricks for a volume whose 4^3 grid has at most 2^21 bricks, bricked
+ * storage (its grid from the CPU index) 8^3; the images are the same, since
+ * skipping only leaves out samples that add nothing. */
+TEST(dense_storage_skips_with_finer_bricks)
+{
+    unsetenv("VOXLIGHT_BRICK_SIZE");
+    static double norm[GX * GY * GZ];
+    vxl_renderer *rs[2] = {make_stored(VXL_STORAGE_DENSE), make_stored(VXL_STORAGE_BRICKED)};
+    vxl_volume *v = make_typed(VXL_DTYPE_U8, norm);
+    REQUIRE(rs[0] && rs[1] && v);
+    float grid[2 * ((GX + 3) / 4) * ((GY + 3) / 4) * ((GZ + 3) / 4)];
+    const uint32_t want[2] = {4, 8};
+    for (int i = 0; i < 2; i++) {
+        vxl_render_params p = phantom_scene(16, 16, VXL_FILTER_CENTRAL, VXL_CLASSIFY_POST);
+        CHECKF(vxl_renderer_set_volume(rs[i], v) == VXL_OK, "%s", vxl_renderer_error(rs[i]));
+        CHECK(page_brick_of(rs[i], &p) == (i ? 8u : 0u)); /* renders */
+        uint32_t dims[3], brick = 0;
+        CHECKF(vxl_probe_skip_grid(rs[i], dims, &brick, grid, sizeof grid / sizeof grid[0]) == VXL_OK, "%s",
+               vxl_renderer_error(rs[i]));
+        CHECKF(brick == want[i], "storage %d: brick edge %u, want %u", i, brick, want[i]);
+        CHECK(dims[0] == (GX + brick - 1) / brick && dims[2] == (GZ + brick - 1) / brick);
+    }
+    vxl_volume_destroy(v);
+    vxl_renderer_destroy(rs[0]);
+    vxl_renderer_destroy(rs[1]);
 }
 
 /* The source tree's shaders/, from this binary's place (BUILD/tests/):
@@ -317,6 +356,7 @@ int main(void)
     RUN(bspline_prefilter_cpu_equals_glsl_to_rounding);
     RUN(gradient_max_cpu_equals_glsl_to_rounding);
     RUN(brick_minmax_cpu_equals_glsl_bit_for_bit);
+    RUN(dense_storage_skips_with_finer_bricks);
     RUN(shader_dir_reads_the_layout_the_library_embeds);
     return TEST_SUMMARY();
 }

@@ -57,7 +57,7 @@ static int brick_pass(vxl_skipping_state *sk, uint32_t apron, float *out)
 static int build_minmax(vxl_skipping_state *sk)
 {
     vxl_bricks *b = &sk->bricks;
-    b->size = vxl_skip_brick_size();
+    b->size = vxl_skip_brick_size_for(sk->storage->geom.dims);
     for (int a = 0; a < 3; a++) b->dims[a] = (sk->storage->geom.dims[a] + b->size - 1) / b->size;
     size_t n = (size_t)b->dims[0] * b->dims[1] * b->dims[2];
     b->minmax = malloc(n * 2 * sizeof(float));

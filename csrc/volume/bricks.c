@@ -18,6 +18,14 @@ uint32_t vxl_skip_brick_size(void)
     return v >= 4 && v <= 64 ? (uint32_t)v : VXL_DEFAULT_BRICK;
 }
 
+uint32_t vxl_skip_brick_size_for(const uint32_t dims[3])
+{
+    if (getenv("VOXLIGHT_BRICK_SIZE")) return vxl_skip_brick_size();
+    uint64_t n = 1;
+    for (int a = 0; a < 3; a++) n *= (dims[a] + VXL_FINE_BRICK - 1) / VXL_FINE_BRICK;
+    return n <= VXL_FINE_BRICK_MAX_COUNT ? VXL_FINE_BRICK : VXL_DEFAULT_BRICK;
+}
+
 /* Table index a normalised value maps to (as classify.glsl computes it). */
 static double table_pos(const vxl_occupancy_rule *f, double v)
 {

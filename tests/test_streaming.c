@@ -2,13 +2,15 @@
  * docs/streaming.md): a streamed copy (vxl_volume_stream_copy) renders what
  * the whole volume renders in sparse storage (same bricks, PSNR >= 60 dB,
  * for several classifications and cameras); progressive frames start
- * coarse and converge to the F12 frame; a budget too small for full
- * resolution falls back to a coarser level; the renderer outlives the
+ * coarse, mix levels per brick as fine bricks arrive and converge to the
+ * F12 frame; a budget too small for full resolution falls back to a
+ * coarser level; the renderer outlives the
  * volume it streams from; destroying a renderer while it loads is clean
  * (run under the ASan build); a failing read is a clear error, not a crash,
  * and the next frame recovers; what needs every voxel refuses. A wrapper
  * around the source's read (a slow disk, a failing disk, bytes counted)
  * stands in for a file source. */
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
@@ -29,6 +31,37 @@ static const vxl_brick_source_ops *inner_ops;
 static atomic_int read_delay_us;  /* per read of level 0 */
 static atomic_int fail_reads;     /* 1: every read fails */
 static atomic_int reads;
+static atomic_int gate_below;  /* reads of a level below this wait at the gate ... */
+static atomic_int gate_passes; /* ... unless a pass is left: each brick takes one */
+static pthread_mutex_t gate_lock = PTHREAD_MUTEX_INITIALIZER;
+static uint32_t gate_passed[4096][4]; /* the bricks (level, origin) that took one: a second read of one passes */
+static uint32_t gate_n;
+
+static int gate_open_for(uint32_t level, const uint32_t lo[3])
+{
+    pthread_mutex_lock(&gate_lock);
+    int open = 0;
+    for (uint32_t i = 0; i < gate_n && !open; i++)
+        open = gate_passed[i][0] == level && !memcmp(gate_passed[i] + 1, lo, 3 * sizeof *lo);
+    if (!open && atomic_load(&gate_passes) > 0 && gate_n < 4096) {
+        atomic_fetch_sub(&gate_passes, 1);
+        gate_passed[gate_n][0] = level;
+        memcpy(gate_passed[gate_n++] + 1, lo, 3 * sizeof *lo);
+        open = 1;
+    }
+    pthread_mutex_unlock(&gate_lock);
+    return open;
+}
+
+/* Holds the loader's reads of fine levels back, so a test decides exactly
+ * how many fine bricks arrive whatever the number of loader threads (a
+ * brick wanted again while in flight may be read twice: it passes free).
+ * Bounded (20 s), so a failing test cannot hang its destroy. */
+static void gate(uint32_t level, const uint32_t lo[3])
+{
+    for (int i = 0; i < 20000 && (int)level < atomic_load(&gate_below) && !gate_open_for(level, lo); i++)
+        nanosleep(&(struct timespec){0, 1000000L}, NULL);
+}
 
 static int wrapped_read(vxl_brick_source *s, uint32_t level, const uint32_t lo[3], const uint32_t size[3], void *out,
                         vxl_err *e)
@@ -39,6 +72,7 @@ static int wrapped_read(vxl_brick_source *s, uint32_t level, const uint32_t lo[3
         snprintf(e->msg, sizeof e->msg, "test disk: sector not found");
         return VXL_ERR_IO;
     }
+    gate(level, lo);
     if (level == 0 && atomic_load(&read_delay_us)) nanosleep(&(struct timespec){0, atomic_load(&read_delay_us) * 1000L}, NULL);
     int rc = inner_ops->read(s, level, lo, size, out, e);
     if (!rc) /* as a file source counts what it read */
@@ -59,6 +93,9 @@ static vxl_volume *streamed(const vxl_volume *whole, uint32_t n_levels)
     v->source->ops = &wrapped_ops;
     atomic_store(&read_delay_us, 0);
     atomic_store(&fail_reads, 0);
+    atomic_store(&gate_below, 0);
+    atomic_store(&gate_passes, 0);
+    gate_n = 0; /* no loader runs between tests */
     return v;
 }
 
@@ -292,6 +329,131 @@ TEST(progressive_frames_start_coarse_and_converge_to_the_f12_frame)
     fixture_close(&x);
 }
 
+/* Per pixel, the largest difference over the channels. */
+static float pixel_diff(const float *a, const float *b, int i)
+{
+    float d = 0;
+    for (int c = 0; c < 4; c++) d = fmaxf(d, fabsf(a[4 * i + c] - b[4 * i + c]));
+    return d;
+}
+
+/* Renders progressive frames until cond or 2000 frames, counting in rose
+ * the frames whose refine_pending or coarsest level drawn rose. */
+#define REFINE_UNTIL(r, p, out, s, cond, rose)                                           \
+    for (int n_ = 0; !(cond) && n_ < 2000; n_++) {                                      \
+        const vxl_render_stats prev_ = (s);                                             \
+        nanosleep(&(struct timespec){0, 2 * 1000000L}, NULL);                          \
+        REQUIRE(vxl_render((r), (p), (out), NULL) == VXL_OK);                           \
+        (s) = stats_of(r);                                                              \
+        (rose) += (s).refine_pending > prev_.refine_pending || (s).stream_level > prev_.stream_level; \
+    }
+
+/* The F12 frame of level 2: the smallest budget from `budget` up (x1.25)
+ * that draws it. 0 when none does (or a finer level comes first). */
+static int level2_frame(vxl_volume *v, const vxl_render_params *p, uint64_t budget, float *out)
+{
+    for (int i = 0; i < 16; i++, budget += budget / 4) {
+        vxl_renderer *r = make_in(VXL_STORAGE_AUTO, 8, budget);
+        if (!r || vxl_renderer_set_volume(r, v) != VXL_OK) {
+            vxl_renderer_destroy(r);
+            continue;
+        }
+        const int rc = vxl_render(r, p, out, NULL);
+        const uint32_t level = stats_of(r).stream_level;
+        vxl_renderer_destroy(r);
+        if (rc == VXL_OK) return level == 2;
+    }
+    return 0;
+}
+
+TEST(progressive_frames_mix_levels_per_brick)
+{
+    fixture x;
+    REQUIRE(fixture_open(&x, 3, 0));
+    vxl_renderer *r = x.r, *f12 = make_in(VXL_STORAGE_AUTO, 8, 0);
+    REQUIRE(f12 && vxl_renderer_set_volume(f12, x.v) == VXL_OK);
+    static float ref[W * H * 4], lvl2[W * H * 4], coarse[W * H * 4];
+    vxl_render_params p = scene(1);
+    REQUIRE(vxl_render(f12, &p, ref, NULL) == VXL_OK);
+    const uint32_t visible = stats_of(f12).pages_resident;
+    /* the F12 frame of level 2 (a budget only it fits, as in the fallback test) */
+    const uint64_t budget2 = (uint64_t)visible * 1000 * 2 / 3;
+    REQUIRE(level2_frame(x.v, &p, budget2, lvl2));
+
+    /* nothing finer than level 2 arrives: every brick of level 0 reads its
+     * level-2 ancestor (4x coarser), which is the level-2 F12 frame */
+    atomic_store(&gate_below, 2);
+    p.progressive = 1;
+    REQUIRE(vxl_render(r, &p, img, NULL) == VXL_OK);
+    vxl_render_stats s = stats_of(r);
+    double psnr = image_psnr(img, lvl2, W * H * 4);
+    fprintf(stderr, "  level 2 only: drawn %u, %u pending, %.1f dB against level 2's F12 frame\n", s.stream_level,
+            s.refine_pending, psnr);
+    CHECK(s.lod_level == 0 && s.stream_level == 2 && s.refine_pending == visible);
+    CHECKF(psnr >= 60, "%.1f dB", psnr);
+    /* so do the paths that read the pool through the table: pre-classified
+     * pool, pre-integration, the illumination volume, MIP and ISO; and
+     * cubic smoothing, whose coefficients are voxels (paged_fetch: the
+     * ancestor interpolated at each voxel, a smoothing of level 2 as the
+     * level-2 frame's spline is) */
+    for (int v = 0; v < 6; v++) {
+        vxl_render_params q = scene(v < 3 ? v + 3 : 1);
+        if (v == 3) q.mode = VXL_MODE_MIP;
+        if (v == 4) q.mode = VXL_MODE_ISO, q.iso_value = 60;
+        if (v == 5) q.filter = VXL_FILTER_CUBIC_SMOOTH;
+        q.illumination_size = 8; /* the least, so the small budget does not halve it */
+        CHECKF(level2_frame(x.v, &q, budget2, lvl2), "variant %d: no level-2 F12 frame", v);
+        q.progressive = 1;
+        int rc = vxl_render(r, &q, img, NULL);
+        CHECKF(rc == VXL_OK, "variant %d: %s", v, vxl_last_error());
+        s = stats_of(r);
+        const double db = image_psnr(img, lvl2, W * H * 4);
+        fprintf(stderr, "  variant %d: drawn %u, %.1f dB against level 2's F12 frame, alpha %.1f\n", v, s.stream_level, db,
+                alpha_sum(img, W * H));
+        CHECK(s.stream_level == 2 && alpha_sum(img, W * H) > 1);
+        CHECKF(db >= (v == 5 ? 40 : 60), "variant %d: %.1f dB", v, db); /* paged_fetch read the slot as level 0: 30 dB */
+    }
+    REQUIRE(vxl_render(r, &p, img, NULL) == VXL_OK);
+    s = stats_of(r);
+
+    /* level 1 arrives, level 0 not: every brick reads its level-1 parent */
+    int rose = 0;
+    atomic_store(&gate_below, 1);
+    REFINE_UNTIL(r, &p, img, s, s.stream_level == 1, rose);
+    CHECK(s.stream_level == 1 && s.refine_pending == visible);
+    memcpy(coarse, img, sizeof coarse);
+
+    /* a third of level 0's visible bricks arrive (the nearest to the eye) */
+    const uint32_t k = visible / 3;
+    atomic_store(&gate_passes, (int)k);
+    REFINE_UNTIL(r, &p, img, s, s.refine_pending == visible - k, rose);
+    CHECKF(s.refine_pending == visible - k && s.stream_level == 1, "%u pending, level %u", s.refine_pending, s.stream_level);
+    /* part of the image is the F12 frame, the rest still level 1's */
+    uint32_t fine = 0, still = 0, differ = 0;
+    for (int i = 0; i < W * H; i++) {
+        if (pixel_diff(ref, coarse, i) < 0.02f) continue; /* the levels agree there */
+        differ++;
+        fine += pixel_diff(img, ref, i) < 1e-3f;
+        still += pixel_diff(img, coarse, i) < 1e-3f;
+    }
+    const double to_f12 = image_psnr(img, ref, W * H * 4), coarse_to_f12 = image_psnr(coarse, ref, W * H * 4);
+    fprintf(stderr, "  %u of %u bricks: of %u pixels where the levels differ, %u are the F12 frame's, %u level 1's "
+            "(%.1f dB to F12, level 1 %.1f dB)\n", k, visible, differ, fine, still, to_f12, coarse_to_f12);
+    CHECK(fine > 0 && still > 0);
+    CHECK(to_f12 > coarse_to_f12);
+
+    /* the rest arrives: the frame refines brick by brick to the F12 frame */
+    atomic_store(&gate_below, 0);
+    REFINE_UNTIL(r, &p, img, s, s.refine_pending == 0, rose);
+    psnr = image_psnr(img, ref, W * H * 4);
+    fprintf(stderr, "  refined: %.1f dB against F12\n", psnr);
+    CHECK(s.refine_pending == 0 && s.stream_level == 0);
+    CHECK(rose == 0); /* neither pending bricks nor the coarsest level drawn ever rose */
+    CHECKF(psnr >= 60, "%.1f dB", psnr);
+    vxl_renderer_destroy(f12);
+    fixture_close(&x);
+}
+
 TEST(a_small_budget_falls_back_to_a_coarser_level)
 {
     fixture x;
@@ -406,6 +568,7 @@ int main(void)
     RUN(the_first_frame_reads_bytes_and_the_float_volume_matches);
     RUN(a_volume_over_the_texture_limit_streams);
     RUN(progressive_frames_start_coarse_and_converge_to_the_f12_frame);
+    RUN(progressive_frames_mix_levels_per_brick);
     RUN(a_small_budget_falls_back_to_a_coarser_level);
     RUN(the_renderer_outlives_the_volume_and_destroy_while_loading_is_clean);
     RUN(a_failing_read_is_a_clear_error_and_the_next_frame_recovers);

@@ -74,9 +74,11 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
 {
     char defines[512] = "";
     const char *fdef = filter < VXL_FILTER_COUNT ? filter_defines[filter] : filter_defines[0];
-    const char *paged = (flags & VXL_FLAG_COMPRESSED_DOMAIN) ? "#define PAGED 1\n#define COMPRESSED_DOMAIN 1\n"
-                        : (flags & VXL_FLAG_PAGED)            ? "#define PAGED 1\n"
-                                                              : "";
+    const uint32_t storage = flags & (VXL_FLAG_PAGED | VXL_FLAG_COMPRESSED_DOMAIN);
+    const char *paged = storage == (VXL_FLAG_PAGED | VXL_FLAG_COMPRESSED_DOMAIN) ? "#define PAGED 1\n#define COMPRESSED_DOMAIN 1\n"
+                        : storage == VXL_FLAG_PAGED                              ? "#define PAGED 1\n"
+                        : storage == VXL_FLAG_PAGED_MIXED                        ? "#define PAGED 1\n#define PAGED_MIXED 1\n"
+                                                                                 : "";
     GLuint a = 0, b = 0;
     int rc;
     switch (kind) {

@@ -12,10 +12,10 @@
  * that level is resident (F12), or (progressive, the viewport) waits only
  * for the coarsest level's visible bricks, asks for those of every finer
  * level down to the chosen one (coarser first, each nearest to the eye
- * first), and draws from the finest level whose visible bricks are all
- * resident; a later frame is finer. The shader samples one level per
- * frame (one page table): bricks of different levels are not mixed within
- * a frame. */
+ * first), and draws whatever has arrived: the frame's page table is its
+ * level's, in which a visible brick not read yet stands in for its finest
+ * resident coarser ancestor (shader define PAGED_MIXED, lib/common.glsl),
+ * so each brick refines as it arrives. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,8 +36,11 @@ typedef struct vxl_stream {
     int32_t *slot_of;        /* per brick: its pool slot, -1 when not resident */
     uint8_t *need;           /* per brick: the last frame can read it */
     float *entries;          /* per brick: its page entry (RGBA, as paged.c's) */
-    GLuint page_tex[VXL_LOD_LEVELS];
-    int dirty[VXL_LOD_LEVELS];
+    float *mixed;            /* the drawn level's entries with ancestors standing in (level 0's count) */
+    GLuint page_tex;         /* `mixed` on the GPU: the one page table drawn */
+    int dirty;               /* an entry, the visible set or the level changed since `mixed` was made */
+    uint32_t mixed_level;    /* the level `mixed` is of */
+    uint32_t coarsest_drawn; /* the coarsest level a visible brick of `mixed` reads */
     uint32_t needed[VXL_LOD_LEVELS], constant[VXL_LOD_LEVELS];
     uint64_t need_key;       /* the occupancy, reach and `all` need was derived for */
     int need_valid;
@@ -237,18 +240,18 @@ static void release_streamed(vxl_storage_state *st)
     vxl_stream *s = st->stream;
     if (s) {
         vxl_loader_stop(s->loader); /* joined: no read is in progress past here */
-        for (int k = 0; k < VXL_LOD_LEVELS; k++)
-            if (s->page_tex[k]) st->gpu->gl.DeleteTextures(1, &s->page_tex[k]);
+        if (s->page_tex) st->gpu->gl.DeleteTextures(1, &s->page_tex);
         free(s->slot_of);
         free(s->need);
         free(s->entries);
+        free(s->mixed);
         free(s->slot_brick);
         free(s->arrived);
         vxl_brick_source_free(s->src);
         free(s);
         st->stream = NULL;
     }
-    st->page_tex = 0; /* one of the page tables above */
+    st->page_tex = 0; /* the page table above */
     vxl_paged_release(st);
 }
 
@@ -278,8 +281,9 @@ static int install_streamed(vxl_storage_state *st, const vxl_volume *v, vxl_stor
     s->slot_of = malloc(n * sizeof *s->slot_of);
     s->need = calloc(n ? n : 1, 1);
     s->entries = malloc(n * 4 * sizeof *s->entries);
+    s->mixed = malloc((n ? vxl_page_count(&st->levels[0]) : 1) * 4 * sizeof *s->mixed);
     s->arrived = malloc(s->queue_bricks * sizeof *s->arrived);
-    if (!s->slot_of || !s->need || !s->entries || !s->arrived)
+    if (!s->slot_of || !s->need || !s->entries || !s->mixed || !s->arrived)
         return vxl_fail(&st->gpu->err, VXL_ERR_NO_MEMORY, "out of memory for the page tables of %llu bricks",
                         (unsigned long long)n);
     for (uint32_t k = 0; k < st->n_levels; k++) {
@@ -289,8 +293,8 @@ static int install_streamed(vxl_storage_state *st, const vxl_volume *v, vxl_stor
             set_absent(pg, i, s->entries + 4 * (s->first[k] + i));
             s->constant[k] += pg->data_index[i] < 0;
         }
-        s->dirty[k] = 1;
     }
+    s->dirty = 1;
     s->read_mark = __atomic_load_n(&s->src->bytes_read, __ATOMIC_RELAXED);
     return vxl_loader_start(&s->loader, s->src, st->levels[0].brick, s->queue_bricks, &st->gpu->err);
 }
@@ -325,7 +329,7 @@ static int64_t take_slot(vxl_storage_state *st)
             const uint32_t k = level_of(s, flat);
             s->slot_of[flat] = -1;
             set_absent(&st->levels[k], flat - s->first[k], s->entries + 4 * flat);
-            s->dirty[k] = 1;
+            s->dirty = 1;
         }
         s->hand = (h + 1) % s->capacity;
         return h;
@@ -354,7 +358,7 @@ static void upload_brick(vxl_storage_state *st, const vxl_loaded_brick *b)
     pe[3] = -1;
     s->slot_of[flat] = (int32_t)slot;
     s->slot_brick[slot] = flat + 1;
-    s->dirty[b->key.level] = 1;
+    s->dirty = 1;
     s->uploaded = 1;
     if (b->key.level == s->target && s->missing_target) s->missing_target--;
     if (b->key.level == s->coarse && s->coarse != s->target && s->missing_coarse) s->missing_coarse--;
@@ -429,7 +433,7 @@ static int ensure_pool(vxl_storage_state *st, uint32_t required, uint64_t fixed)
         const uint64_t flat = sb[i] - 1;
         float *pe = s->entries + 4 * flat;
         for (int a = 0; a < 3; a++) pe[a] = (float)(n[a] + VXL_PAGE_GHOST);
-        s->dirty[level_of(s, flat)] = 1;
+        s->dirty = 1;
     }
     if (old) gl->DeleteTextures(1, &old);
     free(s->slot_brick);
@@ -533,7 +537,51 @@ static int wait_for(vxl_storage_state *st, const vxl_frame *f, const uint64_t *m
     return VXL_OK;
 }
 
-static int level_drawable(const vxl_stream *s, const vxl_pages *pg, uint32_t k) { return count_missing(s, pg, k) == 0; }
+/* The page table of level L as drawn: each visible data brick of L that is
+ * not resident reads its finest resident coarser ancestor instead. With
+ * brick n at every level and s = 2^(k-L), ancestor bc = b / s (clamped to
+ * its grid: a pyramid that floors odd sizes) holds level-L position q at
+ * (q + 0.5) / s - 0.5 - bc n of its brick, so the entry (w = -s) keeps
+ * xyz = corner + (b n + 0.5) / s - 0.5 - bc n and the shader adds
+ * (q - b n) / s: sums of integers and multiples of 1/16, exact in float.
+ * Constant and invisible bricks keep their value, resident ones their own
+ * entry, so a frame with every visible brick of L resident draws exactly
+ * that level's table. Returns the coarsest level a visible brick reads. */
+static uint32_t make_mixed(vxl_stream *s, const vxl_pages *levels, uint32_t n_levels, uint32_t L)
+{
+    const vxl_pages *pg = &levels[L];
+    const uint64_t count = vxl_page_count(pg);
+    const uint32_t n = pg->brick;
+    uint32_t coarsest = L;
+    memcpy(s->mixed, s->entries + 4 * s->first[L], count * 4 * sizeof *s->mixed);
+    for (uint64_t i = 0; i < count; i++) {
+        const uint64_t flat = s->first[L] + i;
+        if (pg->data_index[i] < 0 || !s->need[flat] || s->slot_of[flat] >= 0) continue;
+        const uint64_t b[3] = {i % pg->grid[0], i / pg->grid[0] % pg->grid[1], i / ((uint64_t)pg->grid[0] * pg->grid[1])};
+        float *pe = s->mixed + 4 * i;
+        for (uint32_t k = L + 1; k < n_levels; k++) {
+            const vxl_pages *pk = &levels[k];
+            const uint32_t sh = k - L;
+            uint64_t bc[3];
+            for (int a = 0; a < 3; a++) bc[a] = (b[a] >> sh) < pk->grid[a] ? b[a] >> sh : pk->grid[a] - 1;
+            const uint64_t j = bc[0] + pk->grid[0] * (bc[1] + (uint64_t)pk->grid[1] * bc[2]);
+            if (pk->data_index[j] < 0) { /* one value there, so here too (the plan is the same index's) */
+                pe[0] = pe[1] = pe[2] = 0;
+                pe[3] = pk->low[j];
+            } else if (s->slot_of[s->first[k] + j] >= 0) {
+                const float *ae = s->entries + 4 * (s->first[k] + j);
+                const double scale = (double)(1u << sh);
+                for (int a = 0; a < 3; a++)
+                    pe[a] = (float)(ae[a] + ((double)b[a] * n + 0.5) / scale - 0.5 - (double)bc[a] * n);
+                pe[3] = (float)-scale;
+            } else
+                continue;
+            coarsest = k > coarsest ? k : coarsest;
+            break;
+        }
+    }
+    return coarsest;
+}
 
 static int prepare_streamed(vxl_storage_state *st, const vxl_frame *f)
 {
@@ -546,10 +594,12 @@ static int prepare_streamed(vxl_storage_state *st, const vxl_frame *f)
     uint64_t fixed = fixed_bytes(st->levels, st->n_levels, s->queue_bricks);
     /* what each level's frame reads follows the occupancy: re-derived when it changes */
     const uint64_t need_key = (st->grid->tf_key * 1099511628211ull ^ st->visible_reach) * 2 + (st->visible_all != 0);
-    if (!s->need_valid || need_key != s->need_key)
+    if (!s->need_valid || need_key != s->need_key) {
         for (uint32_t k = 0; k < st->n_levels; k++)
             s->needed[k] = vxl_pages_needed(&st->levels[k], st->grid, st->visible_reach, 1u << k, st->visible_all, NULL,
                                             s->need + s->first[k]);
+        s->dirty = 1;
+    }
     s->need_key = need_key;
     s->need_valid = 1;
     /* the finest level whose visible bricks (with the coarser levels kept
@@ -584,22 +634,24 @@ static int prepare_streamed(vxl_storage_state *st, const vxl_frame *f)
     s->load_ms = now_ms() - t0;
     if (rc) return rc;
     if (drain(st, 0) < 0) return st->gpu->err.code;
-    uint32_t drawn = L;
-    while (drawn < C && !level_drawable(s, &st->levels[drawn], drawn)) drawn++;
-    s->refine_pending = drawn != L ? (uint32_t)s->missing_target : 0;
-    s->stream_level = drawn;
-    if (s->dirty[drawn] || !s->page_tex[drawn]) {
+    /* the table drawn, made again and uploaded only when what it says changed */
+    const int remade = s->dirty || s->mixed_level != L || !s->page_tex;
+    if (remade) {
+        s->coarsest_drawn = make_mixed(s, st->levels, st->n_levels, L);
+        s->mixed_level = L;
         st->gpu->gl.ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
-        vxl_page_table_upload(st, &s->page_tex[drawn], &st->levels[drawn], s->entries + 4 * s->first[drawn]);
-        s->dirty[drawn] = 0;
+        vxl_page_table_upload(st, &s->page_tex, &st->levels[L], s->mixed);
+        s->dirty = 0;
     }
+    s->refine_pending = (uint32_t)count_missing(s, &st->levels[L], L); /* 0 for F12, which waited */
+    s->stream_level = s->coarsest_drawn;
     if ((rc = vxl_gl_check(st->gpu, "uploading streamed bricks"))) return rc;
-    if (s->uploaded || st->level != drawn) st->pool_generation++; /* what is derived from the pool is stale */
+    if (s->uploaded || remade || st->level != L) st->pool_generation++; /* what is derived from the pool or read through the table is stale */
     s->uploaded = 0;
-    st->level = drawn;
-    st->page_tex = s->page_tex[drawn];
-    st->pages_resident = s->needed[drawn];
-    st->pages_constant = s->constant[drawn];
+    st->level = L;
+    st->page_tex = s->page_tex;
+    st->pages_resident = s->needed[L];
+    st->pages_constant = s->constant[L];
     st->pool_bytes = pool_bytes_for(st, &st->levels[0], s->capacity, slots) + fixed;
     st->lod_wanted_bytes = L ? wanted : 0;
     const uint64_t read = __atomic_load_n(&s->src->bytes_read, __ATOMIC_RELAXED);
@@ -640,12 +692,20 @@ static void report_streamed(const vxl_storage_state *st, vxl_render_stats *out)
     out->load_ms = s->load_ms;
 }
 
+/* Programs sample through the mixed page table (PAGED_MIXED): a variant
+ * of its own, so every other storage's programs stay as they are. */
+static uint32_t sample_flags_streamed(const vxl_storage_state *st)
+{
+    (void)st;
+    return VXL_FLAG_PAGED_MIXED;
+}
+
 const vxl_storage_ops vxl_storage_streamed = {
     .plan = plan_streamed,
     .install = install_streamed,
     .check_filter = check_streamed,
     .prepare = prepare_streamed,
-    .sample_flags = vxl_paged_sample_flags,
+    .sample_flags = sample_flags_streamed,
     .bind = vxl_paged_bind,
     .texels = vxl_paged_texels,
     .resident_bytes = vxl_paged_resident_bytes,

@@ -24,6 +24,14 @@ float sample_value(vec3 p) { return textureLod(u_volume, voxel_to_tex(p), 0.0).r
 // footprint of a position inside its brick.
 // u_lod_scale > 1: a coarser level (LOD fallback) of u_page_dims voxels,
 // each the mean of u_lod_scale^3 full-resolution ones.
+// PAGED_MIXED (streamed storage only, storage_streamed.c): a progressive
+// frame mixes levels per brick. An entry with w < -1 is a brick of the
+// level not read yet, standing in for its finest resident coarser ancestor
+// s = -w times coarser (bricks nest, the same size at every level): pool
+// position = xyz + (q - brick corner) / s, xyz folding in the ancestor's
+// slot and the fine brick's place in it (exact in the RGBA32F table). The
+// footprint stays inside the ancestor's brick and ghost. w == -1 is a
+// resident brick, read exactly as without PAGED_MIXED.
 uniform sampler3D u_page;
 uniform vec3 u_pool_dims;
 uniform vec3 u_page_dims;
@@ -62,7 +70,11 @@ vec4 page_entry(sampler3D table, inout vec3 q)
     q = clamp(q, vec3(0.0), u_page_dims - 1.0);
     ivec3 b = ivec3(floor((q + 0.5) / u_page_brick));
     vec4 e = texelFetch(table, b, 0);
+#ifdef PAGED_MIXED
+    q = e.w < -1.0 ? e.xyz + (q - vec3(b) * u_page_brick) / -e.w : e.xyz + q - vec3(b) * u_page_brick;
+#else
     q = e.xyz + q - vec3(b) * u_page_brick;
+#endif
     return e;
 }
 
@@ -94,6 +106,11 @@ float paged_fetch(ivec3 c)
     ivec3 b = c / n;
     vec4 e = texelFetch(u_page, b, 0);
     if (e.w >= 0.0) return e.w;
+#ifdef PAGED_MIXED
+    // a stand-in ancestor: its field at voxel c's centre (trilinear), so
+    // stencils over a coarse region see a smooth field, not steps of s voxels
+    if (e.w < -1.0) return textureLod(u_volume, (e.xyz + vec3(c - b * n) / -e.w + 0.5) / u_pool_dims, 0.0).r;
+#endif
 #ifndef COMPRESSED_DOMAIN
     return texelFetch(u_volume, ivec3(e.xyz) + c - b * n, 0).r;
 #else

@@ -5,7 +5,9 @@
  * whole-volume load and its vxl_volume_downsample2 chain texel for texel,
  * the index equals vxl_bricks_minmax_cpu (at the index brick every source uses); a second open reads the cache, a
  * touched or changed source rebuilds it, damage anywhere is detected and
- * never trusted, a cancel leaves no file, cache_dir is honoured. Calls the
+ * never trusted, a cancel leaves no file, cache_dir is honoured; page bricks
+ * with their ghost read as one stored brick, the renderer's loader with
+ * 1 and 4 threads brings every brick whole, an old format is rebuilt. Calls the
  * cache's internals, so the Makefile links their objects into this test. */
 #include <dirent.h>
 #include <fcntl.h>
@@ -17,9 +19,11 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include "brick_cache.h"
 #include "brick_cache_format.h"
+#include "brick_loader.h"
 #include "bricks.h"
 #include "harness.h"
 #include "loader_test_util.h"
@@ -688,6 +692,274 @@ TEST(vxl_volume_load_streams_a_gz_through_the_cache)
     unlink(s.path);
 }
 
+/* The texels of level L of whole (its downsample chain; the caller frees
+ * the result when it is not whole). */
+static vxl_volume *level_of(const vxl_volume *whole, uint32_t L)
+{
+    vxl_volume *cur = (vxl_volume *)whole;
+    vxl_err e = {0};
+    for (uint32_t k = 0; k < L && cur; k++) {
+        vxl_volume *next = NULL;
+        if (vxl_volume_downsample2(cur, &next, &e) != VXL_OK) next = NULL;
+        if (cur != whole) vxl_volume_destroy(cur);
+        cur = next;
+    }
+    return cur;
+}
+
+/* The box a renderer's loader asks for page brick c of edge P at level
+ * dims: the brick with its one-voxel ghost, cut at the level's edges. */
+static void page_box(const uint32_t c[3], uint32_t P, const uint32_t *dims, uint32_t lo[3], uint32_t sz[3])
+{
+    for (int a = 0; a < 3; a++) {
+        const int64_t l = (int64_t)c[a] * P - 1, h = (int64_t)c[a] * P + P;
+        lo[a] = l < 0 ? 0 : (uint32_t)l;
+        sz[a] = (uint32_t)(h < dims[a] ? h : dims[a] - 1) - lo[a] + 1;
+    }
+}
+
+/* Version 2 stores each brick with a one-voxel apron: a page brick of the
+ * cache's edge is one stored brick (decoded in place), of twice the edge
+ * eight; boxes at random exercise the covering bricks' choice and, touching
+ * far more bricks than the decoded-brick LRU holds, its eviction. */
+TEST(page_bricks_and_random_boxes_equal_the_whole_load)
+{
+    static const uint32_t types[2] = {VXL_DTYPE_U8, VXL_DTYPE_I16};
+    for (int t = 0; t < 2; t++) {
+        fixture f = {.s = {.dtype = types[t], .dims = {100, 61, 45}, .slope = 1, .inter = 0}};
+        REQUIRE(fixture_open(&f, "boxes.nii.gz", 9 + t) == 0);
+        uint8_t *buf = malloc((size_t)f.whole->storage_bytes);
+        REQUIRE(buf);
+        uint32_t rng = 77u + t;
+        for (uint32_t L = 0; L < f.src->n_levels; L++) {
+            vxl_volume *ref = level_of(f.whole, L);
+            REQUIRE(ref);
+            const uint32_t *d = ref->dims;
+            int bad = 0, n = 0;
+            for (uint32_t P = 4; P <= 16; P *= 2) { /* the cache's brick is 8 */
+                const uint32_t g[3] = {(d[0] + P - 1) / P, (d[1] + P - 1) / P, (d[2] + P - 1) / P};
+                for (uint32_t cz = 0; cz < g[2]; cz++)
+                    for (uint32_t cy = 0; cy < g[1]; cy++)
+                        for (uint32_t cx = 0; cx < g[0]; cx++) {
+                            uint32_t lo[3], sz[3];
+                            page_box((const uint32_t[3]){cx, cy, cz}, P, d, lo, sz);
+                            vxl_err e = {0};
+                            n++;
+                            if (f.src->ops->read(f.src, L, lo, sz, buf, &e) != VXL_OK || !box_equals(buf, ref, lo, sz)) bad++;
+                        }
+            }
+            for (int k = 0; k < 400; k++) {
+                uint32_t lo[3], sz[3];
+                for (int a = 0; a < 3; a++) {
+                    rng = rng * 1664525u + 1013904223u;
+                    lo[a] = (rng >> 8) % d[a];
+                    sz[a] = 1 + (rng >> 20) % (k % 2 ? d[a] - lo[a] : (d[a] - lo[a] < 12 ? d[a] - lo[a] : 12));
+                }
+                vxl_err e = {0};
+                n++;
+                if (f.src->ops->read(f.src, L, lo, sz, buf, &e) != VXL_OK || !box_equals(buf, ref, lo, sz)) bad++;
+            }
+            CHECKF(bad == 0, "type %u level %u: %d of %d boxes differ", types[t], L, bad, n);
+            if (ref != f.whole) vxl_volume_destroy(ref);
+        }
+        free(buf);
+        fixture_close(&f);
+    }
+}
+
+/* The renderer's loader over a cache, with 1 and 4 threads and page bricks
+ * of the cache's edge and twice it: every brick of every level arrives
+ * exactly once, also while the wanted list is renewed after every take,
+ * and equals the level's voxels with the edge-repeating ghost (what
+ * paging.c cuts from a whole volume). */
+TEST(loader_threads_give_every_brick_with_its_ghost)
+{
+    fixture f = {.s = {.dtype = VXL_DTYPE_U16, .dims = {53, 38, 27}, .slope = 1, .inter = 0}};
+    REQUIRE(fixture_open(&f, "loader.nii.gz", 4) == 0);
+    const uint32_t tb = f.src->texture_bits / 8;
+    for (uint32_t threads = 1; threads <= 4; threads += 3)
+        for (uint32_t P = 8; P <= 16; P *= 2) {
+            const uint32_t E = P + 2;
+            /* every brick of every level, coarsest first */
+            uint32_t total = 0, first[VXL_SOURCE_MAX_LEVELS + 1];
+            for (uint32_t L = 0; L < f.src->n_levels; L++) {
+                first[L] = total;
+                const uint32_t *d = f.src->level_dims[L];
+                total += ((d[0] + P - 1) / P) * ((d[1] + P - 1) / P) * ((d[2] + P - 1) / P);
+            }
+            first[f.src->n_levels] = total;
+            vxl_brick_key *keys = malloc(total * sizeof *keys);
+            uint8_t *seen = calloc(total, 1);
+            REQUIRE(keys && seen);
+            uint32_t n = 0;
+            for (uint32_t L = f.src->n_levels; L-- > 0;)
+                for (uint32_t i = 0; i < first[L + 1] - first[L]; i++) keys[n++] = (vxl_brick_key){L, i};
+            vxl_brick_loader *ld = NULL;
+            vxl_err e = {0};
+            REQUIRE(vxl_loader_start_threads(&ld, f.src, P, 6, threads, &e) == VXL_OK);
+            REQUIRE(vxl_loader_want(ld, keys, n, &e) == VXL_OK);
+            vxl_volume *refs[VXL_SOURCE_MAX_LEVELS] = {0};
+            for (uint32_t L = 0; L < f.src->n_levels; L++) refs[L] = level_of(f.whole, L);
+            uint32_t got = 0, bad = 0, twice = 0;
+            vxl_loaded_brick arrived[6];
+            while (got < total) {
+                const uint32_t k = vxl_loader_take(ld, arrived, 6, 1);
+                if (!k) break;
+                for (uint32_t j = 0; j < k; j++) {
+                    const vxl_brick_key key = arrived[j].key;
+                    const vxl_volume *ref = refs[key.level];
+                    const uint32_t *d = ref->dims, g0 = (d[0] + P - 1) / P, g1 = (d[1] + P - 1) / P;
+                    const uint32_t c[3] = {key.brick % g0, key.brick / g0 % g1, key.brick / (g0 * g1)};
+                    twice += seen[first[key.level] + key.brick]++;
+                    for (uint32_t z = 0; z < E; z++)
+                        for (uint32_t y = 0; y < E; y++)
+                            for (uint32_t x = 0; x < E; x++) {
+                                const uint32_t v[3] = {x, y, z};
+                                uint64_t at = 0;
+                                for (int a = 2; a >= 0; a--) {
+                                    int64_t q = (int64_t)c[a] * P + v[a] - 1;
+                                    q = q < 0 ? 0 : q >= d[a] ? d[a] - 1 : q;
+                                    at = at * d[a] + (uint64_t)q;
+                                }
+                                bad += memcmp(arrived[j].texels + (((size_t)z * E + y) * E + x) * tb,
+                                              (const uint8_t *)ref->texels + at * tb, tb) != 0;
+                            }
+                }
+                got += k;
+                vxl_loader_recycle(ld, arrived, k);
+                /* as the renderer does each frame: ask again for every brick
+                 * not yet taken, those being read or waiting in the queue
+                 * included; the loader must not read those twice */
+                uint32_t m = 0;
+                for (uint32_t L = f.src->n_levels; L-- > 0;)
+                    for (uint32_t i = 0; i < first[L + 1] - first[L]; i++)
+                        if (!seen[first[L] + i]) keys[m++] = (vxl_brick_key){L, i};
+                REQUIRE(vxl_loader_want(ld, keys, m, &e) == VXL_OK);
+            }
+            CHECKF(vxl_loader_error(ld, &e) == VXL_OK, "threads %u: %s", threads, e.msg);
+            CHECKF(got == total && twice == 0, "threads %u, brick %u: %u of %u bricks arrived (%u twice)", threads, P,
+                   got, total, twice);
+            CHECKF(bad == 0, "threads %u, brick %u: %u voxels differ", threads, P, bad);
+            vxl_loader_stop(ld);
+            for (uint32_t L = 0; L < f.src->n_levels; L++)
+                if (refs[L] != f.whole) vxl_volume_destroy(refs[L]);
+            free(keys);
+            free(seen);
+        }
+    fixture_close(&f);
+}
+
+/* A cache of another format version (version 1 stored bricks without their
+ * apron) is never read as this one: the open rebuilds it. */
+TEST(an_old_format_version_is_rebuilt)
+{
+    fixture f = {.s = {.dtype = VXL_DTYPE_U8, .dims = {30, 20, 19}, .slope = 1, .inter = 0}};
+    REQUIRE(fixture_open(&f, "old.nii.gz", 3) == 0);
+    vxl_brick_source_free(f.src);
+    f.src = NULL;
+    /* the header as version 1 wrote it: version 1, its checksum fixed up */
+    int fd = open(f.cache, O_RDWR);
+    uint8_t head[VXL_CACHE_HEADER_BYTES];
+    REQUIRE(fd >= 0 && pread(fd, head, sizeof head, 0) == (ssize_t)sizeof head);
+    const uint32_t old = 1;
+    memcpy(head + 8, &old, 4);
+    const uint32_t crc = (uint32_t)crc32(crc32(0L, Z_NULL, 0), head, VXL_CACHE_HEADER_BYTES - 4);
+    memcpy(head + VXL_CACHE_HEADER_BYTES - 4, &crc, 4);
+    REQUIRE(pwrite(fd, head, sizeof head, 0) == (ssize_t)sizeof head);
+    close(fd);
+    vxl_cache_header h;
+    vxl_err e = {0};
+    CHECK(vxl_cache_header_decode(head, &h, f.cache, &e) == VXL_ERR_FORMAT && strstr(e.msg, "version 1"));
+    vxl_load_options o = options(NULL, NULL);
+    vxl_brick_cache_info info;
+    REQUIRE(open_cache(&f.s, &o, &f.src, &e) == VXL_OK && info_of(f.src, &info) == VXL_OK);
+    CHECK(info.built == 1);
+    fd = open(f.cache, O_RDONLY);
+    REQUIRE(fd >= 0 && pread(fd, head, sizeof head, 0) == (ssize_t)sizeof head);
+    close(fd);
+    CHECK(vxl_cache_header_decode(head, &h, f.cache, &e) == VXL_OK);
+    check_levels(T_, f.src, f.whole);
+    /* where the compressed stream starts is part of the key */
+    vxl_raw_layout l;
+    layout_of(&f.s, &l);
+    CHECK(vxl_cache_header_matches(&h, &l));
+    l.compressed_start = 1;
+    CHECK(!vxl_cache_header_matches(&h, &l));
+    fixture_close(&f);
+}
+
+/* Appends data to f as a gzip (window 31) or zlib (15) stream; 0 on success. */
+static int append_deflated(FILE *f, const void *data, size_t n, int window)
+{
+    z_stream z;
+    memset(&z, 0, sizeof z);
+    if (deflateInit2(&z, 6, Z_DEFLATED, window, 8, Z_DEFAULT_STRATEGY) != Z_OK) return -1;
+    const uLong cap = deflateBound(&z, (uLong)n);
+    uint8_t *out = malloc(cap);
+    z.next_in = (Bytef *)data;
+    z.avail_in = (uInt)n;
+    z.next_out = out;
+    z.avail_out = (uInt)cap;
+    const int ok = out && deflate(&z, Z_FINISH) == Z_STREAM_END &&
+                   fwrite(out, 1, cap - z.avail_out, f) == cap - z.avail_out;
+    deflateEnd(&z);
+    free(out);
+    return ok ? 0 : -1;
+}
+
+/* Gzip data after a NRRD header (in two concatenated gzip members) and zlib
+ * data after a MetaImage header stream through the cache, which inflates
+ * from the byte after the header (vxl_raw_layout.compressed_start), and
+ * equal the whole read: every level, the index, boxes. */
+TEST(attached_nrrd_gzip_and_zlib_metaimage_stream_through_the_cache)
+{
+    const uint32_t d[3] = {70, 33, 21};
+    const size_t n = (size_t)d[0] * d[1] * d[2] * 2;
+    uint16_t *data = make_data(VXL_DTYPE_U16, d, 5);
+    REQUIRE(data);
+    const char *dir = tmp_path("attached_caches");
+    static const char *names[2] = {"attached.nrrd", "attached.mha"};
+    static const char *heads[2] = {
+        "NRRD0004\n# attached gzip\ntype: ushort\ndimension: 3\nsizes: 70 33 21\nencoding: gzip\nendian: little\n\n",
+        "ObjectType = Image\nNDims = 3\nCompressedData = True\nDimSize = 70 33 21\nElementType = MET_USHORT\n"
+        "BinaryDataByteOrderMSB = False\nElementDataFile = LOCAL\n"};
+    for (int k = 0; k < 2; k++) {
+        char path[256];
+        snprintf(path, sizeof path, "%s", tmp_path(names[k]));
+        FILE *f = fopen(path, "wb");
+        REQUIRE(f);
+        int bad = fputs(heads[k], f) < 0;
+        if (k == 0) /* two gzip members, cut inside a row */
+            bad |= append_deflated(f, data, 1001, 31) || append_deflated(f, (uint8_t *)data + 1001, n - 1001, 31);
+        else
+            bad |= append_deflated(f, data, n, 15);
+        bad |= fclose(f) != 0;
+        REQUIRE(!bad);
+        vxl_load_options o = options(NULL, NULL);
+        vxl_volume *whole = NULL, *streamed = NULL;
+        REQUIRE(vxl_volume_load(path, &o, &whole) == VXL_OK);
+        o.streaming = VXL_STREAMING_ON;
+        o.cache_dir = dir;
+        for (int pass = 0; pass < 2; pass++) { /* the second open reads the cache the first wrote */
+            int rc = vxl_volume_load(path, &o, &streamed);
+            CHECKF(rc == VXL_OK, "%s: %s", names[k], vxl_last_error());
+            if (rc) break;
+            vxl_volume_info info = {.struct_size = sizeof info};
+            CHECK(vxl_volume_get_info(streamed, &info) == VXL_OK && info.streamed == 1 && streamed->source);
+            char files[4][256];
+            CHECKF(files_in(dir, files, 4) == 1 + k && (strstr(files[0], names[k]) || strstr(files[1], names[k])),
+                   "%s: no cache in %s", names[k], dir);
+            CHECK(streamed->tex_lo == whole->tex_lo && streamed->tex_hi == whole->tex_hi);
+            check_levels(T_, streamed->source, whole);
+            vxl_volume_destroy(streamed);
+            streamed = NULL;
+        }
+        vxl_volume_destroy(whole);
+        unlink(path);
+    }
+    free(data);
+}
+
 /* --write-seeds DIR: small valid caches (three types, many levels, every
  * brick kind) for fuzz_brick_cache's seed corpus. */
 static int write_seeds(const char *dir)
@@ -728,6 +1000,10 @@ int main(int argc, char **argv)
     RUN(cancel_leaves_no_file_and_cache_dir_is_honoured);
     RUN(bad_sources_fail_naming_the_file_and_leave_nothing);
     RUN(threads_read_at_once);
+    RUN(page_bricks_and_random_boxes_equal_the_whole_load);
+    RUN(loader_threads_give_every_brick_with_its_ghost);
+    RUN(an_old_format_version_is_rebuilt);
+    RUN(attached_nrrd_gzip_and_zlib_metaimage_stream_through_the_cache);
     RUN(a_brick_inflating_past_its_size_is_an_error);
     RUN(vxl_volume_load_streams_a_gz_through_the_cache);
     remove_tree(tmp_root);

@@ -26,9 +26,11 @@ static const field header_fields[] = {
     F(src_frame),    F(dims),         F(slope),           F(inter),        F(texture_bits), F(brick),
     F(n_levels),     F(index_brick),  F(value_min),       F(value_max),    F(tex_lo),       F(tex_hi),
     F(nan_count),    F(inf_count),    F(brick_count),     F(index_offset), F(index_bytes),  F(table_offset),
-    F(table_bytes),  F(index_crc),    F(table_crc)};
+    F(table_bytes),  F(index_crc),    F(table_crc),       F(src_compressed_start)};
 #undef F
 #define FIELDS_AT 16u /* after the magic, version and byte-order mark */
+/* the fields above take 192 bytes; they must end before the CRC (a new field needs room) */
+_Static_assert(FIELDS_AT + 192 <= VXL_CACHE_HEADER_BYTES - 4, "the header's fields overlap its CRC");
 
 void vxl_cache_header_encode(const vxl_cache_header *h, uint8_t out[VXL_CACHE_HEADER_BYTES])
 {
@@ -144,8 +146,8 @@ int vxl_cache_header_check(const vxl_cache_header *h, uint64_t file_size, uint32
 int vxl_cache_header_matches(const vxl_cache_header *h, const vxl_raw_layout *l)
 {
     return h->src_size == l->file_size && h->src_mtime_ns == l->mtime_ns && h->src_header_hash == l->header_hash &&
-           h->src_offset == l->offset && h->src_dtype == l->dtype && h->src_swap == (uint32_t)(l->swap != 0) &&
-           h->src_frame == l->frame && h->dims[0] == l->dims[0] && h->dims[1] == l->dims[1] &&
+           h->src_offset == l->offset && h->src_compressed_start == l->compressed_start && h->src_dtype == l->dtype &&
+           h->src_swap == (uint32_t)(l->swap != 0) && h->src_frame == l->frame && h->dims[0] == l->dims[0] && h->dims[1] == l->dims[1] &&
            h->dims[2] == l->dims[2] && memcmp(&h->slope, &l->slope, sizeof h->slope) == 0 &&
            memcmp(&h->inter, &l->inter, sizeof h->inter) == 0;
 }
@@ -155,8 +157,9 @@ void vxl_cache_brick_box(const vxl_cache_grid *g, uint32_t level, uint64_t i, ui
     const uint32_t *nb = g->bricks[level], *d = g->dims[level];
     const uint64_t c[3] = {i % nb[0], i / nb[0] % nb[1], i / ((uint64_t)nb[0] * nb[1])};
     for (int a = 0; a < 3; a++) {
-        lo[a] = (uint32_t)(c[a] * g->brick);
-        size[a] = d[a] - lo[a] < g->brick ? d[a] - lo[a] : g->brick;
+        const uint64_t core = c[a] * g->brick, end = core + g->brick + VXL_CACHE_APRON;
+        lo[a] = (uint32_t)(core < VXL_CACHE_APRON ? 0 : core - VXL_CACHE_APRON);
+        size[a] = (uint32_t)((end < d[a] ? end : d[a]) - lo[a]);
     }
 }
 

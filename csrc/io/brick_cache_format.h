@@ -8,8 +8,15 @@
  * ends with a CRC32 of everything before it, and holds CRC32s of the index
  * and of the table; each table entry holds the CRC32 of its brick's stored
  * bytes. Bricks are numbered level by level, then x fastest; a brick at the
- * volume's end is cut to what is left. Nothing read from a cache is used
- * before vxl_cache_header_check has bounded it. */
+ * volume's end is cut to what is left.
+ *
+ * Version 2: each brick stores its `brick`^3 core widened by a one-voxel
+ * apron on every side that lies inside the level (VXL_CACHE_APRON): a
+ * renderer's page brick of the same edge with its one-voxel ghost is then
+ * exactly one stored brick, one inflate, instead of up to 27 (version 1
+ * stored the core alone). A version-1 cache fails the version check and is
+ * rebuilt. Nothing read from a cache is used before vxl_cache_header_check
+ * has bounded it. */
 #ifndef VXL_BRICK_CACHE_FORMAT_H
 #define VXL_BRICK_CACHE_FORMAT_H
 
@@ -21,7 +28,8 @@
 #include "raw_layout.h"
 
 #define VXL_CACHE_MAGIC "VXLBRICK"
-#define VXL_CACHE_VERSION 1u
+#define VXL_CACHE_VERSION 2u
+#define VXL_CACHE_APRON 1u /* voxels each stored brick extends past its core (inside the level) */
 #define VXL_CACHE_BYTE_ORDER 0x01020304u
 #define VXL_CACHE_HEADER_BYTES 224u
 #define VXL_CACHE_ENTRY_BYTES 24u
@@ -38,6 +46,7 @@ typedef struct vxl_cache_header {
     uint64_t src_header_hash;
     uint64_t src_offset;
     uint32_t src_dtype, src_swap, src_frame;
+    uint64_t src_compressed_start; /* where the compressed stream starts in the source file */
     uint32_t dims[3];
     double slope, inter;
     /* the content */
@@ -81,7 +90,8 @@ int vxl_cache_grid_make(const uint32_t dims[3], uint32_t texture_bits, uint32_t 
                         uint32_t index_brick, vxl_cache_grid *g);
 /* 1 when h was made from this layout's source (size, mtime, header, how it is read). */
 int vxl_cache_header_matches(const vxl_cache_header *h, const vxl_raw_layout *l);
-/* Voxels of brick i's box at level L: origin and size. */
+/* Voxels stored for brick i of level L (its core plus the apron, cut at the
+ * level's edges): origin and size. */
 void vxl_cache_brick_box(const vxl_cache_grid *g, uint32_t level, uint64_t i, uint32_t lo[3], uint32_t size[3]);
 
 void vxl_cache_entry_encode(const vxl_cache_entry *en, uint8_t out[VXL_CACHE_ENTRY_BYTES]);

@@ -174,7 +174,8 @@ int vxl_brick_cache_read_open(const char *path, const vxl_raw_layout *l, uint32_
     s->index_brick = c->h.index_brick;
     memcpy(s->index_dims, c->g.index_dims, sizeof s->index_dims);
     s->resident_bytes = sizeof *s + sizeof *c + c->h.index_bytes + c->h.brick_count * sizeof *c->table +
-                        (uint64_t)LRU_SLOTS * c->h.brick * c->h.brick * c->h.brick * c->g.texel_bytes;
+                        (uint64_t)LRU_SLOTS * (c->h.brick + 2 * VXL_CACHE_APRON) * (c->h.brick + 2 * VXL_CACHE_APRON) *
+                            (c->h.brick + 2 * VXL_CACHE_APRON) * c->g.texel_bytes;
     *out = s;
     return VXL_OK;
 }
@@ -233,6 +234,37 @@ static void copy_overlap(const uint8_t *brick, const uint32_t blo[3], const uint
                    brick + (((size_t)(z - blo[2]) * bsz[1] + (y - blo[1])) * bsz[0] + (a[0] - blo[0])) * tb, row);
 }
 
+/* The stored bricks whose boxes (core plus apron) cover lo .. lo + size - 1
+ * on one axis: k0 .. k1. Brick k stores k*B - 1 .. k*B + B (inside the
+ * level), so k0 = (lo + 1) / B starts at or before lo and k1 = (hi - 1) / B,
+ * hi = lo + size - 1 the box's last voxel, ends at or past hi. A page brick
+ * of edge B with its one-voxel ghost is one stored brick. */
+static void covering(uint32_t lo, uint32_t size, uint32_t B, uint32_t n, uint32_t *k0, uint32_t *k1)
+{
+    const uint64_t hi = (uint64_t)lo + size - 1;
+    *k0 = (uint32_t)(((uint64_t)lo + VXL_CACHE_APRON) / B);
+    if (*k0 >= n) *k0 = n - 1;
+    *k1 = hi >= VXL_CACHE_APRON ? (uint32_t)((hi - VXL_CACHE_APRON) / B) : 0;
+    if (*k1 >= n) *k1 = n - 1;
+    if (*k1 < *k0) *k1 = *k0;
+}
+
+/* Brick id (+1, as the LRU's ids) copied from the LRU into the box; 0 when absent. */
+static int copy_cached(cache_ctx *c, uint64_t id, const uint32_t blo[3], const uint32_t bsz[3], const uint32_t lo[3],
+                       const uint32_t size[3], uint8_t *out)
+{
+    pthread_mutex_lock(&c->lock);
+    lru_slot *hit = NULL;
+    for (int k = 0; k < LRU_SLOTS && !hit; k++)
+        if (c->lru[k].id == id) hit = &c->lru[k];
+    if (hit) {
+        hit->stamp = ++c->clock;
+        copy_overlap(hit->data, blo, bsz, lo, size, out, c->g.texel_bytes);
+    }
+    pthread_mutex_unlock(&c->lock);
+    return hit != NULL;
+}
+
 static int cache_read(vxl_brick_source *s, uint32_t level, const uint32_t lo[3], const uint32_t size[3], void *out,
                       vxl_err *e)
 {
@@ -246,25 +278,21 @@ static int cache_read(vxl_brick_source *s, uint32_t level, const uint32_t lo[3],
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "box %u+%u %u+%u %u+%u is outside level %u (%ux%ux%u)",
                             lo[0], size[0], lo[1], size[1], lo[2], size[2], level, d[0], d[1], d[2]);
     const uint32_t *nb = c->g.bricks[level];
-    for (uint32_t bz = lo[2] / B; bz <= (lo[2] + size[2] - 1) / B; bz++)
-        for (uint32_t by = lo[1] / B; by <= (lo[1] + size[1] - 1) / B; by++)
-            for (uint32_t bx = lo[0] / B; bx <= (lo[0] + size[0] - 1) / B; bx++) {
+    uint32_t k0[3], k1[3];
+    for (int a = 0; a < 3; a++) covering(lo[a], size[a], B, nb[a], &k0[a], &k1[a]);
+    for (uint32_t bz = k0[2]; bz <= k1[2]; bz++)
+        for (uint32_t by = k0[1]; by <= k1[1]; by++)
+            for (uint32_t bx = k0[0]; bx <= k1[0]; bx++) {
                 const uint64_t i = bx + (uint64_t)nb[0] * (by + (uint64_t)nb[1] * bz), id = c->g.first[level] + i + 1;
                 uint32_t blo[3], bsz[3];
                 vxl_cache_brick_box(&c->g, level, i, blo, bsz);
-                pthread_mutex_lock(&c->lock);
-                lru_slot *hit = NULL;
-                for (int k = 0; k < LRU_SLOTS && !hit; k++)
-                    if (c->lru[k].id == id) hit = &c->lru[k];
-                if (hit) {
-                    hit->stamp = ++c->clock;
-                    copy_overlap(hit->data, blo, bsz, lo, size, out, c->g.texel_bytes);
-                    pthread_mutex_unlock(&c->lock);
-                    continue;
-                }
-                pthread_mutex_unlock(&c->lock);
-                /* decoded outside the lock, into a buffer of this call */
+                if (copy_cached(c, id, blo, bsz, lo, size, out)) continue;
                 const uint64_t bytes = (uint64_t)bsz[0] * bsz[1] * bsz[2] * c->g.texel_bytes;
+                if (!memcmp(blo, lo, sizeof blo) && !memcmp(bsz, size, sizeof bsz))
+                    /* the box is this brick (a page brick of the cache's edge): decoded in place, not kept,
+                       since the renderer keeps it and it is the only read that wants all of it */
+                    return load_brick(s, level, i, out, bytes, e);
+                /* decoded outside the lock, into a buffer of this call */
                 uint8_t *data = malloc((size_t)bytes);
                 if (!data) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for a brick of %s", c->path);
                 int rc = load_brick(s, level, i, data, bytes, e);

@@ -1,12 +1,14 @@
-/* brick_cache_write.c - streams a gzip-compressed source once into a
- * bricked cache (brick_cache.h, format in brick_cache_format.h).
+/* brick_cache_write.c - streams a gzip- or zlib-compressed source once
+ * into a bricked cache (brick_cache.h, format in brick_cache_format.h).
  *
- * Memory stays bounded by a slab of `brick` slices per level (the slab of
- * level k+1 is a quarter of level k's), one slice of raw values and the
- * index, never the volume: slices are converted to texels exactly as
- * vxl_volume_build converts a whole volume, a full slab is cut into bricks
- * and written, then averaged 2x2x2 into the next level's slab exactly as
- * vxl_volume_downsample2 averages a whole level.
+ * Memory stays bounded by a slab of `brick` + 2 slices per level (the core
+ * and the slices either side that the bricks' one-voxel apron takes; the
+ * slab of level k+1 is a quarter of level k's), one slice of raw values and
+ * the index, never the volume: slices are converted to texels exactly as
+ * vxl_volume_build converts a whole volume, a full core is cut into bricks
+ * and written once the slice after it is in, then averaged 2x2x2 into the
+ * next level's slab exactly as vxl_volume_downsample2 averages a whole
+ * level.
  *
  * 32-bit and 64-bit types are normalised by the volume's finite range, which
  * is only known at the end: for them a first pass inflates the file for the
@@ -33,12 +35,16 @@
 #include "brick_cache_format.h"
 #include "brick_levels.h"
 
-#define GZ_CHUNK (1u << 30) /* gzread takes an unsigned and returns an int */
 
+/* A level's slab: its `brick` core slices z0 .. z0 + brick - 1 in slots
+ * 1 .. brick, the slice before them (the bricks' lower apron) in slot 0 and
+ * the one after (their upper apron) in slot brick + 1. */
 typedef struct slab {
-    uint8_t *buf;        /* `brick` slices of the level */
-    uint32_t z0, filled; /* first slice held, slices held */
+    uint8_t *buf;        /* brick + 2 slices of the level */
+    uint32_t z0, filled; /* first core slice, slices held from z0 on */
 } slab;
+
+#define SLAB_SLOTS(B) ((B) + 2 * VXL_CACHE_APRON)
 
 typedef struct writer {
     const vxl_raw_layout *l;
@@ -75,38 +81,99 @@ static int report(writer *w, double done)
 
 /* ---------------------------------------------------------- the source */
 
-static int open_source(writer *w, gzFile *gz)
+/* The compressed stream from the layout's compressed_start: zlib's
+ * inflateInit2(15 + 32) takes a gzip or a zlib header, so a .nii.gz, a
+ * gzip NRRD data file or the gzip data after a NRRD header, and zlib
+ * MetaImage data after its header all read the same way; a gzip member
+ * that ends with more input after it is followed by the next (concatenated
+ * members, as gzip and gzread allow). */
+#define IN_CHUNK (1u << 18)
+
+typedef struct zsrc {
+    FILE *f;
+    z_stream z;
+    int started, ended; /* ended: the last inflate ended a member */
+    uint8_t *in;
+} zsrc;
+
+static void close_source(zsrc *s)
 {
-    *gz = gzopen(w->l->path, "rb");
-    if (!*gz) return vxl_fail(w->e, VXL_ERR_IO, "cannot open %s: %s", w->l->path, strerror(errno));
-    gzbuffer(*gz, 1u << 18);
-    /* skip to the chosen frame (gzseek inflates forward) */
-    if (w->l->offset && gzseek(*gz, (z_off_t)w->l->offset, SEEK_SET) != (z_off_t)w->l->offset) {
-        gzclose(*gz);
-        *gz = NULL;
-        return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends before its voxels (offset %llu)", w->l->path,
-                        (unsigned long long)w->l->offset);
+    if (s->started) inflateEnd(&s->z);
+    if (s->f) fclose(s->f);
+    free(s->in);
+    memset(s, 0, sizeof *s);
+}
+
+/* Inflates the next n bytes into dst (NULL: skip them). */
+static int inflate_bytes(writer *w, zsrc *s, uint8_t *dst, uint64_t n, uint32_t z_slice)
+{
+    uint8_t skip[4096];
+    while (n) {
+        if (!s->z.avail_in) {
+            const size_t r = fread(s->in, 1, IN_CHUNK, s->f);
+            if (!r) {
+                if (ferror(s->f)) return vxl_fail(w->e, VXL_ERR_IO, "read error in %s: %s", w->l->path, strerror(errno));
+                return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends at slice %u of %u: the file is shorter than its header says",
+                                w->l->path, z_slice, w->l->dims[2]);
+            }
+            s->z.next_in = s->in;
+            s->z.avail_in = (uInt)r;
+        }
+        if (s->ended) { /* another member follows */
+            if (inflateReset(&s->z) != Z_OK) return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "%s: zlib reset failed", w->l->path);
+            s->ended = 0;
+        }
+        const uInt room = n > (dst ? (1u << 30) : sizeof skip) ? (dst ? (1u << 30) : (uInt)sizeof skip) : (uInt)n;
+        s->z.next_out = dst ? dst : skip;
+        s->z.avail_out = room;
+        const int zr = inflate(&s->z, Z_NO_FLUSH);
+        const uInt got = room - s->z.avail_out;
+        if (dst) dst += got;
+        n -= got;
+        if (zr == Z_STREAM_END) s->ended = 1;
+        else if (zr == Z_BUF_ERROR && !s->z.avail_in) continue; /* needs more input */
+        else if (zr != Z_OK)
+            return vxl_fail(w->e, VXL_ERR_FORMAT, "%s: the compressed stream is damaged at slice %u: %s", w->l->path,
+                            z_slice, s->z.msg ? s->z.msg : "zlib error");
     }
     return VXL_OK;
 }
 
-static int read_slice(writer *w, gzFile gz, uint32_t z, size_t bytes)
+/* Opens the stream at compressed_start and inflates up to the chosen
+ * frame's first voxel (offset in the inflated bytes). */
+static int open_source(writer *w, zsrc *s)
 {
-    size_t got = 0;
-    while (got < bytes) {
-        unsigned want = bytes - got > GZ_CHUNK ? GZ_CHUNK : (unsigned)(bytes - got);
-        int r = gzread(gz, w->raw + got, want);
-        if (r <= 0) {
-            int zerr = 0;
-            const char *msg = gzerror(gz, &zerr);
-            if (r < 0 || zerr)
-                return vxl_fail(w->e, VXL_ERR_FORMAT, "%s: the compressed stream is damaged at slice %u: %s",
-                                w->l->path, z, msg);
-            return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends at slice %u of %u: the file is shorter than its header says",
-                            w->l->path, z, w->l->dims[2]);
-        }
-        got += (size_t)r;
+    memset(s, 0, sizeof *s);
+    s->f = fopen(w->l->path, "rb");
+    if (!s->f) return vxl_fail(w->e, VXL_ERR_IO, "cannot open %s: %s", w->l->path, strerror(errno));
+    if (!(s->in = malloc(IN_CHUNK))) {
+        close_source(s);
+        return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "out of memory reading %s", w->l->path);
     }
+    if (w->l->compressed_start > (uint64_t)INT64_MAX || fseeko(s->f, (off_t)w->l->compressed_start, SEEK_SET) != 0) {
+        close_source(s);
+        return vxl_fail(w->e, VXL_ERR_FORMAT, "%s: no compressed data at byte %llu", w->l->path,
+                        (unsigned long long)w->l->compressed_start);
+    }
+    if (inflateInit2(&s->z, 15 + 32) != Z_OK) { /* zlib or gzip, auto-detected */
+        close_source(s);
+        return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "%s: cannot start zlib", w->l->path);
+    }
+    s->started = 1;
+    int rc = inflate_bytes(w, s, NULL, w->l->offset, 0);
+    if (rc) {
+        close_source(s);
+        if (w->e->code == VXL_ERR_FORMAT && strstr(w->e->msg, " ends at slice "))
+            return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends before its voxels (offset %llu)", w->l->path,
+                            (unsigned long long)w->l->offset);
+    }
+    return rc;
+}
+
+static int read_slice(writer *w, zsrc *src, uint32_t z, size_t bytes)
+{
+    int rc = inflate_bytes(w, src, w->raw, bytes, z);
+    if (rc) return rc;
     if (w->l->swap) {
         const uint32_t n = vxl_dtype_size(w->l->dtype);
         for (size_t i = 0; i < bytes; i += n)
@@ -201,12 +268,19 @@ static void int_slice_texels(writer *w, uint8_t *dst)
     if (mx > w->h.value_max) w->h.value_max = mx;
 }
 
-/* Texels of the slice (raw values already read) into slot `slot` of level
- * 0's slab; for 8/16-bit types the range too. */
-static void slice_texels(writer *w, uint32_t slot)
+/* Slice z of level L in its slab (z0 - 1 .. z0 + brick). */
+static uint8_t *slab_slice(const writer *w, uint32_t L, uint32_t z)
+{
+    const size_t plane = (size_t)w->g.dims[L][0] * w->g.dims[L][1] * w->tb;
+    return w->lv[L].buf + (size_t)(z + VXL_CACHE_APRON - w->lv[L].z0) * plane;
+}
+
+/* Texels of slice z (raw values already read) into level 0's slab; for
+ * 8/16-bit types the range too. */
+static void slice_texels(writer *w, uint32_t z)
 {
     const uint32_t nx = w->l->dims[0], ny = w->l->dims[1];
-    uint8_t *dst = w->lv[0].buf + (size_t)slot * nx * ny * w->tb;
+    uint8_t *dst = slab_slice(w, 0, z);
     if (w->tb < 4) {
         int_slice_texels(w, dst);
         return;
@@ -265,58 +339,78 @@ static int store_brick(writer *w, uint64_t id, size_t n)
 
 static int push_slice(writer *w, uint32_t level);
 
+
 /* Averages level L's slice pair (2z, 2z+1, the last repeated at an odd
  * end) of its slab into the next level's slab, as vxl_volume_downsample2
  * averages a whole level (brick_levels.h). */
 static void downsample_slice(writer *w, uint32_t L, uint32_t z)
 {
-    const uint32_t *d = w->g.dims[L], *o = w->g.dims[L + 1];
-    const size_t plane = (size_t)d[0] * d[1] * w->tb;
-    const uint32_t za = 2 * z - w->lv[L].z0, zb = (2 * z + 1 < d[2] ? 2 * z + 1 : d[2] - 1) - w->lv[L].z0;
-    vxl_downsample2_slice(w->tb * 8, w->lv[L].buf + za * plane, w->lv[L].buf + zb * plane, d[0], d[1],
-                          w->lv[L + 1].buf + (size_t)(z - w->lv[L + 1].z0) * o[0] * o[1] * w->tb);
+    const uint32_t *d = w->g.dims[L];
+    vxl_downsample2_slice(w->tb * 8, slab_slice(w, L, 2 * z), slab_slice(w, L, 2 * z + 1 < d[2] ? 2 * z + 1 : d[2] - 1),
+                          d[0], d[1], slab_slice(w, L + 1, z));
 }
 
-/* Level L's slab is full (or the level ends): cut it into bricks, write
- * them, average it into level L+1. */
-static int flush_slab(writer *w, uint32_t L)
+/* Level L's core slices z0 .. z0 + core - 1 are in, with the slices
+ * around them that the level has: cut them into bricks with their apron
+ * (vxl_cache_brick_box's boxes), write them, average the core into level
+ * L+1. */
+static int flush_slab(writer *w, uint32_t L, uint32_t core)
 {
     slab *sl = &w->lv[L];
     const uint32_t *d = w->g.dims[L], *nb = w->g.bricks[L], B = w->g.brick;
     const uint32_t bz = sl->z0 / B;
     for (uint32_t by = 0; by < nb[1]; by++)
         for (uint32_t bx = 0; bx < nb[0]; bx++) {
-            const uint32_t x0 = bx * B, y0 = by * B;
-            const uint32_t sx = d[0] - x0 < B ? d[0] - x0 : B, sy = d[1] - y0 < B ? d[1] - y0 : B;
+            const uint64_t id = bx + (uint64_t)nb[0] * (by + (uint64_t)nb[1] * bz);
+            uint32_t lo[3], sz[3];
+            vxl_cache_brick_box(&w->g, L, id, lo, sz);
             uint8_t *p = w->brick_buf;
-            for (uint32_t z = 0; z < sl->filled; z++)
-                for (uint32_t y = 0; y < sy; y++) {
-                    size_t row = (size_t)sx * w->tb;
-                    memcpy(p, sl->buf + ((size_t)z * d[1] * d[0] + (size_t)(y0 + y) * d[0] + x0) * w->tb, row);
+            const size_t row = (size_t)sz[0] * w->tb;
+            for (uint32_t z = 0; z < sz[2]; z++) {
+                const uint8_t *slice = slab_slice(w, L, lo[2] + z);
+                for (uint32_t y = 0; y < sz[1]; y++) {
+                    memcpy(p, slice + ((size_t)(lo[1] + y) * d[0] + lo[0]) * w->tb, row);
                     p += row;
                 }
-            int rc = store_brick(w, w->g.first[L] + bx + (uint64_t)nb[0] * (by + (uint64_t)nb[1] * bz),
-                                 (size_t)sx * sy * sl->filled);
+            }
+            int rc = store_brick(w, w->g.first[L] + id, (size_t)sz[0] * sz[1] * sz[2]);
             if (rc) return rc;
         }
     if (L + 1 < w->g.n_levels) {
-        for (uint32_t z = sl->z0 / 2; z <= (sl->z0 + sl->filled - 1) / 2; z++) {
+        for (uint32_t z = sl->z0 / 2; z <= (sl->z0 + core - 1) / 2; z++) {
             downsample_slice(w, L, z);
             int rc = push_slice(w, L + 1);
             if (rc) return rc;
         }
     }
-    sl->z0 += sl->filled;
-    sl->filled = 0;
     return VXL_OK;
 }
 
-/* A slice was written at the end of level L's slab: flush when full. */
+/* A slice was written after the last one held in level L's slab. Once the
+ * slice after a full core is in (the core's upper apron), the core is
+ * written and the slab moves on by `brick`, keeping its last core slice and
+ * that slice as the next core's lower apron and first slice; at the
+ * level's end what is left is written. */
 static int push_slice(writer *w, uint32_t L)
 {
     slab *sl = &w->lv[L];
+    const uint32_t B = w->g.brick, nz = w->g.dims[L][2];
+    const size_t plane = (size_t)w->g.dims[L][0] * w->g.dims[L][1] * w->tb;
     sl->filled++;
-    if (sl->filled == w->g.brick || sl->z0 + sl->filled == w->g.dims[L][2]) return flush_slab(w, L);
+    if (sl->filled == B + VXL_CACHE_APRON) {
+        int rc = flush_slab(w, L, B);
+        if (rc) return rc;
+        /* slices z0 + B - APRON .. z0 + B + APRON - 1 (slots B ..) to the slab's start */
+        memmove(sl->buf, sl->buf + (size_t)B * plane, 2 * VXL_CACHE_APRON * plane);
+        sl->z0 += B;
+        sl->filled = VXL_CACHE_APRON;
+    }
+    if (sl->z0 + sl->filled == nz) {
+        int rc = flush_slab(w, L, sl->filled);
+        sl->filled = 0;
+        sl->z0 = nz;
+        return rc;
+    }
     return VXL_OK;
 }
 
@@ -324,33 +418,32 @@ static int push_slice(writer *w, uint32_t L)
 
 static int range_pass(writer *w, size_t slice_bytes)
 {
-    gzFile gz;
+    zsrc src;
     w->stage = "reading the value range"; /* before open_source, which reports too */
-    int rc = open_source(w, &gz);
+    int rc = open_source(w, &src);
     for (uint32_t z = 0; !rc && z < w->l->dims[2]; z++) {
-        rc = read_slice(w, gz, z, slice_bytes);
+        rc = read_slice(w, &src, z, slice_bytes);
         if (!rc) slice_range(w);
         if (!rc) rc = report(w, (z + 1.0) / w->l->dims[2]);
     }
-    if (gz) gzclose(gz);
+    close_source(&src);
     return rc;
 }
 
 static int write_pass(writer *w, size_t slice_bytes)
 {
-    gzFile gz;
+    zsrc src;
     w->stage = "writing the brick cache";
-    int rc = open_source(w, &gz);
-    const size_t l0_plane = (size_t)w->l->dims[0] * w->l->dims[1] * w->tb;
+    int rc = open_source(w, &src);
     for (uint32_t z = 0; !rc && z < w->l->dims[2]; z++) {
-        rc = read_slice(w, gz, z, slice_bytes);
+        rc = read_slice(w, &src, z, slice_bytes);
         if (rc) break;
-        slice_texels(w, w->lv[0].filled);
-        vxl_index_build_slice(&w->index, z, w->lv[0].buf + (size_t)w->lv[0].filled * l0_plane);
+        slice_texels(w, z);
+        vxl_index_build_slice(&w->index, z, slab_slice(w, 0, z));
         rc = push_slice(w, 0);
         if (!rc) rc = report(w, (z + 1.0) / w->l->dims[2]);
     }
-    if (gz) gzclose(gz);
+    close_source(&src);
     return rc;
 }
 
@@ -413,6 +506,7 @@ static int plan(writer *w, const vxl_brick_cache_tuning *t)
     h->src_mtime_ns = l->mtime_ns;
     h->src_header_hash = l->header_hash;
     h->src_offset = l->offset;
+    h->src_compressed_start = l->compressed_start;
     h->src_dtype = l->dtype;
     h->src_swap = l->swap != 0;
     h->src_frame = l->frame;
@@ -431,11 +525,11 @@ static int plan(writer *w, const vxl_brick_cache_tuning *t)
 
 static int allocate(writer *w)
 {
-    const uint32_t B = w->g.brick;
-    const size_t brick_bytes = (size_t)B * B * B * w->tb;
+    const uint32_t B = w->g.brick, E = B + 2 * VXL_CACHE_APRON; /* a stored brick's edge at most */
+    const size_t brick_bytes = (size_t)E * E * E * w->tb;
     int ok = 1;
     for (uint32_t L = 0; L < w->g.n_levels; L++)
-        ok &= (w->lv[L].buf = malloc((size_t)B * w->g.dims[L][0] * w->g.dims[L][1] * w->tb)) != NULL;
+        ok &= (w->lv[L].buf = malloc((size_t)SLAB_SLOTS(B) * w->g.dims[L][0] * w->g.dims[L][1] * w->tb)) != NULL;
     w->table = calloc((size_t)w->g.first[w->g.n_levels], sizeof *w->table);
     w->brick_buf = malloc(brick_bytes);
     w->zcap = compressBound((uLong)brick_bytes);

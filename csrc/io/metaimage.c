@@ -245,9 +245,8 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
     if (!rc) rc = parse_header(text, len, file_size, path, &h, e);
     if (!rc) {
         for (int a = 0; a < 3; a++) dims[a] = a < h.ndims ? (uint32_t)h.dimsize[a] : 1;
-        /* zlib data (not gzip) is not what a bricked cache reads */
-        rc = vxl_stream_plan(path, dims, h.dtype, opt, h.compressed ? "compressed MetaImage data" : NULL, &stream,
-                             &nbytes, e);
+        /* zlib data streams through a bricked cache, inflated from where it starts */
+        rc = vxl_stream_plan(path, dims, h.dtype, opt, NULL, &stream, &nbytes, e);
     }
     if (!rc && h.data_file) {
         data_path = vxl_sibling_path(path, h.data_file);
@@ -273,7 +272,7 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
                           dpath, (unsigned long long)total, (unsigned long long)size);
         if (!rc) offset = size - total;
     }
-    if (!rc && stream && !vxl_stream_file_holds(dpath, offset, 0, nbytes, opt)) {
+    if (!rc && stream && !vxl_stream_file_holds(dpath, offset, h.compressed, nbytes, opt)) {
         stream = 0; /* AUTO and a file too short to stream: today's whole-read checks say why */
         rc = vxl_plan_voxels(path, dims, h.dtype, opt, &nbytes, e);
     }
@@ -282,7 +281,9 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
     if (l) {
         double sp[3], A[16];
         rc = geometry(&h, sp, A, path, e);
-        if (!rc) rc = vxl_layout_init(l, dpath, offset, dims, h.dtype, sp, A, e);
+        if (!rc) rc = vxl_layout_init(l, dpath, h.compressed ? 0 : offset, dims, h.dtype, sp, A, e);
+        l->compressed = h.compressed;
+        l->compressed_start = h.compressed ? offset : 0; /* the zlib stream starts after the header */
         l->swap = vxl_dtype_size(h.dtype) > 1 && h.msb != vxl_host_big_endian();
         l->affine_source = h.nmatrix || h.norigin ? 2 : 0;
         l->header_hash = vxl_fnv(14695981039346656037ull, text, len);

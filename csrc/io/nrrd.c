@@ -444,11 +444,8 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
     const char *dpath = path;
     int stream = 0;
     if (!rc) rc = choose_axes(&h, axes, &nax, dims, &block, path, e);
-    /* a gzip stream after the text header does not start where a bricked cache reads from */
-    if (!rc)
-        rc = vxl_stream_plan(path, dims, h.dtype, opt,
-                             h.encoding == ENC_GZIP && !h.data_file ? "gzip data attached to a NRRD header" : NULL,
-                             &stream, &nbytes, e);
+    /* gzip data, attached or detached, streams through a bricked cache that inflates from its start */
+    if (!rc) rc = vxl_stream_plan(path, dims, h.dtype, opt, NULL, &stream, &nbytes, e);
     if (!rc && h.data_file) {
         data_path = vxl_sibling_path(path, h.data_file);
         if (!data_path) rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", path);
@@ -488,13 +485,14 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
         stream = 0; /* AUTO and a file too short to stream: today's whole-read checks say why */
         rc = vxl_plan_voxels(path, dims, h.dtype, opt, &nbytes, e);
     }
-    if (!rc && stream) { /* issue 21: read on demand (stream_load.h); detached gzip data through a cache */
+    if (!rc && stream) { /* issue 21: read on demand (stream_load.h); gzip data through a cache */
         double sp[3], A[16];
         vxl_raw_layout l;
         rc = geometry(&h, axes, nax, sp, A, path, e);
         if (!rc) rc = vxl_layout_init(&l, dpath, stream_offset, dims, h.dtype, sp, A, e);
         if (!rc) {
             l.compressed = h.encoding == ENC_GZIP;
+            if (l.compressed) l.compressed_start = offset; /* the file byte after the header (and skipped lines) */
             l.swap = vxl_dtype_size(h.dtype) > 1 && (h.endian == 2) != vxl_host_big_endian();
             l.affine_source = h.ndirs ? 2 : 0;
             l.header_hash = vxl_fnv(14695981039346656037ull, text, len);

@@ -1,4 +1,4 @@
-/* brick_loader.h - the loader thread of a renderer that streams a volume
+/* brick_loader.h - the loader threads of a renderer that streams a volume
  * (docs/streaming.md). The renderer's thread says which page bricks it
  * wants, in priority order; the loader reads each with its one-voxel ghost
  * border (out-of-volume voxels repeat the edge voxel, as paging.c's bricks
@@ -6,7 +6,7 @@
  * buffers, which the renderer's thread uploads and hands back. CPU only, no
  * GL; one loader per storage state, started at install, joined at release,
  * so nothing is global and a renderer destroyed while loading waits for
- * the one read in progress and frees everything. */
+ * the reads in progress and frees everything. */
 #ifndef VXL_BRICK_LOADER_H
 #define VXL_BRICK_LOADER_H
 
@@ -27,13 +27,18 @@ typedef struct vxl_loaded_brick {
 
 typedef struct vxl_brick_loader vxl_brick_loader;
 
-/* Starts the thread reading from src (which must outlive the loader) bricks
- * of `brick` voxels per edge (ghost excluded) with at most queue_bricks
- * staging buffers (allocated as needed). */
+/* Starts the threads reading from src (which must outlive the loader)
+ * bricks of `brick` voxels per edge (ghost excluded) with at most
+ * queue_bricks staging buffers (allocated as needed; a thread reads into
+ * one of them, so the threads add no memory). One thread per core, at most
+ * 4 and queue_bricks: the source's read is thread-safe (brick_source.h). */
 int vxl_loader_start(vxl_brick_loader **out, vxl_brick_source *src, uint32_t brick, uint32_t queue_bricks, vxl_err *e);
-/* Stops and joins the thread, frees the queue; NULL is a no-op. */
+/* The same with n_threads threads (1..4; 0 = one per core, as above). */
+int vxl_loader_start_threads(vxl_brick_loader **out, vxl_brick_source *src, uint32_t brick, uint32_t queue_bricks,
+                             uint32_t n_threads, vxl_err *e);
+/* Stops and joins the threads, frees the queue; NULL is a no-op. */
 void vxl_loader_stop(vxl_brick_loader *l);
-/* CPU bytes the loader may hold: its staging buffers and its read buffer. */
+/* CPU bytes the loader may hold: its staging buffers. */
 uint64_t vxl_loader_bytes(const vxl_brick_loader *l);
 /* Replaces what the loader reads next by keys[0..n-1], in that order. */
 int vxl_loader_want(vxl_brick_loader *l, const vxl_brick_key *keys, uint32_t n, vxl_err *e);

@@ -273,10 +273,10 @@ case "$cmd" in
         # by library name (tests/lsan.supp); ours are not.
         ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions="$ROOT/tests/lsan.supp" UBSAN_OPTIONS=print_stacktrace=1 \
             run_suite "C tests under ASan+UBSan" run_c_tests build-asan
-        # every file loader under libFuzzer + ASan/UBSan, 20 s each, after
+        # every file loader under libFuzzer + ASan/UBSan, 10 s each (CI's 30-minute budget), after
         # replaying tests/crashers/ (which fails when a loader's corpus is
         # missing or empty; ./build.sh fuzz runs them longer)
-        run_suite "Loader fuzzing (ASan+UBSan)" tests/fuzz/run.sh 20
+        run_suite "Loader fuzzing (ASan+UBSan)" tests/fuzz/run.sh 10
         run_suite "CLI tests" /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/cli
         run_suite "Benchmark smoke" /usr/bin/python3 -m pytest -q -p no:cacheprovider tests/bench
         if [ -x tools/run_blender_tests.sh ]; then
@@ -287,7 +287,7 @@ case "$cmd" in
         [ "$TOTAL_FAIL" -eq 0 ] ;;
     fuzz)
         # ./build.sh fuzz [SECONDS [TARGET...]]: each loader's libFuzzer target
-        # (nifti nrrd metaimage tiff png dicom vdb label_table zarr brick_cache) for SECONDS (default 300);
+        # (nifti nrrd metaimage tiff png dicom vdb label_table zarr brick_cache tiff_layout) for SECONDS (default 300);
         # crashes are kept in tests/crashers/<target>/. SECONDS "replay":
         # replay tests/crashers/ only
         install_deps; build

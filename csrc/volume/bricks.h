@@ -46,7 +46,7 @@ uint32_t vxl_skip_brick_size(void);
  * (skipping.c): VXL_FINE_BRICK while that grid has at most
  * VXL_FINE_BRICK_MAX_COUNT bricks (up to 512^3 voxels: 16 MiB of min-max,
  * 2 MiB of distances), else VXL_DEFAULT_BRICK; VOXLIGHT_BRICK_SIZE overrides.
- * Finer bricks fit the tissue's edge closer: 20-38% fewer samples on the
+ * Finer bricks fit the tissue's edge closer: 16-38% fewer samples on the
  * brain volumes at identical images (docs/skipping.md). The paged storages
  * keep VXL_DEFAULT_BRICK: their grids come from CPU indexes of 8^3 bricks
  * (a streamed volume's smallest), and sparse and streamed storage must page

@@ -21,6 +21,11 @@ downloaded; every file is the same on every run (fixed seeds).
       is computed from the analytic field at its own voxels, a chunk row at
       a time.
 
+  make_stream_data.py tiff PATH.tif [--dims 2600,1500,400]
+      The gzip kind's body as an uncompressed multi-page 8-bit TIFF (one
+      page per z slice, one strip per page, rows top first as images store
+      them): what TIFF streaming reads by offset.
+
 --dims X,Y,Z makes smaller versions (the smoke test uses them)."""
 import argparse
 import gzip
@@ -142,6 +147,39 @@ def write_gzip(path, dims, slab=4, level=1):
         f.write(comp.flush())
 
 
+def write_tiff(path, dims, slab=4):
+    """Classic little-endian TIFF, each page's data then its directory."""
+    rng = np.random.default_rng(7)  # the gzip kind's balls: the same body
+    balls = [(rng.uniform(-0.6, 0.6), rng.uniform(-0.5, 0.5), rng.uniform(-0.8, 0.8), rng.uniform(0.02, 0.06))
+             for _ in range(12)]
+    nx, ny, nz = dims
+    if nx * ny * nz + nz * 256 >= 1 << 32:
+        sys.exit("make_stream_data: %dx%dx%d does not fit a classic TIFF" % dims)
+    with open(path, "wb") as f:
+        f.write(b"II*\x00" + struct.pack("<I", 0))
+        link = 4  # where the previous directory's next-directory offset lies
+        for z0 in range(0, nz, slab):
+            v = body_slab(dims, z0, min(nz, z0 + slab), balls).astype(np.uint8)
+            for page in v.reshape(-1, ny, nx):
+                data = f.tell()
+                f.write(np.ascontiguousarray(page[::-1]).tobytes())  # top row first
+                if f.tell() % 2:
+                    f.write(b"\0")
+                ifd = f.tell()
+                tags = [(256, 4, nx), (257, 4, ny), (258, 3, 8), (259, 3, 1), (262, 3, 1), (273, 4, data),
+                        (277, 3, 1), (278, 4, ny), (279, 4, nx * ny)]
+                f.write(struct.pack("<H", len(tags)))
+                for tag, typ, val in tags:
+                    f.write(struct.pack("<HHI", tag, typ, 1) +
+                            (struct.pack("<HH", val, 0) if typ == 3 else struct.pack("<I", val)))
+                f.write(struct.pack("<I", 0))
+                end = f.tell()
+                f.seek(link)
+                f.write(struct.pack("<I", ifd))
+                f.seek(end)
+                link = ifd + 2 + 12 * len(tags)
+
+
 # -------------------------------------------------------------------- zarr
 
 
@@ -225,12 +263,13 @@ def write_zarr(path, dims, levels=4, chunk=64, codec="zstd"):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("kind", choices=["sparse", "gzip", "zarr"])
+    ap.add_argument("kind", choices=["sparse", "gzip", "tiff", "zarr"])
     ap.add_argument("path")
     ap.add_argument("--dims", help="X,Y,Z")
     ap.add_argument("--codec", default="zstd", choices=["zstd", "blosc", "gzip", "raw"])
     a = ap.parse_args(argv)
-    default = {"sparse": (4096, 4096, 1600), "gzip": (2600, 1500, 400), "zarr": (2048, 2048, 512)}[a.kind]
+    default = {"sparse": (4096, 4096, 1600), "gzip": (2600, 1500, 400), "tiff": (2600, 1500, 400),
+               "zarr": (2048, 2048, 512)}[a.kind]
     dims = tuple(int(v) for v in a.dims.split(",")) if a.dims else default
     if len(dims) != 3 or min(dims) < 8:
         ap.error("--dims needs three sizes of at least 8")
@@ -238,6 +277,8 @@ def main(argv=None):
         write_sparse(a.path, dims)
     elif a.kind == "gzip":
         write_gzip(a.path, dims)
+    elif a.kind == "tiff":
+        write_tiff(a.path, dims)
     else:
         write_zarr(a.path, dims, codec=a.codec)
 

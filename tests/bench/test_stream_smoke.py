@@ -1,7 +1,8 @@
 """The streaming benchmark (bench/stream_study.c, docs/streaming.md
-"Benchmark") on small versions of its three inputs from
-tests/make_stream_data.py: a sparse uncompressed NIfTI, a .nii.gz (first
-open writes the bricked cache, the second reads it) and an OME-Zarr pyramid.
+"Benchmark") on small versions of its inputs from tests/make_stream_data.py:
+a sparse uncompressed NIfTI, a .nii.gz (first open writes the bricked cache,
+the second reads it), an uncompressed multi-page TIFF (read by offset) and
+an OME-Zarr pyramid.
 Each must stream, refine to the end, read bytes, and report a CSV row and a
 markdown row with every column. Nothing here is timed."""
 import csv
@@ -16,7 +17,8 @@ BENCH = ROOT / "build" / "voxlight-streambench"
 sys.path.insert(0, str(ROOT / "tests"))
 import make_stream_data  # noqa: E402
 
-CASES = [("sparse", "s.nii", "256,256,96"), ("gzip", "g.nii.gz", "130,75,24"), ("zarr", "z.zarr", "128,128,64")]
+CASES = [("sparse", "s.nii", "256,256,96"), ("gzip", "g.nii.gz", "130,75,24"), ("tiff", "t.tif", "130,75,24"),
+         ("zarr", "z.zarr", "128,128,64")]
 
 
 @pytest.mark.parametrize("kind,name,dims", CASES)

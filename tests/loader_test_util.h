@@ -8,6 +8,7 @@
 #include <dirent.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -39,6 +40,26 @@ static double voxel(const vxl_volume *v, uint64_t i)
     else if (v->texture_bits == 16) t = ((const uint16_t *)v->texels)[i] / 65535.0;
     else t = ((const float *)v->texels)[i];
     return v->tex_lo + t * (v->tex_hi - v->tex_lo);
+}
+
+/* Peak resident set of this process (kB), after clearing it when reset. */
+static inline long peak_rss_kb(int reset)
+{
+    if (reset) {
+        FILE *c = fopen("/proc/self/clear_refs", "w");
+        if (c) {
+            fputs("5", c); /* resets VmHWM to the current RSS */
+            fclose(c);
+        }
+    }
+    FILE *f = fopen("/proc/self/status", "r");
+    if (!f) return -1;
+    char line[256];
+    long kb = -1;
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, "VmHWM:", 6)) kb = strtol(line + 6, NULL, 10);
+    fclose(f);
+    return kb;
 }
 
 #endif

@@ -529,26 +529,6 @@ TEST(truncated_over_claiming_and_cancelled_opens_fail_cleanly)
     free(raw);
 }
 
-/* Peak resident set of this process (kB), after clearing it when reset. */
-static long peak_rss_kb(int reset)
-{
-    if (reset) {
-        FILE *c = fopen("/proc/self/clear_refs", "w");
-        if (c) {
-            fputs("5", c); /* resets VmHWM to the current RSS */
-            fclose(c);
-        }
-    }
-    FILE *f = fopen("/proc/self/status", "r");
-    if (!f) return -1;
-    char line[256];
-    long kb = -1;
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "VmHWM:", 6)) kb = strtol(line + 6, NULL, 10);
-    fclose(f);
-    return kb;
-}
-
 TEST(a_sparse_file_larger_than_memory_opens_with_bounded_memory)
 {
     char p[512];

@@ -111,38 +111,26 @@ static uint8_t *directories(const tiff_spec *sp)
         ENTRY(262, 3, 2, 1, sp->spp >= 3 ? 2 : 1);
         /* strip offsets and byte counts: arrays of LONG (LONG8 in BigTIFF) */
         const uint64_t page0 = d0 + p * page_span(sp);
-        {
-            put(sp, e + esz * k, 273, 2);
-            put(sp, e + esz * k + 2, sp->big ? 16 : 4, 2);
-            put(sp, e + esz * k + 4, strips, sp->big ? 8 : 4);
-            uint8_t *v = e + esz * k + (sp->big ? 12 : 8);
-            if ((uint64_t)strips * osz > (uint64_t)field) {
-                put(sp, v, extra, field);
-                v = b + extra;
-                extra += (uint64_t)strips * osz;
-            }
-            for (uint32_t s = 0; s < strips; s++)
-                put(sp, v + (uint64_t)s * osz, page0 + s * (sp->rps * row_bytes(sp) + sp->gap), osz);
-            k++;
-        }
+        /* one LONG (BigTIFF: LONG8) per strip, VALUE an expression of the strip s */
+#define STRIP_ENTRY(tag, VALUE)                                                                \
+    do {                                                                                       \
+        put(sp, e + esz * k, tag, 2);                                                          \
+        put(sp, e + esz * k + 2, sp->big ? 16 : 4, 2);                                         \
+        put(sp, e + esz * k + 4, strips, sp->big ? 8 : 4);                                     \
+        uint8_t *v_ = e + esz * k + (sp->big ? 12 : 8);                                        \
+        if ((uint64_t)strips * osz > (uint64_t)field) {                                        \
+            put(sp, v_, extra, field);                                                         \
+            v_ = b + extra;                                                                    \
+            extra += (uint64_t)strips * osz;                                                   \
+        }                                                                                      \
+        for (uint32_t s = 0; s < strips; s++) put(sp, v_ + (uint64_t)s * osz, (VALUE), osz);   \
+        k++;                                                                                   \
+    } while (0)
+        STRIP_ENTRY(273, page0 + s * (sp->rps * row_bytes(sp) + sp->gap));
         ENTRY(277, 3, 2, 1, sp->spp);
         ENTRY(278, 4, 4, 1, sp->rps);
-        {
-            put(sp, e + esz * k, 279, 2);
-            put(sp, e + esz * k + 2, sp->big ? 16 : 4, 2);
-            put(sp, e + esz * k + 4, strips, sp->big ? 8 : 4);
-            uint8_t *v = e + esz * k + (sp->big ? 12 : 8);
-            if ((uint64_t)strips * osz > (uint64_t)field) {
-                put(sp, v, extra, field);
-                v = b + extra;
-                extra += (uint64_t)strips * osz;
-            }
-            for (uint32_t s = 0; s < strips; s++) {
-                const uint32_t rows = s + 1 < strips ? sp->rps : sp->h - s * sp->rps;
-                put(sp, v + (uint64_t)s * osz, rows * row_bytes(sp), osz);
-            }
-            k++;
-        }
+        STRIP_ENTRY(279, (s + 1 < strips ? sp->rps : sp->h - s * sp->rps) * row_bytes(sp));
+#undef STRIP_ENTRY
         ENTRY(339, 3, 2, sp->spp, sp->format);
 #undef ENTRY
         put(sp, b + ifd + cnt + 10 * esz, p + 1 < sp->pages ? ifd + blk : 0, field);
@@ -427,26 +415,6 @@ TEST(a_truncated_tiff_is_an_error_naming_it)
     REQUIRE(truncate(p, 200) == 0);
     CHECK(load(p, VXL_STREAMING_ON, 0, &v) == VXL_ERR_FORMAT && !v);
     CHECKF(strstr(vxl_last_error(), p) && strstr(vxl_last_error(), "truncated"), "%s", vxl_last_error());
-}
-
-/* Peak resident set of this process (kB), after clearing it when reset. */
-static long peak_rss_kb(int reset)
-{
-    if (reset) {
-        FILE *c = fopen("/proc/self/clear_refs", "w");
-        if (c) {
-            fputs("5", c); /* resets VmHWM to the current RSS */
-            fclose(c);
-        }
-    }
-    FILE *f = fopen("/proc/self/status", "r");
-    if (!f) return -1;
-    char line[256];
-    long kb = -1;
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "VmHWM:", 6)) kb = strtol(line + 6, NULL, 10);
-    fclose(f);
-    return kb;
 }
 
 TEST(a_sparse_bigtiff_larger_than_the_budget_streams_with_bounded_memory)

@@ -6,7 +6,9 @@ cache behind."""
 import gzip
 import signal
 import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -74,6 +76,25 @@ def test_streamed_render_equals_the_whole_one(tmp_path):
     assert_same_image(whole, streamed)
     # render says what a streamed frame read; a whole volume reads nothing then
     assert "voxlight: streamed:" in streamed_err and "voxlight: streamed:" not in whole_err
+
+
+def test_streamed_multipage_tiff_equals_the_whole_read(tmp_path):
+    # an uncompressed multi-page TIFF streams by offset in the library;
+    # read whole it goes through the OpenImageIO helper: the same volume
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    import make_stream_data
+    path = tmp_path / "body.tif"
+    make_stream_data.main(["tiff", str(path), "--dims", "72,56,40"])
+    on, off = run("info", path, "--streaming", "on"), run("info", path, "--streaming", "off")
+    assert on.returncode == 0 and off.returncode == 0, on.stderr + off.stderr
+    assert info_field(on.stdout, "streamed").startswith("yes") and info_field(off.stdout, "streamed").startswith("no")
+    for field in ("dimensions", "value range", "data type"):
+        assert info_field(on.stdout, field) == info_field(off.stdout, field)
+    whole, _ = render_pixels(path, tmp_path / "off.png", "--streaming", "off")
+    streamed, err = render_pixels(path, tmp_path / "on.png", "--streaming", "on")
+    assert whole[..., 3].mean() > 5
+    assert_same_image(whole, streamed)
+    assert "voxlight: streamed:" in err
 
 
 def test_gzip_first_open_caches_with_progress_then_reads_the_cache(tmp_path):

@@ -109,7 +109,7 @@ def measure_pair(lib, name, path, tf, a, cache_dir, log):
         table = TABLES[tf]()
         view, proj = r.default_camera(width=a.size, height=a.size, azimuth=30.0, elevation=15.0)
         view, proj = np.asarray(view, np.float64), np.asarray(proj, np.float64)
-        params = native.make_params(width=a.size, height=a.size, view=view, proj=proj, filter="central",
+        params = native.make_params(width=a.size, height=a.size, view=view, proj=proj, filter=a.filter,
                                     sample_distance=1.0, step=a.step, tf_rgba=table, window=window,
                                     material=MATERIAL, shading=True, lib=lib)
         dims_read, data = vtk_peer.read_nifti(path)
@@ -272,6 +272,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--size", type=int, default=512)
     ap.add_argument("--step", type=float, default=0.5, help="ray step in voxels, both renderers")
+    ap.add_argument("--filter", default="central",
+                    help="Voxlight's gradient filter (VTK takes central differences; the error column says what another costs)")
     ap.add_argument("--ref-step", type=float, default=0.125, help="the reference's step in voxels")
     ap.add_argument("--frames", type=int, default=5, help="timed frames per renderer (median)")
     ap.add_argument("--volumes", default=",".join(VOLUMES), help="comma-separated: " + ", ".join(VOLUMES))

@@ -14,6 +14,7 @@
 // the running minimum, and ISO over one whose range excludes the iso value.
 // AVERAGE needs every sample. The sample positions are t_start + i * step
 // whether or not bricks are skipped, so skipping changes no result.
+#include "lib/ray_box.glsl"
 #ifndef MODE
 #define MODE 0
 #endif
@@ -34,13 +35,7 @@ vec2 brick_range(vec3 p, out ivec3 b)
 // loop's i++ lands on the first one past it.
 int brick_last_sample(ivec3 b, vec3 o, vec3 dir, float t_start, int i)
 {
-    vec3 lo = vec3(b) * float(u_brick_size) - 0.5, hi = lo + float(u_brick_size);
-    vec3 tb = vec3(1e30);
-    for (int a = 0; a < 3; a++)
-        if (abs(dir[a]) >= 1e-12) tb[a] = ((dir[a] > 0.0 ? hi[a] : lo[a]) - o[a]) / dir[a];
-    float t_exit = min(tb.x, min(tb.y, tb.z));
-    int next = int(min(ceil((t_exit - t_start) / u_step - 1e-3), float(u_max_steps)));
-    return max(i, next - 1);
+    return last_sample_before(brick_cube_exit(b, 1u, float(u_brick_size), o, dir), t_start, u_step, u_max_steps, i);
 }
 #endif
 

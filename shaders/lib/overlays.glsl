@@ -12,6 +12,7 @@
 // then MAX, then ADD (overlays.c), the order they combine in. A leap skips
 // only where every volume is empty: the nearest exit of all their empty
 // regions, each found in its own voxels with the shared ray parameter t.
+#include "lib/ray_box.glsl"
 #ifdef OVERLAYS
 
 uniform sampler3D u_ov_volume[OVERLAYS];    // normalised texels, linear, clamp to edge
@@ -27,22 +28,12 @@ uniform int u_ov_shading[OVERLAYS];         // 1: lit; 0: emission only
 uniform int u_ov_brick_size[OVERLAYS];      // voxels per brick edge of the distance map
 
 // The part [ta, tb] of the ray o + t * d (t in [0, t_far]) inside the box
-// [lo, hi]; false when it misses. The slab test of main(), with its guard.
+// [lo, hi]; false when it misses (lib/ray_box.glsl's slab test).
 bool ov_box_span(vec3 o, vec3 d, vec3 lo, vec3 hi, float t_far, out float ta, out float tb)
 {
     ta = 0.0;
     tb = t_far;
-    for (int a = 0; a < 3; a++) {
-        if (abs(d[a]) < 1e-12) {
-            if (o[a] < lo[a] || o[a] > hi[a]) return false;
-        } else {
-            float inv = 1.0 / d[a];
-            float t0 = (lo[a] - o[a]) * inv, t1 = (hi[a] - o[a]) * inv;
-            ta = max(ta, min(t0, t1));
-            tb = min(tb, max(t0, t1));
-        }
-    }
-    return ta < tb;
+    return box_clip(o, d, lo, hi, ta, tb) && ta < tb;
 }
 
 vec3 ov_origin(int k, vec3 o) { return (u_ov_from_vox[k] * vec4(o, 1.0)).xyz; }
@@ -127,12 +118,7 @@ float ov_empty_until(usampler3D dist, int bs, vec3 qo, vec3 qd, float t, float t
     ivec3 b = ivec3(floor((q + 0.5) / float(bs)));
     uint k = texelFetch(dist, clamp(b, ivec3(0), textureSize(dist, 0) - 1), 0).r;
     if (k == 0u) return t;
-    vec3 lo = vec3(b - ivec3(k - 1u)) * float(bs) - 0.5;
-    vec3 hi = vec3(b + ivec3(k)) * float(bs) - 0.5;
-    vec3 te = vec3(1e30);
-    for (int a = 0; a < 3; a++)
-        if (abs(qd[a]) >= 1e-12) te[a] = ((qd[a] > 0.0 ? hi[a] : lo[a]) - qo[a]) / qd[a];
-    return min(te.x, min(te.y, te.z));
+    return brick_cube_exit(b, k, float(bs), qo, qd);
 }
 
 // -ln(1 - a) >= 0, the optical depth of a step of opacity a; a series where

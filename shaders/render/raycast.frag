@@ -8,6 +8,7 @@
 #include "lib/shading.glsl"
 #include "lib/cut.glsl" // issue 19 cutaways: CUT_CONVEX, CUT_CUTTERS
 #include "lib/matcap.glsl"
+#include "lib/ray_box.glsl"
 
 #ifndef GOPACITY
 #define GOPACITY 0
@@ -200,16 +201,10 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
                 uint k = texelFetch(u_brick_distance, clamp(b, ivec3(0), textureSize(u_brick_distance, 0) - 1), 0).r;
                 if (k > 0u) {
                     // Leap to where the ray leaves the cube of 2k-1 empty bricks
-                    // around this one (Chebyshev distance map).
-                    vec3 lo = vec3(b - ivec3(k - 1u)) * float(u_brick_size) - 0.5;
-                    vec3 hi = vec3(b + ivec3(k)) * float(u_brick_size) - 0.5;
-                    vec3 tb = vec3(1e30);
-                    for (int a = 0; a < 3; a++)
-                        if (abs(dir[a]) >= 1e-12) tb[a] = ((dir[a] > 0.0 ? hi[a] : lo[a]) - o[a]) / dir[a];
-                    float t_exit = min(tb.x, min(tb.y, tb.z));
-                    // the sample at the exit is evaluated (minus a hair for rounding)
-                    int next = int(min(ceil((t_exit - t_start) / u_step - 1e-3), float(u_max_steps)));
-                    leap = max(i, next - 1); // the loop's i++ lands on `next`
+                    // around this one (Chebyshev distance map); the loop's i++
+                    // lands on the first sample past it.
+                    leap = last_sample_before(brick_cube_exit(b, k, float(u_brick_size), o, dir), t_start, u_step,
+                                              u_max_steps, i);
 #ifndef CLASSIFY_PREINT
                     i = leap;
                     continue;
@@ -290,23 +285,12 @@ void main()
     if (!(len > 0.0) || isinf(len) || any(isnan(o)) || any(isinf(o)) || isnan(t_far)) { emit_nothing(); return; }
     dir /= len;
 
-    // Slab test with a guarded reciprocal: an axis-parallel ray whose origin
-    // lies on a slab plane would otherwise give 0 * inf = NaN.
-    vec3 lo = vec3(-0.5), hi = u_dims - 0.5;
+    // The part of the ray inside the volume's box (lib/ray_box.glsl).
     float t0 = 0.0, t1 = t_far;
 #ifdef OVERLAYS
     if (!overlay_span(o, dir, t_far, t0, t1)) { emit_nothing(); return; } // issue 20: the union of all boxes
 #else
-    for (int a = 0; a < 3; a++) {
-        if (abs(dir[a]) < 1e-12) {
-            if (o[a] < lo[a] || o[a] > hi[a]) { emit_nothing(); return; }
-        } else {
-            float inv = 1.0 / dir[a];
-            float ta = (lo[a] - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
-            t0 = max(t0, min(ta, tb));
-            t1 = min(t1, max(ta, tb));
-        }
-    }
+    if (!box_clip(o, dir, vec3(-0.5), u_dims - 0.5, t0, t1)) { emit_nothing(); return; }
 #endif
     // View-space planar distance along the ray is affine in t.
     vec4 row2 = vec4(u_mv[0][2], u_mv[1][2], u_mv[2][2], u_mv[3][2]);

@@ -74,10 +74,10 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
 {
     char defines[512] = "";
     const char *fdef = filter < VXL_FILTER_COUNT ? filter_defines[filter] : filter_defines[0];
-    const uint32_t storage = flags & (VXL_FLAG_PAGED | VXL_FLAG_COMPRESSED_DOMAIN);
+    const uint32_t storage = flags & (VXL_FLAG_PAGED | VXL_FLAG_COMPRESSED_DOMAIN | VXL_FLAG_PAGED_MIXED);
     const char *paged = storage == (VXL_FLAG_PAGED | VXL_FLAG_COMPRESSED_DOMAIN) ? "#define PAGED 1\n#define COMPRESSED_DOMAIN 1\n"
                         : storage == VXL_FLAG_PAGED                              ? "#define PAGED 1\n"
-                        : storage == VXL_FLAG_PAGED_MIXED                        ? "#define PAGED 1\n#define PAGED_MIXED 1\n"
+                        : storage == (VXL_FLAG_PAGED | VXL_FLAG_PAGED_MIXED)     ? "#define PAGED 1\n#define PAGED_MIXED 1\n"
                                                                                  : "";
     GLuint a = 0, b = 0;
     int rc;
@@ -178,7 +178,7 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
 
 int vxl_program_get(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLuint *out)
 {
-    uint32_t key = kind | (filter << 5) | (flags << 12); /* kind < 32, filter < 8 */
+    const uint64_t key = kind | (filter << 5) | ((uint64_t)flags << 12); /* kind < 32, filter < 8 */
     for (int i = 0; i < g->n_programs; i++)
         if (g->programs[i].key == key) {
             *out = g->programs[i].program;

@@ -43,9 +43,9 @@
 /* Program flags the storage sets on shaders that sample the volume. */
 #define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
 #define VXL_FLAG_COMPRESSED_DOMAIN 128u /* with PAGED: the pool holds codes, every tap decodes its 8 neighbours */
-/* 128 without PAGED (the key has no bit to spare): PAGED and PAGED_MIXED, the streamed storage's page table whose
- * entries may stand in for a coarser level's brick (storage_streamed.c) */
-#define VXL_FLAG_PAGED_MIXED 128u
+/* with PAGED: the streamed storage's page table, whose entries may stand in for a coarser level's brick
+ * (PAGED_MIXED, storage_streamed.c) */
+#define VXL_FLAG_PAGED_MIXED (1u << 20)
 /* Ray caster program flags of issue 19 (gl_util.c turns them into defines). */
 #define VXL_FLAG_MODE_SHIFT 10u        /* bits 10-12: VXL_MODE_* (MODE) */
 #define VXL_FLAG_MATCAP (1u << 13)     /* MATCAP: shading reads the MatCap */
@@ -57,7 +57,7 @@
 #define VXL_FLAG_OVERLAYS_SHIFT 18u
 
 typedef struct vxl_program_entry {
-    uint32_t key;
+    uint64_t key; /* kind | filter << 5 | flags << 12 (gl_util.c): every flag bit fits */
     GLuint program;
 } vxl_program_entry;
 

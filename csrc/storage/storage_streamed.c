@@ -697,7 +697,7 @@ static void report_streamed(const vxl_storage_state *st, vxl_render_stats *out)
 static uint32_t sample_flags_streamed(const vxl_storage_state *st)
 {
     (void)st;
-    return VXL_FLAG_PAGED_MIXED;
+    return VXL_FLAG_PAGED | VXL_FLAG_PAGED_MIXED;
 }
 
 const vxl_storage_ops vxl_storage_streamed = {

@@ -127,6 +127,20 @@ void vxl_overlays_geoms(const vxl_overlays_state *s, const vxl_volume_geom *geom
 uint32_t vxl_overlays_flags(const vxl_frame *f) { return f->overlays.count << VXL_FLAG_OVERLAYS_SHIFT; }
 
 /* The overlay's transfer function on its slot, when its key changed. */
+/* After a texture upload: on a GL error the texture is deleted and its bytes
+ * and key cleared (the next frame uploads again), else they become the
+ * new ones; the budget's count follows either way. */
+static int settle_upload(vxl_overlays_state *s, GLuint *tex, uint64_t *bytes, uint64_t *key, uint64_t new_bytes,
+                         uint64_t new_key, const char *what)
+{
+    const int rc = vxl_gl_check(s->gpu, what);
+    if (rc) delete_tex(s->gpu, tex);
+    *bytes = rc ? 0 : new_bytes;
+    *key = rc ? 0 : new_key;
+    recount(s);
+    return rc;
+}
+
 static int ensure_tf(vxl_overlays_state *s, vxl_overlay_slot *sl, const vxl_frame_overlay *ov)
 {
     if (sl->tf_tex && sl->tf_key == ov->key) return VXL_OK;
@@ -140,16 +154,9 @@ static int ensure_tf(vxl_overlays_state *s, vxl_overlay_slot *sl, const vxl_fram
     gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
     gl->BindTexture(GL_TEXTURE_1D, sl->tf_tex);
     gl->TexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, (GLsizei)ov->tf_size, 0, GL_RGBA, GL_FLOAT, ov->tf);
-    if ((rc = vxl_gl_check(g, "uploading an overlay's transfer function"))) {
-        delete_tex(g, &sl->tf_tex);
-        sl->tf_bytes = 0;
-        sl->tf_key = 0;
-        recount(s);
+    if ((rc = settle_upload(s, &sl->tf_tex, &sl->tf_bytes, &sl->tf_key, bytes, ov->key,
+                            "uploading an overlay's transfer function")))
         return rc;
-    }
-    sl->tf_bytes = bytes;
-    sl->tf_key = ov->key;
-    recount(s);
     s->table_uploads++;
     return VXL_OK;
 }
@@ -192,17 +199,8 @@ static int ensure_distance(vxl_overlays_state *s, vxl_overlay_slot *sl, const vx
     gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, (GLsizei)b->dims[0], (GLsizei)b->dims[1], (GLsizei)b->dims[2], 0,
                    GL_RED_INTEGER, GL_UNSIGNED_BYTE, d);
     free(d);
-    if ((rc = vxl_gl_check(g, "uploading an overlay's brick distance map"))) {
-        delete_tex(g, &sl->distance_tex);
-        sl->distance_bytes = 0;
-        sl->distance_key = 0;
-        recount(s);
-        return rc;
-    }
-    sl->distance_bytes = n;
-    sl->distance_key = key;
-    recount(s);
-    return VXL_OK;
+    return settle_upload(s, &sl->distance_tex, &sl->distance_bytes, &sl->distance_key, n, key,
+                         "uploading an overlay's brick distance map");
 }
 
 static GLint loc_k(vxl_gl *gl, GLuint prog, const char *name, uint32_t k)

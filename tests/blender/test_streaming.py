@@ -114,6 +114,26 @@ def streamed_volume_renders_like_a_whole_one():
     assert diff.max() < 0.02, diff.max()
 
 
+@test
+def streamed_tiff_stack_renders_like_a_whole_one():
+    # an uncompressed multi-page TIFF is read by offset in the library when
+    # streamed, by the OpenImageIO helper when read whole: the same F12
+    path = os.path.join(u.TMP, "body_stream.tif")
+    script = os.path.join(u.ROOT, "tests", "make_stream_data.py")
+    subprocess.run(["/usr/bin/python3", script, "tiff", path, "--dims", "64,48,40"], check=True, timeout=120)
+    scene, ob = streamed_scene(path, "off")
+    assert not entry_of(ob).info["streamed"]
+    whole = f12(scene, "tiff_whole")
+    scene, ob = streamed_scene(path, "on")
+    entry = entry_of(ob)
+    assert entry.info["streamed"], "an uncompressed multi-page TIFF did not stream"
+    streamed = f12(scene, "tiff_streamed")
+    assert entry.last_frame["stream_level"] == 0 and entry.last_frame["refine_pending"] == 0, entry.last_frame
+    assert whole[..., 3].max() > 0.1, "the body does not show"
+    diff = np.abs(whole - streamed)
+    assert diff.max() < 0.02, diff.max()
+
+
 SPARSE_DIMS = os.environ.get("VOXLIGHT_STREAM_DIMS", "2048,2048,768")
 
 

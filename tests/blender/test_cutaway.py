@@ -144,7 +144,10 @@ def slice_plane_shows_the_library_resample_and_follows_the_plane():
                                window=look["window"], tf_rgba=look["tf_rgba"])
         # the library's colours are display-referred: the image holds them scene-linear
         want = _mod("render_hooks").display_to_linear(entry.renderer.render_slice(p, sq, "nearest"))
-        assert np.array_equal(px, want), (tag, np.abs(px - want).max())
+        # equal to float rounding: the add-on takes the plane and model from
+        # the evaluated objects, this check from the originals, whose float
+        # matrices may differ in the last bit (seen once: 6e-8 after a move)
+        assert np.abs(px - want).max() <= 1e-6, (tag, np.abs(px - want).max())
         inside = slice_plane.inside_volume(slice_plane.pixel_positions(sq, w, h), model,
                                            tuple(ob.voxlight.dims))
         assert (px[..., 3][inside] == 1).mean() > 0.99, tag

@@ -165,11 +165,13 @@ static uint32_t queue_bricks_for(const vxl_storage_state *st, const vxl_pages *p
     return n < 2 ? 2 : n > 4096 ? 4096 : (uint32_t)n;
 }
 
-/* What the storage holds whatever the pool: every level's page table, and
- * the staging queue plus read buffer on the CPU. */
+/* What the storage holds whatever the pool: the loader's staging queue
+ * (vxl_loader_bytes: its threads read into those buffers), every level's
+ * entries on the CPU, and the drawn table at most level 0's size twice
+ * (`mixed` on the CPU, its texture on the GPU); 16 bytes an entry. */
 static uint64_t fixed_bytes(const vxl_pages *levels, uint32_t n_levels, uint32_t queue)
 {
-    uint64_t b = ((uint64_t)queue + 1) * brick_bytes(&levels[0]);
+    uint64_t b = (uint64_t)queue * brick_bytes(&levels[0]) + 2 * vxl_page_count(&levels[0]) * 16;
     for (uint32_t k = 0; k < n_levels; k++) b += vxl_page_count(&levels[k]) * 16;
     return b;
 }

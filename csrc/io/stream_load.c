@@ -61,9 +61,14 @@ int vxl_stream_plan(const char *path, const uint32_t dims[3], uint32_t dtype, co
     vxl_err inner = {0};
     int rc = vxl_plan_voxels(path, dims, dtype, opt, nbytes, &inner);
     if (rc == VXL_ERR_LIMIT && not_streamable && mode != VXL_STREAMING_OFF)
-        return vxl_fail(e, rc, "%s (streaming is not available for %s)", inner.msg, not_streamable);
+        return vxl_fail_not_streamable(e, rc, inner.msg, not_streamable);
     if (rc) return vxl_fail(e, rc, "%s", inner.msg);
     return VXL_OK;
+}
+
+int vxl_fail_not_streamable(vxl_err *e, int rc, const char *msg, const char *what)
+{
+    return vxl_fail(e, rc, "%s (streaming is not available for %s)", msg, what); /* vxl_fail formats before it writes e */
 }
 
 int vxl_stream_file_holds(const char *path, uint64_t offset, int compressed, uint64_t nbytes,

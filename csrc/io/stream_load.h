@@ -26,6 +26,10 @@ uint32_t vxl_load_streaming(const vxl_load_options *opt);
 int vxl_stream_plan(const char *path, const uint32_t dims[3], uint32_t dtype, const vxl_load_options *opt,
                     const char *not_streamable, int *stream, uint64_t *nbytes, vxl_err *e);
 
+/* Fails with msg (a whole read's budget error) ended by why streaming did
+ * not help: "(streaming is not available for <what>)". msg may be e->msg. */
+int vxl_fail_not_streamable(vxl_err *e, int rc, const char *msg, const char *what);
+
 /* Whether the file can hold what its header claims (raw: offset + nbytes
  * within it; compressed: within deflate's 1032:1 bound), checked in AUTO
  * mode before streaming: when it cannot, the loader reads whole, whose

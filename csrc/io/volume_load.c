@@ -44,12 +44,7 @@ static int vxl_tiff_load(const char *path, const vxl_load_options *opt, vxl_volu
     snprintf(why, sizeof why, "%s", rc == VXL_OK && !t.page_offsets ? t.why : "");
     vxl_tiff_layout_free(&t);
     rc = vxl_image_stack_load(path, opt, out, e);
-    if (rc == VXL_ERR_LIMIT && why[0] && e) {
-        char msg[sizeof e->msg];
-        snprintf(msg, sizeof msg, "%s", e->msg);
-        return vxl_fail(e, rc, "%s (streaming is not available for %s)", msg, why);
-    }
-    return rc;
+    return rc == VXL_ERR_LIMIT && why[0] && e ? vxl_fail_not_streamable(e, rc, e->msg, why) : rc;
 }
 
 static int has_suffix(const char *s, const char *suffix)
@@ -111,6 +106,6 @@ int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **
     const char *whole_only = fn == vxl_dicom_load ? "DICOM" : fn == vxl_image_stack_load ? "TIFF/PNG image stacks"
                              : fn == vxl_vdb_load ? "OpenVDB" : NULL;
     if (rc == VXL_ERR_LIMIT && whole_only && vxl_load_streaming(opt) != VXL_STREAMING_OFF)
-        return vxl_fail(NULL, rc, "%s (streaming is not available for %s)", e.msg, whole_only);
+        return vxl_fail_not_streamable(NULL, rc, e.msg, whole_only);
     return rc;
 }

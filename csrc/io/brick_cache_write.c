@@ -104,7 +104,9 @@ static void close_source(zsrc *s)
     memset(s, 0, sizeof *s);
 }
 
-/* Inflates the next n bytes into dst (NULL: skip them). */
+#define BEFORE_VOXELS UINT32_MAX /* inflate_bytes' z_slice while skipping to the chosen frame */
+
+/* Inflates the next n bytes of slice z_slice into dst (NULL: skip them). */
 static int inflate_bytes(writer *w, zsrc *s, uint8_t *dst, uint64_t n, uint32_t z_slice)
 {
     uint8_t skip[4096];
@@ -113,6 +115,9 @@ static int inflate_bytes(writer *w, zsrc *s, uint8_t *dst, uint64_t n, uint32_t 
             const size_t r = fread(s->in, 1, IN_CHUNK, s->f);
             if (!r) {
                 if (ferror(s->f)) return vxl_fail(w->e, VXL_ERR_IO, "read error in %s: %s", w->l->path, strerror(errno));
+                if (z_slice == BEFORE_VOXELS)
+                    return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends before its voxels (offset %llu)", w->l->path,
+                                    (unsigned long long)w->l->offset);
                 return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends at slice %u of %u: the file is shorter than its header says",
                                 w->l->path, z_slice, w->l->dims[2]);
             }
@@ -123,7 +128,8 @@ static int inflate_bytes(writer *w, zsrc *s, uint8_t *dst, uint64_t n, uint32_t 
             if (inflateReset(&s->z) != Z_OK) return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "%s: zlib reset failed", w->l->path);
             s->ended = 0;
         }
-        const uInt room = n > (dst ? (1u << 30) : sizeof skip) ? (dst ? (1u << 30) : (uInt)sizeof skip) : (uInt)n;
+        const uint64_t cap = dst ? (1u << 30) : sizeof skip; /* inflate counts in uInt */
+        const uInt room = (uInt)(n < cap ? n : cap);
         s->z.next_out = dst ? dst : skip;
         s->z.avail_out = room;
         const int zr = inflate(&s->z, Z_NO_FLUSH);
@@ -134,7 +140,7 @@ static int inflate_bytes(writer *w, zsrc *s, uint8_t *dst, uint64_t n, uint32_t 
         else if (zr == Z_BUF_ERROR && !s->z.avail_in) continue; /* needs more input */
         else if (zr != Z_OK)
             return vxl_fail(w->e, VXL_ERR_FORMAT, "%s: the compressed stream is damaged at slice %u: %s", w->l->path,
-                            z_slice, s->z.msg ? s->z.msg : "zlib error");
+                            z_slice == BEFORE_VOXELS ? 0 : z_slice, s->z.msg ? s->z.msg : "zlib error");
     }
     return VXL_OK;
 }
@@ -160,13 +166,8 @@ static int open_source(writer *w, zsrc *s)
         return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "%s: cannot start zlib", w->l->path);
     }
     s->started = 1;
-    int rc = inflate_bytes(w, s, NULL, w->l->offset, 0);
-    if (rc) {
-        close_source(s);
-        if (w->e->code == VXL_ERR_FORMAT && strstr(w->e->msg, " ends at slice "))
-            return vxl_fail(w->e, VXL_ERR_FORMAT, "%s ends before its voxels (offset %llu)", w->l->path,
-                            (unsigned long long)w->l->offset);
-    }
+    int rc = inflate_bytes(w, s, NULL, w->l->offset, BEFORE_VOXELS);
+    if (rc) close_source(s);
     return rc;
 }
 

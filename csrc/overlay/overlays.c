@@ -126,7 +126,6 @@ void vxl_overlays_geoms(const vxl_overlays_state *s, const vxl_volume_geom *geom
 
 uint32_t vxl_overlays_flags(const vxl_frame *f) { return f->overlays.count << VXL_FLAG_OVERLAYS_SHIFT; }
 
-/* The overlay's transfer function on its slot, when its key changed. */
 /* After a texture upload: on a GL error the texture is deleted and its bytes
  * and key cleared (the next frame uploads again), else they become the
  * new ones; the budget's count follows either way. */
@@ -141,6 +140,7 @@ static int settle_upload(vxl_overlays_state *s, GLuint *tex, uint64_t *bytes, ui
     return rc;
 }
 
+/* The overlay's transfer function on its slot, when its key changed. */
 static int ensure_tf(vxl_overlays_state *s, vxl_overlay_slot *sl, const vxl_frame_overlay *ov)
 {
     if (sl->tf_tex && sl->tf_key == ov->key) return VXL_OK;

@@ -155,7 +155,7 @@ $(BUILD)/voxlight-sceneshadowbench: bench/scene_shadow_study.c bench/bench_util.
 # test_brick_cache calls the cache's internals (csrc/io/brick_cache.h), so it
 # links their objects and those its checks compare against, as well as the library.
 BRICK_CACHE_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,brick_cache brick_cache_read brick_cache_write \
-	brick_cache_format brick_source brick_levels bricks volume error paging lod brick_loader)
+	brick_cache_format brick_source brick_levels bricks volume error paging lod brick_loader loader_util)
 $(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wildcard tests/*.h) $(BRICK_CACHE_TEST_OBJ) \
 		$(BUILD)/libvoxlight.so | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(BRICK_CACHE_TEST_OBJ) -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'

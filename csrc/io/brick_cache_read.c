@@ -19,6 +19,7 @@
 
 #include "brick_cache.h"
 #include "brick_cache_format.h"
+#include "loader_util.h"
 
 #define LRU_SLOTS 64
 #define TABLE_CHUNK 4096 /* entries read at a time */
@@ -46,18 +47,10 @@ static int cache_read(vxl_brick_source *s, uint32_t level, const uint32_t lo[3],
 static void cache_close(vxl_brick_source *s);
 static const vxl_brick_source_ops cache_ops = {cache_read, cache_close};
 
+/* 0 when all n bytes at off were read (a short or failed read is damage to the cache) */
 static int pread_all(int fd, void *buf, size_t n, uint64_t off)
 {
-    uint8_t *p = buf;
-    while (n) {
-        ssize_t r = pread(fd, p, n, (off_t)off);
-        if (r < 0 && errno == EINTR) continue;
-        if (r <= 0) return -1;
-        p += r;
-        n -= (size_t)r;
-        off += (uint64_t)r;
-    }
-    return 0;
+    return vxl_pread_full(fd, buf, n, off) == (int64_t)n ? 0 : -1;
 }
 
 static uint64_t brick_bytes(const cache_ctx *c, uint32_t level, uint64_t i)

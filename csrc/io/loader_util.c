@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #define IO_CHUNK (256u * 1024u)
@@ -15,6 +16,19 @@
 int vxl_fail_in(vxl_err *e, const char *path, const vxl_err *inner)
 {
     return vxl_fail(e, inner->code, "'%s': %s", path, inner->msg);
+}
+
+int64_t vxl_pread_full(int fd, void *buf, size_t n, uint64_t off)
+{
+    size_t got = 0;
+    while (got < n) {
+        ssize_t r = pread(fd, (uint8_t *)buf + got, n - got, (off_t)(off + got));
+        if (r < 0 && errno == EINTR) continue;
+        if (r < 0) return -1;
+        if (r == 0) break;
+        got += (size_t)r;
+    }
+    return (int64_t)got;
 }
 
 int vxl_regular_file(const char *path, uint64_t *size, vxl_err *e)

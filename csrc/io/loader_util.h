@@ -23,6 +23,11 @@ int vxl_read_head(const char *path, char **text, size_t *len, uint64_t *file_siz
  * directory a hostile header could point at); *size receives its size. */
 int vxl_regular_file(const char *path, uint64_t *size, vxl_err *e);
 
+/* Reads n bytes at file offset off, retrying short reads and EINTR: n when
+ * all were read, fewer when the file ends first, -1 on a read error (errno
+ * says which). The callers word their own errors. */
+int64_t vxl_pread_full(int fd, void *buf, size_t n, uint64_t off);
+
 /* Splits off the next line of text[*pos..len): returns it NUL-terminated in
  * place (without \r\n) or NULL at the end; *pos moves past the newline.
  * *had_newline says whether the line was terminated. */

@@ -61,16 +61,11 @@ static void raw_close(vxl_brick_source *s)
 static int read_at(vxl_brick_source *s, void *buf, size_t n, uint64_t off, vxl_err *e)
 {
     const raw_ctx *c = s->ctx;
-    size_t got = 0;
-    while (got < n) {
-        ssize_t r = pread(c->fd, (uint8_t *)buf + got, n - got, (off_t)(off + got));
-        if (r < 0 && errno == EINTR) continue;
-        if (r < 0) return vxl_fail(e, VXL_ERR_IO, "read error in '%s': %s", c->l.path, strerror(errno));
-        if (r == 0)
-            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': file ends at %llu, before the voxels the header claims",
-                            c->l.path, (unsigned long long)(off + got));
-        got += (size_t)r;
-    }
+    const int64_t got = vxl_pread_full(c->fd, buf, n, off);
+    if (got < 0) return vxl_fail(e, VXL_ERR_IO, "read error in '%s': %s", c->l.path, strerror(errno));
+    if ((uint64_t)got < n)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': file ends at %llu, before the voxels the header claims", c->l.path,
+                        (unsigned long long)(off + (uint64_t)got));
     __atomic_fetch_add(&s->bytes_read, (uint64_t)n, __ATOMIC_RELAXED);
     return VXL_OK;
 }

@@ -54,16 +54,11 @@ static uint64_t get(const tfile *f, const uint8_t *p, int n)
 /* n bytes at off, which the caller has checked lie in the file. */
 static int read_exact(const tfile *f, void *buf, size_t n, uint64_t off, vxl_err *e)
 {
-    size_t got = 0;
-    while (got < n) {
-        ssize_t r = pread(f->fd, (uint8_t *)buf + got, n - got, (off_t)(off + got));
-        if (r < 0 && errno == EINTR) continue;
-        if (r < 0) return vxl_fail(e, VXL_ERR_IO, "read error in '%s': %s", f->path, strerror(errno));
-        if (r == 0)
-            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': truncated file: it ends at byte %llu", f->path,
-                            (unsigned long long)(off + got));
-        got += (size_t)r;
-    }
+    const int64_t got = vxl_pread_full(f->fd, buf, n, off);
+    if (got < 0) return vxl_fail(e, VXL_ERR_IO, "read error in '%s': %s", f->path, strerror(errno));
+    if ((uint64_t)got < n)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': truncated file: it ends at byte %llu", f->path,
+                        (unsigned long long)(off + (uint64_t)got));
     return VXL_OK;
 }
 

@@ -33,7 +33,7 @@ static void remove_tree(const char *path)
 }
 
 /* Data value of voxel i, reconstructed from the stored texel. */
-static double voxel(const vxl_volume *v, uint64_t i)
+static inline double voxel(const vxl_volume *v, uint64_t i)
 {
     double t;
     if (v->texture_bits == 8) t = ((const uint8_t *)v->texels)[i] / 255.0;

@@ -47,6 +47,25 @@ int vxl_context_open(vxl_context *c, uint32_t backend, vxl_err *e)
     }
 }
 
+int vxl_context_screen_kind(const char *backend_name, const char *gl_renderer)
+{
+    if (!backend_name || !gl_renderer || !strstr(gl_renderer, "llvmpipe")) return 0;
+    if (!strcmp(backend_name, "osmesa")) return 1;
+    if (!strcmp(backend_name, "egl-surfaceless")) return 2;
+    if (!strcmp(backend_name, "egl-device")) return 3; /* Mesa's software device, when it lists one */
+    return 4; /* an unknown llvmpipe backend: one lock of its own, never none */
+}
+
+pthread_mutex_t *vxl_context_screen_lock(int kind)
+{
+    /* One mutex per llvmpipe screen a process can have through us: the
+     * screens are process-wide inside Mesa, so their locks are too. They
+     * hold no data and need no set-up. */
+    static pthread_mutex_t locks[4] = {PTHREAD_MUTEX_INITIALIZER, PTHREAD_MUTEX_INITIALIZER,
+                                       PTHREAD_MUTEX_INITIALIZER, PTHREAD_MUTEX_INITIALIZER};
+    return kind >= 1 && kind <= 4 ? &locks[kind - 1] : NULL;
+}
+
 void vxl_context_close(vxl_context *c)
 {
     if (c && c->close) c->close(c);

@@ -4,6 +4,7 @@
 #ifndef VXL_CONTEXT_H
 #define VXL_CONTEXT_H
 
+#include <pthread.h>
 #include <stdint.h>
 
 #include "error.h"
@@ -26,6 +27,23 @@ typedef struct vxl_context {
  * VOXLIGHT_BACKEND (auto|osmesa|egl) overrides AUTO only. */
 int vxl_context_open(vxl_context *c, uint32_t backend, vxl_err *e);
 void vxl_context_close(vxl_context *c);
+
+/* Mesa's llvmpipe (22.3, Debian 12) has every context of one screen look
+ * into the others' queued scenes without their owners' synchronisation:
+ * mapping a buffer or texture (glBufferData, glTexSubImage3D, glReadPixels...)
+ * walks the resource lists of every context's scenes, while each context's
+ * own thread frees and refills them. Two renderers rendering at once then
+ * read freed memory and crash in lp_scene_is_resource_referenced
+ * (tests/upstream/llvmpipe_shared_screen_race.c reproduces it without
+ * Voxlight). All OSMesa contexts of a process share one screen, and so do all
+ * surfaceless EGL contexts (one EGLDisplay), so each backend's llvmpipe
+ * contexts take turns: the lock returned here is held around every job of a
+ * renderer's GL thread. The lock is process-wide because the screen it
+ * guards is. Which screen kind a context is on: 0 none (a GPU driver: no
+ * lock), else a small number naming the shared lock. */
+int vxl_context_screen_kind(const char *backend_name, const char *gl_renderer);
+/* The lock for that kind, NULL for 0. */
+pthread_mutex_t *vxl_context_screen_lock(int kind);
 
 /* Backend entry points, in backend_osmesa.c and backend_egl.c. egl_mode: 0
  * hardware device only, 1 Mesa surfaceless only, 2 device then surfaceless. */

@@ -13,7 +13,11 @@ static void *thread_main(void *p)
             vxl_job_fn fn = t->job;
             void *arg = t->arg;
             pthread_mutex_unlock(&t->lock);
+            t->held = t->exclusive;
+            if (t->held) pthread_mutex_lock(t->held);
             int r = fn ? fn(arg) : 0;
+            if (t->held) pthread_mutex_unlock(t->held);
+            t->held = NULL;
             pthread_mutex_lock(&t->lock);
             t->result = r;
             t->pending = 0;
@@ -64,6 +68,15 @@ int vxl_gl_thread_call(vxl_gl_thread *t, vxl_job_fn fn, void *arg)
     pthread_mutex_unlock(&t->lock);
     pthread_mutex_unlock(&t->call_lock);
     return r;
+}
+
+void vxl_gl_thread_hold(vxl_gl_thread *t, pthread_mutex_t *m)
+{
+    t->exclusive = m;
+    if (t->held == m) return;
+    if (t->held) pthread_mutex_unlock(t->held);
+    t->held = m;
+    if (m) pthread_mutex_lock(m);
 }
 
 void vxl_gl_thread_stop(vxl_gl_thread *t, vxl_job_fn fn, void *arg)

@@ -41,6 +41,8 @@ static int job_open(void *p)
     r->gpu.info.backend = r->ctx.backend;
     snprintf(r->gpu.info.backend_name, sizeof r->gpu.info.backend_name, "%s", r->ctx.name);
     copy_gl_string(r, GL_RENDERER, r->gpu.info.gl_renderer, sizeof r->gpu.info.gl_renderer);
+    /* before any call that maps a resource: llvmpipe contexts of one screen take turns */
+    vxl_gl_thread_hold(&r->thread, vxl_context_screen_lock(vxl_context_screen_kind(r->ctx.name, r->gpu.info.gl_renderer)));
     copy_gl_string(r, GL_VERSION, r->gpu.info.gl_version, sizeof r->gpu.info.gl_version);
     r->gpu.gl.GetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &r->gpu.info.max_3d_texture_size);
     r->gpu.gl.GenVertexArrays(1, &r->vao);

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "reader_stream.h"
@@ -58,6 +59,37 @@ static int parse_options(char **argv, vxl_load_options *opt)
     return 1;
 }
 
+/* A third-party reader that asks for an absurd allocation (OpenImageIO
+ * sized a buffer by a corrupt strip header: 31 GB for a 288-byte file) must
+ * get a failed allocation, which the reader reports as a clear error, not a
+ * machine pushed into swap or the OOM killer. So the helper caps its own
+ * address space: three times the budget (the source voxels, the volume built
+ * from them, a reader's own copy) plus 2 GiB for the libraries, thread
+ * stacks and the reader's chunk buffers. Sanitizer builds reserve terabytes
+ * of shadow memory up front, so there the cap is left off. */
+#if defined(__SANITIZE_ADDRESS__)
+#define VXL_HELPER_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define VXL_HELPER_SANITIZED 1
+#endif
+#endif
+
+static void cap_address_space(uint64_t budget)
+{
+#ifndef VXL_HELPER_SANITIZED
+    const uint64_t headroom = 2ull << 30;
+    uint64_t cap = budget > (UINT64_MAX - headroom) / 3 ? UINT64_MAX : 3 * budget + headroom;
+    struct rlimit lim;
+    if (getrlimit(RLIMIT_AS, &lim) == 0 && (lim.rlim_max == RLIM_INFINITY || cap < lim.rlim_max)) {
+        lim.rlim_cur = (rlim_t)cap;
+        setrlimit(RLIMIT_AS, &lim); /* best effort: a failure leaves the process as it was */
+    }
+#else
+    (void)budget;
+#endif
+}
+
 static void volume_header(const vxl_volume *v, vxl_reader_header *h)
 {
     h->kind = VXL_REPLY_VOLUME;
@@ -100,6 +132,7 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
         perror(helper);
         return 3;
     }
+    cap_address_space(opt.memory_budget_bytes);
     const char *path = argv[2];
     vxl_reader_header h;
     memset(&h, 0, sizeof h);

@@ -300,6 +300,42 @@ int collect_slices(const std::string &path, const vxl_load_options *opt, std::ve
     return VXL_OK;
 }
 
+// OpenImageIO converts a page in chunks of whole strips (about 64 MiB,
+// rounded up to a multiple of RowsPerStrip) or of whole tiles, allocating
+// one chunk up front. A corrupt strip or tile size makes that chunk absurd:
+// a 288-byte TIFF with 1,986,356,271 rows per strip asked for 31 GB, which
+// ends the helper process (or, in-process, any caller) before OpenImageIO
+// reads a byte. Strips of more rows than the page has, tiles larger than the
+// page, and rows larger than the memory budget are corruption: refused here,
+// before the read, with the numbers.
+constexpr uint64_t kReadChunkBytes = 64ull << 20; // OpenImageIO's chunk target
+
+int check_read_geometry(const OIIO::ImageSpec &spec, const std::string &name, uint64_t budget, vxl_err *e)
+{
+    const uint64_t row = spec.scanline_bytes(true); // native type, every channel
+    const uint64_t page = row * static_cast<uint64_t>(spec.height);
+    if (row > budget)
+        return vxl_fail(e, VXL_ERR_LIMIT, "'%s': one row of %d channels needs %llu bytes, over the %llu-byte memory budget",
+                        name.c_str(), spec.nchannels, static_cast<unsigned long long>(row),
+                        static_cast<unsigned long long>(budget));
+    if (spec.tile_width > 0) {
+        const uint64_t tile = static_cast<uint64_t>(spec.tile_width) * static_cast<uint64_t>(spec.tile_height) *
+                              static_cast<uint64_t>(spec.tile_depth > 0 ? spec.tile_depth : 1) * spec.pixel_bytes(true);
+        if (tile > std::max(kReadChunkBytes, 4 * page))
+            return vxl_fail(e, VXL_ERR_FORMAT,
+                            "'%s': corrupt TIFF: %dx%d tiles in a %dx%d image (reading one tile would need %llu bytes)",
+                            name.c_str(), spec.tile_width, spec.tile_height, spec.width, spec.height,
+                            static_cast<unsigned long long>(tile));
+        return VXL_OK;
+    }
+    const int rps = spec.get_int_attribute("tiff:RowsPerStrip", 0);
+    if (rps > spec.height && static_cast<uint64_t>(rps) * row > std::max(kReadChunkBytes, page))
+        return vxl_fail(e, VXL_ERR_FORMAT,
+                        "'%s': corrupt TIFF: %d rows per strip in a %d-row image (reading it would need %llu bytes)",
+                        name.c_str(), rps, spec.height, static_cast<unsigned long long>(rps) * row);
+    return VXL_OK;
+}
+
 std::string slice_name(const Slice &s)
 {
     return s.subimage ? s.path + " (page " + std::to_string(s.subimage + 1) + ")" : s.path;
@@ -379,6 +415,8 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
             if (dtype_for(spec.format, rt) != dtype)
                 return vxl_fail(e, VXL_ERR_FORMAT, "mixed slices: '%s' has pixel type %s, unlike '%s'", name.c_str(),
                                 spec.format.c_str(), first.c_str());
+            rc = check_read_geometry(spec, name, vxl_load_budget(opt), e);
+            if (rc) return rc;
             if (!in->read_image(s.subimage, 0, 0, nread, read_as, tmp.data())) {
                 std::string msg = in->geterror();
                 vxl_one_line(&msg[0]);
@@ -396,7 +434,11 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
         if (rc) return vxl_fail_in(e, path, &inner);
         return VXL_OK;
     } catch (const std::bad_alloc &) {
-        return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory", path);
+        // the helper's address-space cap (helper_main.c) turns an absurd
+        // allocation inside OpenImageIO into this, not into a dead process
+        return vxl_fail(e, VXL_ERR_NO_MEMORY,
+                        "'%s': the image reader ran out of memory: the file is corrupt, or larger than the memory budget",
+                        path);
     } catch (const std::exception &x) {
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %s", path, x.what());
     } catch (...) {

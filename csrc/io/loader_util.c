@@ -170,6 +170,11 @@ void vxl_swap_elements(void *p, uint64_t count, size_t elem)
     }
 }
 
+uint64_t vxl_load_budget(const vxl_load_options *opt)
+{
+    return opt && opt->memory_budget_bytes ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
+}
+
 int vxl_plan_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, const vxl_load_options *opt,
                     uint64_t *nbytes, vxl_err *e)
 {

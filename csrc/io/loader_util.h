@@ -61,6 +61,9 @@ void vxl_swap_elements(void *p, uint64_t count, size_t elem);
 /* 1 when this host is big-endian. */
 int vxl_host_big_endian(void);
 
+/* The load's memory budget in bytes: the options' own, else the default. */
+uint64_t vxl_load_budget(const vxl_load_options *opt);
+
 /* Plans a 3D read: checks the dims against the limits (naming path) and
  * returns the raw byte count for dtype. */
 int vxl_plan_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, const vxl_load_options *opt,

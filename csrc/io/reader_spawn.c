@@ -273,7 +273,7 @@ static int spawn_helper(const vxl_reader *r, const char *helper, const char *com
     vxl_load_voxel_size(opt, voxel);
     snprintf(max_dim, sizeof max_dim, "%u", opt && opt->max_dim ? opt->max_dim : VXL_DEFAULT_MAX_DIM);
     snprintf(budget, sizeof budget, "%llu",
-             (unsigned long long)(opt && opt->memory_budget_bytes ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET));
+             (unsigned long long)vxl_load_budget(opt));
     for (int a = 0; a < 3; a++) snprintf(vs[a], sizeof vs[a], "%.17g", voxel[a]);
     snprintf(frame, sizeof frame, "%u", vxl_load_frame(opt));
     const char *series = vxl_load_series(opt);

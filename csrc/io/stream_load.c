@@ -45,7 +45,7 @@ int vxl_stream_plan(const char *path, const uint32_t dims[3], uint32_t dtype, co
                     const char *not_streamable, int *stream, uint64_t *nbytes, vxl_err *e)
 {
     const uint32_t mode = vxl_load_streaming(opt);
-    const uint64_t budget = opt && opt->memory_budget_bytes ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
+    const uint64_t budget = vxl_load_budget(opt);
     const uint32_t es = vxl_dtype_size(dtype), bpv = vxl_texture_bits_for(dtype) / 8;
     *stream = 0;
     if (mode == VXL_STREAMING_ON) *stream = 1;

@@ -159,7 +159,7 @@ static int read_level(const char *path, const vxl_zarr_store *s, const vxl_zarr_
                             (unsigned long long)VXL_ZARR_MAX_CHUNKS, (unsigned long long)a->chunks[i]);
     }
     const uint64_t cbytes = vxl_zarr_chunk_bytes(a);
-    const uint64_t budget = opt && opt->memory_budget_bytes ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
+    const uint64_t budget = vxl_load_budget(opt);
     if (cbytes > budget) /* the chunk buffer comes on top of the volume: never past the budget */
         return vxl_fail(e, VXL_ERR_LIMIT, "'%s': one chunk needs %.1f MiB, over the memory budget of %.1f MiB",
                         a->path, cbytes / 1048576.0, budget / 1048576.0);

@@ -447,7 +447,7 @@ static int level_range(vxl_brick_source *s, uint32_t level, double *mn, double *
  * budget, but room for 4 chunks of level 0 whatever (at most 256 MiB). */
 static uint64_t cache_capacity(const vxl_zarr_array *a, const vxl_load_options *opt)
 {
-    const uint64_t budget = opt && opt->memory_budget_bytes ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
+    const uint64_t budget = vxl_load_budget(opt);
     const uint64_t chunk = vxl_zarr_chunk_bytes(a), four = 4 * chunk < (256ull << 20) ? 4 * chunk : (256ull << 20);
     const uint64_t cap = budget / 16 < CACHE_MAX_BYTES ? budget / 16 : CACHE_MAX_BYTES;
     return cap > four ? cap : four;
@@ -563,7 +563,7 @@ int vxl_zarr_open_source(const char *path, const vxl_load_options *opt, vxl_bric
                       (unsigned long long)a->shape[st->axis[VXL_ZARR_Z]], max_dim);
         goto fail;
     }
-    const uint64_t budget = opt && opt->memory_budget_bytes ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
+    const uint64_t budget = vxl_load_budget(opt);
     if (vxl_zarr_chunk_bytes(a) > budget / 4) { /* a reader holds a chunk or two next to the budget's bricks */
         rc = vxl_fail(e, VXL_ERR_LIMIT, "'%s': one chunk needs %.1f MiB, over a quarter of the memory budget of "
                       "%.1f MiB", a->path, vxl_zarr_chunk_bytes(a) / 1048576.0, budget / 1048576.0);
@@ -604,7 +604,7 @@ static int wants_streaming(const char *path, const vxl_load_options *opt)
         const vxl_zarr_array *a = &st->level[l];
         const double bytes = (double)a->shape[st->axis[VXL_ZARR_X]] * (double)a->shape[st->axis[VXL_ZARR_Y]] *
                              (double)a->shape[st->axis[VXL_ZARR_Z]] * (vxl_texture_bits_for(a->dtype) / 8);
-        const uint64_t budget = opt && opt->memory_budget_bytes ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
+        const uint64_t budget = vxl_load_budget(opt);
         stream = bytes > budget / 2.0;
     }
     free(st); /* a store that does not open is the whole read's to report */

@@ -123,3 +123,14 @@ def test_a_crashing_helper_is_an_error(inputs, tmp_path):
     assert "the DICOM reader crashed (signal 6: SIGABRT)" in r.stderr, r.stderr
     loads("stack", inputs, env)
     loads("nrrd", inputs, env)
+
+
+def test_a_tiff_whose_strips_claim_gigabytes_is_called_corrupt():
+    """A 288-byte TIFF found by fuzzing claims 1,986,356,271 rows per strip in
+    a 3-row page: OpenImageIO would allocate 31 GB for one strip before
+    reading a byte. The helper refuses it first, and the message says why."""
+    bad = ROOT / "tests" / "crashers" / "tiff" / "oiio_rows_per_strip_31gb.tif"
+    out = run("info", str(bad))
+    assert out.returncode == 1, out.stdout + out.stderr
+    assert "corrupt TIFF: 1986356271 rows per strip in a 3-row image" in out.stderr, out.stderr
+    assert "crashed" not in out.stderr and "signal" not in out.stderr

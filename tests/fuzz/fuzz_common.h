@@ -31,7 +31,18 @@ static const vxl_load_options vxl_fuzz_options = {
 /* Writes the input to the target's file (input.EXT) and returns its path. */
 static inline const char *vxl_fuzz_write(const uint8_t *data, size_t size, const char *ext)
 {
-    if (!vxl_fuzz_dir[0]) {
+    if (!vxl_fuzz_dir[0] && !vxl_fuzz_path[0]) {
+        /* VOXLIGHT_FUZZ_DIR: a folder the caller made and names the same way
+         * on every run (tests/fuzz/run.sh ci passes "."). The loaders compare
+         * the path's characters, and libFuzzer learns from what they compare,
+         * so a random folder name would make two runs of one seed differ. */
+        const char *fixed = getenv("VOXLIGHT_FUZZ_DIR");
+        if (fixed && *fixed) {
+            snprintf(vxl_fuzz_path, sizeof vxl_fuzz_path, "%s/input.%s", fixed, ext);
+            atexit(vxl_fuzz_cleanup);
+        }
+    }
+    if (!vxl_fuzz_dir[0] && !vxl_fuzz_path[0]) {
         /* a file per input: tmpfs (/dev/shm) where there is one, since a
          * disk-backed /tmp can cost milliseconds per write */
         snprintf(vxl_fuzz_dir, sizeof vxl_fuzz_dir, "/dev/shm/vxl_fuzz_XXXXXX");

@@ -149,6 +149,16 @@ def look_kwargs(props):
                                 for lab in s.labels])}
 
 
+def own_label_ids(obj, entry):
+    """The distinct ids of obj's label image when it is the volume's own
+    file (a labels object: entry.info's distinct_ids), else None (unknown)."""
+    s = obj.voxlight_labels
+    path = s.active_path
+    if not path or os.path.abspath(path) != os.path.abspath(entry.path):
+        return None
+    return entry.info.get("distinct_ids")
+
+
 def label_material(lab):
     """The label's own (ambient, diffuse, specular, shininess), or None for the volume's."""
     if not lab.use_material:

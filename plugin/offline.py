@@ -7,8 +7,8 @@ the scene's meshes in numpy (zbuffer.py) and passing that as scene_depth.
 import bpy
 import numpy as np
 
-from . import overlay_frames, params, scene_shadows
-from .core import native, runtime, scene_geometry, volume_space, zbuffer
+from . import label_props, overlay_frames, params, scene_shadows
+from .core import label_runtime, native, runtime, scene_geometry, volume_space, zbuffer
 
 
 def render_size(scene):
@@ -111,7 +111,10 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
 
     if frame_info is not None:
         frame_info.update(depth=zbuf, named_lights=named if want_shadows else [],
-                          casters=[volume_kwargs(ob, mw) for ob, mw in casters]
+                          casters=[(entry, kw) for entry, kw, ob in (
+                              volume_kwargs(ob, mw) + (ob,) for ob, mw in casters)
+                              if not label_runtime.shows_nothing(
+                                  kw.get("labels"), label_props.own_label_ids(ob, entry))]
                           if want_shadows else [])
     if not vols:
         return (np.zeros((height, width, 4), np.float32),

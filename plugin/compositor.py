@@ -10,8 +10,13 @@ Render Layers' Image now leaves the Alpha Over, so the user's effects
 (Invert, Glare, colour grading ...) apply to the volume and the mesh render
 alike. Each run re-routes links that the user has since drawn from Render
 Layers' Image; a user who feeds the Alpha Over's background from anything
-else keeps that wiring. The nodes are found again by name; with nothing to
-show, the Alpha Over is muted so it passes the render through.
+else keeps that wiring. The nodes are found again by name. The nodes change
+only before a frame is evaluated (render_init, render_pre): the compositor
+runs on Blender's evaluated copy of the tree, which edits made while the
+frame renders (frame_change_post) do not reach, so a frame changes only
+pixels. With nothing to show the image is emptied, and an 'over' of an
+empty image is the render itself; with no volume to render at all the
+Alpha Over is also muted.
 
 "Volume as Separate Layer" (scene.voxlight.render_separate_layer) leaves the
 user's tree alone instead: the Alpha Over is taken out (its links restored
@@ -44,8 +49,13 @@ NO_DEPTH = 1e10  # what Blender's own Depth pass holds where nothing is
 
 
 def ensure_image(width, height, name=IMAGE_NAME):
+    """The float image `name` at width x height. A new or resized one holds
+    nothing (clear_image): Blender fills new images with opaque black, which
+    the Alpha Over would lay over the whole frame whenever a render writes
+    no pixels into it (the volume hidden, empty or out of view)."""
     img = bpy.data.images.get(name)
-    if img is not None and (not img.is_float or tuple(img.size) != (width, height)):
+    fresh = img is None or not img.is_float or tuple(img.size) != (width, height)
+    if img is not None and fresh:
         if tuple(img.size) != (width, height) and img.is_float:
             img.scale(width, height)
         else:
@@ -58,7 +68,29 @@ def ensure_image(width, height, name=IMAGE_NAME):
     if name in (PASS_ALPHA, PASS_DEPTH):
         img.colorspace_settings.is_data = True
     img.use_fake_user = False
+    if fresh:
+        clear_image(img)
     return img
+
+
+def empty_pixel(name):
+    """What image `name` holds where the volume shows nothing: no colour and
+    no coverage (an 'over' of it gives the scene back bit for bit), and
+    Blender's own empty depth in the depth pass."""
+    if name == PASS_DEPTH:
+        return (NO_DEPTH, NO_DEPTH, NO_DEPTH, 1.0)
+    if name == PASS_ALPHA:
+        return (0.0, 0.0, 0.0, 1.0)
+    return (0.0, 0.0, 0.0, 0.0)
+
+
+def clear_image(img):
+    """Fill `img` with empty_pixel of its name."""
+    w, h = img.size
+    px = np.empty((max(h, 0), max(w, 0), 4), np.float32)
+    px[...] = empty_pixel(img.name)
+    img.pixels.foreach_set(px.ravel())
+    img.update()
 
 
 def _image_node(tree, name, image, location):
@@ -162,10 +194,13 @@ def ensure_pass_nodes(scene, width, height):
 
 
 def write_passes(scene, rgba_linear, depth):
-    """Fill the pass images: premultiplied colour, alpha as grey, depth as
-    grey (NO_DEPTH where the volume shows nothing)."""
+    """Fill the pass images (made by ensure_pass_nodes before the frame):
+    premultiplied colour, alpha as grey, depth as grey (NO_DEPTH where the
+    volume shows nothing). Only pixels change: the compositor runs on the
+    copy of the node tree Blender evaluated before this frame's handlers,
+    so nodes changed now would not take part in this frame."""
     h, w = rgba_linear.shape[:2]
-    color, alpha, zimg = ensure_pass_nodes(scene, w, h)
+    color, alpha, zimg = (ensure_image(w, h, name) for name in PASSES)
     color.pixels.foreach_set(np.ascontiguousarray(rgba_linear, np.float32).ravel())
     a = rgba_linear[..., 3]
     one = np.ones_like(a)
@@ -177,17 +212,13 @@ def write_passes(scene, rgba_linear, depth):
 
 
 def clear_passes(scene):
-    """Separate-layer mode with nothing to show: empty colour and alpha,
-    NO_DEPTH depth, so a user's wiring composites nothing stale."""
-    for name, value in ((PASS_COLOR, 0.0), (PASS_ALPHA, 0.0), (PASS_DEPTH, NO_DEPTH)):
+    """Nothing to show: the volume image and the separate-layer passes
+    emptied (empty_pixel), so the composite and a user's wiring give the
+    scene exactly, and nothing stale from an earlier frame."""
+    for name in (IMAGE_NAME,) + PASSES:
         img = bpy.data.images.get(name)
-        if img is None:
-            continue
-        px = np.full((img.size[1], img.size[0], 4), value, np.float32)
-        if name != PASS_COLOR:
-            px[..., 3] = 1.0
-        img.pixels.foreach_set(px.ravel())
-        img.update()
+        if img is not None:
+            clear_image(img)
 
 
 def mute(scene):

@@ -183,13 +183,25 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         runtime.adopt(entry)
         info = entry.info
         streamed = ", streamed from disk (%d levels)" % info["level_count"] if info.get("streamed") else ""
-        self.report({"INFO"}, "Voxlight: imported %s (%d x %d x %d, %s%s)"
-                    % (name, *info["dims"], info["dtype"], streamed))
+        self.report({"INFO"}, "Voxlight: imported %s (%d x %d x %d, %s%s) %s"
+                    % (name, *info["dims"], info["dtype"], streamed, self._why))
         return {"FINISHED"}
 
     def _label_plan(self, context, path, info):
-        """((kind, lookup, table) or None for an intensity volume, error)."""
+        """((kind, lookup, table) or None for an intensity volume, error).
+        Sets self._why: what the volume became and why, for the report."""
         lookup = bpy.path.abspath(self.lookup_file) if self.lookup_file else ""
+        if self.import_as == "AUTO":  # labels only on evidence (core/label_import.guess)
+            kind, lookup, why = label_import.guess(
+                info["dtype"], info.get("distinct_ids"), label_import.candidates(path, lookup),
+                _lookup_ids)
+            self._why = ("as a label map: " if kind == "new" else "as an intensity volume: ") + why
+            if kind == "intensity":
+                return None, ""
+            table, err = label_props.read_lookup(lookup)
+            return ("new", lookup, table), err
+        self._why = ("as an intensity volume" if self.import_as == "INTENSITY"
+                     else "as a label map: chosen in the importer")
         kind, lookup = label_import.plan(self.import_as, path, lookup)
         kind, err = label_import.check(kind, self.import_as, info["dtype"], lookup, path,
                                        value_range=(info["value_min"], info["value_max"]))
@@ -200,10 +212,6 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             if target is None or not target.voxlight.is_volume:
                 return None, "no active Voxlight volume to attach the labels to"
         table, err = label_props.read_lookup(lookup)
-        if err and self.import_as == "AUTO":  # a text file that is no lookup table
-            self.report({"WARNING"}, "Voxlight: %s is not a lookup file (%s): imported as an "
-                                     "intensity volume" % (os.path.basename(lookup), err))
-            return None, ""
         return (kind, lookup, table), err
 
     def _create_object(self, context, path, info):
@@ -246,6 +254,12 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
         if self.frame_in_view:
             frame_in_views(context, obj)
         return obj
+
+
+def _lookup_ids(path):
+    """The ids a lookup file names, or None when it is no lookup file."""
+    table, _err = label_props.read_lookup(path)
+    return None if table is None else [t["id"] for t in table]
 
 
 def _show_status(context, job):

@@ -13,7 +13,7 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
-from .core import label_runtime, native
+from .core import label_import, label_runtime, native
 from .operators import OnActiveVolume
 
 _MODE_UI = {
@@ -149,6 +149,16 @@ def look_kwargs(props):
                                 for lab in s.labels])}
 
 
+def own_label_ids(obj, entry):
+    """The distinct ids of obj's label image when it is the volume's own
+    file (a labels object: entry.info's distinct_ids), else None (unknown)."""
+    s = obj.voxlight_labels
+    path = s.active_path
+    if not path or os.path.abspath(path) != os.path.abspath(entry.path):
+        return None
+    return entry.info.get("distinct_ids")
+
+
 def label_material(lab):
     """The label's own (ambient, diffuse, specular, shininess), or None for the volume's."""
     if not lab.use_material:
@@ -185,8 +195,43 @@ class VOXLIGHT_OT_label_visibility(OnActiveVolume, bpy.types.Operator):
         return {"FINISHED"}
 
 
+class VOXLIGHT_OT_use_as_labels(OnActiveVolume, bpy.types.Operator):
+    """Draw this volume as the label map of its own file (or as an intensity
+    volume again), without importing it again: for a guess that went the
+    wrong way"""
+    bl_idname = "voxlight.use_as_labels"
+    bl_label = "Use as Label Map"
+    bl_options = {"REGISTER", "UNDO"}
+
+    labels: BoolProperty(name="Labels", default=True,
+                         description="On: its values are label ids; off: an intensity volume")
+
+    def execute(self, context):
+        obj = context.object
+        s = obj.voxlight_labels
+        if not self.labels:
+            s.enabled = False
+            return {"FINISHED"}
+        own = bpy.path.abspath(obj.voxlight.filepath, library=obj.library)
+        if not s.filepath or not s.labels or \
+                os.path.abspath(bpy.path.abspath(s.filepath)) != os.path.abspath(own):
+            lookup = bpy.path.abspath(s.lookup_file) if s.lookup_file else ""
+            found = label_import.candidates(own, lookup)
+            if not found:
+                self.report({"ERROR"}, "Voxlight: no lookup file beside %s: choose one in "
+                                       "Labels > Lookup File" % os.path.basename(own))
+                return {"CANCELLED"}
+            table, err = read_lookup(found[0][0])
+            if table is None:
+                self.report({"ERROR"}, "Voxlight: %s" % err)
+                return {"CANCELLED"}
+            attach(obj, own, found[0][0], table, "surface")
+        s.enabled = True
+        return {"FINISHED"}
+
+
 _classes = (VoxlightLabel, VoxlightLabelSettings, VOXLIGHT_OT_load_label_lookup,
-            VOXLIGHT_OT_label_visibility)
+            VOXLIGHT_OT_label_visibility, VOXLIGHT_OT_use_as_labels)
 
 
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(_classes)

@@ -42,6 +42,11 @@ class VOXLIGHT_PT_volume_labels(_VolumePanel, bpy.types.Panel):
 
     def draw(self, context):
         s = context.object.voxlight_labels
+        # A wrong guess at import is undone here, without importing again.
+        row = self.layout.row(align=True)
+        row.operator("voxlight.use_as_labels", text="Intensity Volume",
+                     depress=not s.enabled).labels = False
+        row.operator("voxlight.use_as_labels", text="Label Map", depress=s.enabled).labels = True
         layout = _split(self.layout)
         col = layout.column()
         col.prop(s, "filepath")

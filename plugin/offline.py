@@ -7,8 +7,8 @@ the scene's meshes in numpy (zbuffer.py) and passing that as scene_depth.
 import bpy
 import numpy as np
 
-from . import overlay_frames, params, scene_shadows
-from .core import native, runtime, scene_geometry, volume_space, zbuffer
+from . import label_props, overlay_frames, params, scene_shadows
+from .core import label_runtime, native, runtime, scene_geometry, volume_space, zbuffer
 
 
 def render_size(scene):
@@ -73,7 +73,8 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
     volumes (or of the objects in `only`). camera None = the library's
     default camera framing the volume. Returns None when there is nothing.
     frame_info (a dict, F12's scene shadows): filled with the scene's
-    z-buffer ("depth"), its lights with their names ("named_lights") and,
+    z-buffer ("depth"), what it saw ("surface": triangles, the triangle
+    index per pixel, view, proj), its lights with their names ("named_lights") and,
     per volume that casts shadows (in the frame or not), its entry and
     make_params keyword arguments ("casters")."""
     vols = volume_instances(depsgraph, only, for_render)
@@ -96,10 +97,11 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
             fused.get(ob.original, ()), view, proj)]
     # A volume outside the frame may still shadow what is in it.
     want_shadows = bool(frame_info is not None and camera is not None and casters and lights)
-    zbuf = None
+    zbuf = ids = tris = None
     if camera is not None and (occlusion and vols or want_shadows):
-        zbuf = zbuffer.rasterize(scene_geometry.triangles(depsgraph, for_render),
-                                 view, proj, width, height)
+        tris = scene_geometry.triangles(depsgraph, for_render)
+        ids = np.full((height, width), -1, np.int64) if want_shadows else None
+        zbuf = zbuffer.rasterize(tris, view, proj, width, height, ids=ids)
     opts = dict(runtime.options_of(scene.voxlight), backend=backend)
 
     def volume_kwargs(ob, mw):
@@ -111,7 +113,11 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
 
     if frame_info is not None:
         frame_info.update(depth=zbuf, named_lights=named if want_shadows else [],
-                          casters=[volume_kwargs(ob, mw) for ob, mw in casters]
+                          surface=(tris, ids, view, proj) if want_shadows else None,
+                          casters=[(entry, kw) for entry, kw, ob in (
+                              volume_kwargs(ob, mw) + (ob,) for ob, mw in casters)
+                              if not label_runtime.shows_nothing(
+                                  kw.get("labels"), label_props.own_label_ids(ob, entry))]
                           if want_shadows else [])
     if not vols:
         return (np.zeros((height, width, 4), np.float32),

@@ -39,11 +39,16 @@ _pending = False  # a render job is between render_pre and its compositing
 
 
 def _prepare_nodes(scene):
+    """Before the frame is evaluated: the nodes, and images that hold
+    nothing, so a frame that writes no pixels (hidden, empty, out of view,
+    failed) leaves the render exactly as it is, and nothing of the previous
+    frame shows."""
     w, h = offline.render_size(scene)
     if scene.voxlight.render_separate_layer:
         compositor.ensure_pass_nodes(scene, w, h)
     else:
         compositor.ensure_nodes(scene, compositor.ensure_image(w, h))
+    compositor.clear_passes(scene)
     # The volume's shadows on the scene: light groups and the chain before
     # the Alpha Over (issue 18, scene_shadows.py).
     scene_shadows.prepare_render(scene, w, h)
@@ -51,8 +56,8 @@ def _prepare_nodes(scene):
 
 def _show_nothing(scene, shadows=False):
     """No volume to lay over the render; shadows=False: no volume shadows
-    either (a failed frame), else the shadow images written stay."""
-    compositor.mute(scene)
+    either (a failed frame), else the shadow images written stay. Only
+    pixels change (see compositor.py for why not the nodes)."""
     compositor.clear_passes(scene)
     if not shadows:
         scene_shadows.clear_render(scene)
@@ -71,6 +76,7 @@ def on_render_pre(scene, *args):
     s = scene.voxlight
     if not s.render_enabled or not _volumes_present(scene) or scene.camera is None:
         _show_nothing(scene)
+        compositor.mute(scene)  # before the frame is evaluated: it takes part
         scene_shadows.revert(scene)
         _pending = False
         return
@@ -114,7 +120,6 @@ def on_frame_change_post(scene, depsgraph=None, *args):
     img = compositor.ensure_image(w, h)
     img.pixels.foreach_set(display_to_linear(rgba).ravel())
     img.update()
-    compositor.ensure_nodes(scene, img)
 
 
 @persistent

@@ -22,6 +22,7 @@ import numpy as np
 from bpy.app.handlers import persistent
 
 from . import compositor
+from .core import facing
 from .core import lights as _lights
 from .core import native, scene_geometry, shadow_plan
 
@@ -280,13 +281,22 @@ def prepare_render(scene, width, height):
 
 def transmittances(frame, depth, width, height):
     """{light index: (height, width) transmittance through every casting
-    volume}, from the volumes `frame` lists (offline.render's frame_info)."""
+    volume}, from the volumes `frame` lists (offline.render's frame_info).
+    1 where the visible surface turns its lit side away from the light
+    (core/facing.py): no light it could block reaches there."""
     out = {}
     for entry, kwargs in frame["casters"]:
         p = native.make_params(width=width, height=height, scene_depth=depth, **kwargs)
         for i in range(len(kwargs["lights"])):
             t = entry.renderer.scene_transmittance(p, i)
             out[i] = t if i not in out else out[i] * t
+    surface = frame.get("surface")
+    if surface is not None and surface[0] is not None and out:
+        tris, ids, view, proj = surface
+        for i, light in enumerate(l for _n, _g, l in frame["named_lights"]):
+            if i in out:
+                out[i] = np.where(facing.faces_light(tris, ids, depth, view, proj, light.position),
+                                  out[i], 1.0).astype(np.float32)
     return out
 
 

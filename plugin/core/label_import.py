@@ -14,8 +14,8 @@ LABEL_DTYPES = ("uint8", "uint16", "int16", "int32")
 
 # The importer's "Import as" choices (identifier, name, description).
 IMPORT_MODES = (
-    ("AUTO", "Detect", "Labels when an integer volume has a lookup file beside it "
-                       "(as a new labels object), else an intensity volume"),
+    ("AUTO", "Detect", "Labels when an integer volume has a lookup file beside it that "
+                       "names most of its values (as a new labels object), else an intensity volume"),
     ("INTENSITY", "Intensity Volume", "An ordinary volume, even with a lookup file beside it"),
     ("NEW", "New Labels Object", "A labels-only volume object: each label shaded as a surface"),
     ("ATTACH", "Label Map of Active Volume", "Attach the labels to the active volume object "
@@ -73,3 +73,79 @@ def check(kind, mode, dtype, lookup, image_path, exists=os.path.isfile, value_ra
     if not exists(lookup):
         return kind, "lookup file %s not found" % lookup
     return kind, ""
+
+
+# How much of a volume's distinct non-zero values a lookup file must name
+# before AUTO takes the volume as its label map. A file named after the
+# image was made for it, so "most" suffices; a folder-wide table (labels.txt,
+# FreeSurferColorLUT.txt) may belong to another image in the folder, so it
+# must name nearly all of them. An intensity volume has hundreds of values
+# and a small table names few of them; a segmentation's ids are all named.
+SAME_STEM_COVERAGE = 0.5
+FOLDER_COVERAGE = 0.9
+MAX_DISTINCT_BINS = MAX_LABEL_ID + 1  # a histogram bin per possible id, at most
+
+
+def distinct_ids(info, histogram):
+    """The distinct values of an integer volume whose values could be label
+    ids (0..MAX_LABEL_ID), as a sorted list of ints, else None. histogram
+    is Volume.histogram(bins, lo, hi): one bin per integer value."""
+    if not is_label_dtype(info.get("dtype")):
+        return None
+    lo, hi = info.get("value_min"), info.get("value_max")
+    if lo is None or hi is None or not (0 <= lo <= hi <= MAX_LABEL_ID):
+        return None
+    lo, hi = int(round(lo)), int(round(hi))
+    bins = hi - lo + 1
+    if bins > MAX_DISTINCT_BINS:
+        return None
+    counts = histogram(bins, lo - 0.5, hi + 0.5)
+    return [lo + i for i, c in enumerate(counts) if c > 0]
+
+
+def candidates(image_path, chosen="", exists=os.path.isfile):
+    """[(lookup path, specific)] for guess(): the file the user chose (it
+    counts as made for the image), else every one found beside the image;
+    specific: named after the image (aal.nii.lut for aal.nii.gz) rather
+    than a folder-wide table."""
+    if chosen:
+        return [(chosen, True)]
+    return [(p, os.path.basename(p) not in label_files.FOLDER_NAMES)
+            for p in label_files.find_lookup_files(image_path, exists=exists)]
+
+
+def coverage(ids, named):
+    """(named, total): how many of the volume's non-zero ids `named` names
+    (0 is the background, never a label)."""
+    present = [i for i in ids if i != 0]
+    names = set(named)
+    return sum(1 for i in present if i in names), len(present)
+
+
+def guess(dtype, ids, found, read_ids):
+    """AUTO's decision after the load: (kind "new" | "intensity", lookup
+    path or "", why: a sentence for the import report).
+    ids: distinct_ids of the volume (None: not integer label ids).
+    found: candidates(), in priority order.
+    read_ids(path): the ids a lookup file names, or None when it is none."""
+    if ids is None:
+        if not is_label_dtype(dtype):
+            return "intensity", "", "%s data hold no label ids" % dtype
+        return "intensity", "", "its values are no label ids (0..%d)" % MAX_LABEL_ID
+    if not found:
+        return "intensity", "", "no lookup file beside it"
+    why = []
+    for path, same in found:
+        named = read_ids(path)
+        base = os.path.basename(path)
+        if named is None:
+            why.append("%s is no lookup file" % base)
+            continue
+        n, total = coverage(ids, named)
+        need = SAME_STEM_COVERAGE if same else FOLDER_COVERAGE
+        where = "named after it" if same else "folder-wide"
+        if total and n >= need * total:
+            return "new", path, "%s (%s) names %d of its %d values" % (base, where, n, total)
+        why.append("%s (%s) names %d of its %d values, under %d%%" % (
+            base, where, n, total, round(need * 100)))
+    return "intensity", "", "; ".join(why)

@@ -64,3 +64,17 @@ def show(entry, path, lib=None):
         entry.renderer.set_labels(None)
     entry.label_key = want
     return error
+
+
+def shows_nothing(labels, present=None):
+    """Whether make_params' labels=(mode, [(id, rgba, visible, material), ...])
+    draw nothing at all: in surface and mask mode only listed, visible labels
+    with some opacity are drawn, and only those among `present` (the label
+    image's distinct ids; None: unknown, any may be). The library's shadow
+    volumes do not see labels, so such a volume must cast no shadow on the
+    scene either: its shadow would be that of everything it hides."""
+    if not labels or labels[0] not in ("surface", "mask"):
+        return False
+    present = None if present is None else set(present)
+    return not any(visible and rgba[3] > 0.0 and (present is None or i in present)
+                   for i, rgba, visible, *_rest in labels[1])

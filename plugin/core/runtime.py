@@ -19,7 +19,7 @@ import os
 import threading
 import time
 
-from . import budget_split, frames, label_runtime, native, tf_fit
+from . import budget_split, frames, label_import, label_runtime, native, tf_fit
 from .native_volume import ERR_CANCELLED
 
 _lock = threading.Lock()
@@ -333,7 +333,8 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
         # For the panel (32 bins, saved with the object) and for fitting presets
         # to the data (tf_fit); the library counts them for every format.
         info = dict(vol.info, histogram=vol.histogram(32),
-                    histogram_fine=vol.histogram(tf_fit.HISTOGRAM_BINS))
+                    histogram_fine=vol.histogram(tf_fit.HISTOGRAM_BINS),
+                    distinct_ids=label_import.distinct_ids(vol.info, vol.histogram))
         if stop():
             return None
         entry = VolumeEntry(path, renderer, info, series, {"storage": storage, "memory_budget": memory_budget})

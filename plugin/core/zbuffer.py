@@ -19,13 +19,15 @@ from . import depth as _depth
 _CHUNK_PIXELS = 1 << 22
 
 
-def _clip_near(clip):
+def _clip_near(clip, src):
     """Clip triangles (n, 3, 4) in clip space against the near plane
-    (z > -w). Returns the surviving and newly cut triangles (m, 3, 4)."""
+    (z > -w). Returns the surviving and newly cut triangles (m, 3, 4) and
+    the index in `src` of the triangle each came from."""
     dist = clip[:, :, 2] + clip[:, :, 3]
     inside = dist > 0.0
     count = inside.sum(axis=1)
     out = [clip[count == 3]]
+    origin = [src[count == 3]]
 
     def lerp(a, b, da, db):
         t = (da / (da - db))[:, None]
@@ -41,6 +43,7 @@ def _clip_near(clip):
         a, b, e = c[r, i0], c[r, i1], c[r, i2]
         da, db, de = d[r, i0], d[r, i1], d[r, i2]
         out.append(np.stack([a, lerp(a, b, da, db), lerp(a, e, da, de)], axis=1))
+        origin.append(src[sel])
     # Two vertices inside: a quad, split into two triangles.
     sel = count == 2
     if sel.any():
@@ -54,13 +57,16 @@ def _clip_near(clip):
         pb = lerp(b, ov, db, do)  # on edge b-o
         out.append(np.stack([a, b, pb], axis=1))
         out.append(np.stack([a, pb, pa], axis=1))
-    return np.concatenate(out, axis=0) if out else clip[:0]
+        origin += [src[sel], src[sel]]
+    return np.concatenate(out, axis=0), np.concatenate(origin)
 
 
-def rasterize(triangles, view, proj, width, height, zbuf=None):
+def rasterize(triangles, view, proj, width, height, zbuf=None, ids=None):
     """triangles: (n, 3, 3) world-space vertices. view, proj: 4x4 math
     matrices. Returns (height, width) float32 planar distances (min-merged
-    into zbuf when given)."""
+    into zbuf when given). ids, a (height, width) int64 array: where a
+    triangle is nearest, set to its index in `triangles` (the scene shadow
+    needs the visible surface's normal)."""
     width, height = int(width), int(height)
     if zbuf is None:
         zbuf = np.full((height, width), np.inf, np.float32)
@@ -70,7 +76,7 @@ def rasterize(triangles, view, proj, width, height, zbuf=None):
     mvp = np.asarray(proj, np.float64) @ np.asarray(view, np.float64)
     hom = np.concatenate([tris, np.ones(tris.shape[:2] + (1,))], axis=2)
     clip = hom @ mvp.T
-    clip = _clip_near(clip)
+    clip, src = _clip_near(clip, np.arange(len(clip)))
     if len(clip) == 0:
         return zbuf
     w = clip[:, :, 3]
@@ -89,12 +95,13 @@ def rasterize(triangles, view, proj, width, height, zbuf=None):
     keep = (x1 >= x0) & (y1 >= y0) & (np.abs(area) > 1e-12) & (sz.min(axis=1) <= 1.0)
     if not keep.any():
         return zbuf
-    sx, sy, sz, area = sx[keep], sy[keep], sz[keep], area[keep]
+    sx, sy, sz, area, src = sx[keep], sy[keep], sz[keep], area[keep], src[keep]
     x0, x1, y0, y1 = x0[keep], x1[keep], y0[keep], y1[keep]
     bw = x1 - x0 + 1
     npix = bw * (y1 - y0 + 1)
 
     flat = zbuf.reshape(-1)
+    flat_ids = None if ids is None else ids.reshape(-1)
     start = 0
     n = len(npix)
     cum = np.cumsum(npix)
@@ -122,14 +129,18 @@ def rasterize(triangles, view, proj, width, height, zbuf=None):
         inside &= (z >= -1.0) & (z <= 1.0)
         pix = (py * width + px)[inside]
         z = z[inside]
+        tri = tri[inside]
         if len(z):
             # Nearest sample per pixel: sort by (pixel, z), keep each pixel's first.
             order = np.lexsort((z, pix))
-            pix, z = pix[order], z[order]
+            pix, z, tri = pix[order], z[order], tri[order]
             first = np.ones(len(pix), bool)
             first[1:] = pix[1:] != pix[:-1]
-            pix, z = pix[first], z[first]
+            pix, z, tri = pix[first], z[first], tri[first]
             dist = _depth.window_to_planar(z * 0.5 + 0.5, proj)
-            flat[pix] = np.minimum(flat[pix], dist)
+            nearer = dist < flat[pix]
+            flat[pix[nearer]] = dist[nearer]
+            if flat_ids is not None:
+                flat_ids[pix[nearer]] = src[tri[nearer]]
         start = stop
     return zbuf

@@ -1,0 +1,66 @@
+"""GUI Blender under Xvfb: F12 (the render job, as a user starts it) with
+EEVEE, a perspective camera and Cast Shadows on, while the viewport draws
+the volume, finishes and gives the volume over the lit floor, for
+perspective and orthographic cameras. A user once saw Blender freeze here.
+
+xvfb-run -a -s "-screen 0 1280x1024x24" blender --factory-startup \
+    --enable-event-simulate --python-exit-code 1 --python tests/blender/test_gui_f12.py
+
+A frozen main thread runs no timer, so _gui.Run's own limit cannot end a
+hang: faulthandler's watchdog thread (no GIL needed) prints every Python
+thread's stack and ends the process, which then has no RESULT line and
+fails in tools/run_blender_tests.sh.
+"""
+
+import faulthandler
+import os
+import sys
+import time
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _gui  # noqa: E402
+import _util as u  # noqa: E402
+
+HANG_S = 240  # generous: each render takes seconds under Xvfb
+faulthandler.dump_traceback_later(HANG_S, exit=True)
+RUN = _gui.Run("test_gui_f12", limit_s=HANG_S)
+check = RUN.check
+EEVEE = "BLENDER_EEVEE_NEXT" if (4, 2, 0) <= bpy.app.version < (5, 0, 0) else "BLENDER_EEVEE"
+
+
+def steps():
+    vx = u.install_addon()
+    scene = u.reset_scene()
+    ob = u.import_volume(u.CH2)
+    ob.voxlight.cast_shadows = True
+    u.add_plane((6.0, 6.0), (0.0, 0.0, -1.0), name="Floor", color=(0.6, 0.6, 0.6))
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    sun.rotation_euler = (0.4, 0.3, 0.0)
+    scene.collection.objects.link(sun)
+    cam = u.add_camera((0.0, -5.0, 2.0))
+    scene.render.engine = EEVEE
+    if hasattr(scene.eevee, "taa_render_samples"):
+        scene.eevee.taa_render_samples = 8
+    scene.render.resolution_x, scene.render.resolution_y = 160, 120
+    scene.render.resolution_percentage = 100
+    done = []
+    bpy.app.handlers.render_complete.append(lambda *a: done.append(True))
+    yield 1.0  # the viewport draws the volume first
+    for kind in ("PERSP", "ORTHO"):
+        cam.data.type = kind
+        cam.data.ortho_scale = 4.0
+        del done[:]
+        t = time.time()
+        bpy.ops.render.render("INVOKE_DEFAULT")
+        while not done and time.time() - t < HANG_S / 3:
+            yield 0.25
+        check("f12_%s_finishes" % kind.lower(), done, "%.1f s" % (time.time() - t))
+        check("f12_%s_no_error" % kind.lower(), not vx.render_hooks.last_error,
+              vx.render_hooks.last_error)
+        yield 0.5
+
+
+RUN.start(steps())

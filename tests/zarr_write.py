@@ -52,7 +52,7 @@ def blosc_compress(raw, typesize, cname="lz4", shuffle=1):
 
 
 def encode(codec, raw, typesize):
-    return {"raw": lambda: raw, "gzip": lambda: gzip.compress(raw), "zlib": lambda: zlib.compress(raw),
+    return {"raw": lambda: raw, "gzip": lambda: gzip.compress(raw, mtime=0), "zlib": lambda: zlib.compress(raw),
             "zstd": lambda: zstd_compress(raw), "blosc": lambda: blosc_compress(raw, typesize)}[codec]()
 
 

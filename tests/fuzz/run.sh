@@ -39,8 +39,9 @@ targets=("$@")
 # through a third-party library inside a helper process.
 OWN_TARGETS=" nifti nrrd metaimage label_table zarr brick_cache tiff_layout "
 is_own() { [[ $OWN_TARGETS == *" $1 "* ]]; }
-# ci: inputs per own target (about 8 s each on the 2-core CI machine) and the
-# one seed every run uses
+# ci: inputs per own target (about 8 s each on the 2-core CI machine;
+# VOXLIGHT_FUZZ_CI_RUNS overrides them all, as tests/cli/test_crash_replay.py
+# does) and the one seed every run uses
 declare -A CI_RUNS=([nifti]=30000 [nrrd]=100000 [metaimage]=100000 [label_table]=100000
                     [zarr]=20000 [brick_cache]=20000 [tiff_layout]=150000)
 CI_SEED=20261207
@@ -163,15 +164,17 @@ replay_seeds() {  # target bin leaks
 
 # ci, own parser: a fixed seed and a fixed number of inputs from a fresh
 # corpus (the seeds only), so the inputs tried are the same on every run; a
-# per-input time-out of 60 s only ends a hang. libFuzzer also learns from the
-# values its target compares, and pointers are among them: with address
-# randomisation on, two runs of one seed part ways (measured: 495 against 501
-# edges after 100,000 nrrd inputs). So address randomisation is off for the
-# run, and so is the corpus reload (it rereads the folder on a timer).
+# per-input time-out of 60 s only ends a hang. libFuzzer also mutates with the
+# values its target compared, and heap addresses are among them: two runs of
+# one seed parted ways (495 against 501 edges after 100,000 nrrd inputs), so
+# that is off here (-use_cmp=0; open-ended fuzzing keeps it), and so are
+# address randomisation, the corpus reload (it rereads the folder on a
+# timer) and the RSS thread (-malloc_limit_mb instead); measured: every
+# target reaches the same coverage on every run, at any machine load.
 NO_ASLR=""
 setarch "$(uname -m)" -R true 2>/dev/null && NO_ASLR="setarch $(uname -m) -R"
 fuzz_fixed() {  # target bin leaks crash_dir
-    local t=$1 bin=$2 leaks=$3 crash_dir=$4 log corpus work rc runs=${CI_RUNS[$1]} root
+    local t=$1 bin=$2 leaks=$3 crash_dir=$4 log corpus work rc runs=${VOXLIGHT_FUZZ_CI_RUNS:-${CI_RUNS[$1]}} root
     root=$(pwd)
     [[ $crash_dir == /* ]] || crash_dir=$root/$crash_dir
     log=$(mktemp)
@@ -186,7 +189,8 @@ fuzz_fixed() {  # target bin leaks crash_dir
     mkdir "$work/seeds"
     find "build/fuzz/seeds/$t" -maxdepth 1 -type f -print0 | sort -z | xargs -0 -r cp -t "$work/seeds"
     (cd "$work" && VOXLIGHT_FUZZ_DIR=. $NO_ASLR env ASAN_OPTIONS=detect_leaks=$leaks "$root/$bin" -seed=$CI_SEED \
-        -runs="$runs" -reload=0 -timeout=60 -rss_limit_mb=0 -malloc_limit_mb=2048 -detect_leaks=$leaks -print_final_stats=1 \
+        -runs="$runs" -use_cmp=0 -reload=0 -timeout=60 -rss_limit_mb=0 -malloc_limit_mb=2048 -detect_leaks=$leaks \
+        -print_final_stats=1 \
         -artifact_prefix="$crash_dir/" "$corpus" seeds) >"$log" 2>&1
     rc=$?
     execs=$(grep -oE 'stat::number_of_executed_units: [0-9]+' "$log" | grep -oE '[0-9]+$' | tail -n 1)

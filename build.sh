@@ -16,8 +16,8 @@ ROOT=$(pwd)
 # runtime for the loader fuzz targets (tests/fuzz/) and llvm for llvm-symbolizer
 # (sanitizer stacks name csrc/ files: tests/fuzz/run.sh reads them), pyopenvdb
 # to write test .vdb files, VTK and matplotlib for the benchmark, and Python
-# 3.11's venv for the bpy wheels (./build.sh bpy; Debian 13 has no Python 3.11,
-# so there a pyenv 3.11 is used).
+# 3.11's and 3.13's venv for the bpy wheels (./build.sh bpy: 4.5 and 5.0 are
+# cp311, 5.1 on cp313; where a release lacks one, a pyenv Python is used).
 # Names differ between Debian releases (12 and 13 are supported), so each
 # entry is one need: alternatives separated by '|', of which the first
 # installed, else the first the apt lists offer, is used. '?' marks a need a
@@ -27,7 +27,7 @@ ROOT=$(pwd)
 NEEDS=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
        libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev libzstd-dev libblosc-dev mricron-data blender
        xvfb xauth python3 python3-numpy python3-pytest zip unzip clang clang-rt llvm
-       python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv")
+       python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv" "?python3.13-venv")
 
 # (output captured, not piped into grep -q: under pipefail an early grep exit
 # would fail the pipeline)
@@ -110,14 +110,16 @@ build_asan() {
 }
 
 # Blender as a Python module (pip's bpy), one virtual environment per tested
-# release under build/bpy/<major.minor>/: the current LTS (4.5) and the newest
-# 5.x whose wheel installs on this Python. Both need Python 3.11. A venv that
-# already holds the right bpy is kept (no network); BPY_REFRESH=1 looks again
-# for a newer 5.x.
-find_python311() {
-    local c
-    for c in /usr/bin/python3.11 "$(command -v python3.11 || true)" "$HOME"/.pyenv/versions/3.11*/bin/python3.11; do
-        if [ -n "$c" ] && [ -x "$c" ] && "$c" -c 'import sys, venv, ensurepip; sys.exit(sys.version_info[:2] != (3, 11))' 2>/dev/null; then
+# release under build/bpy/<major.minor>/: the current LTS (4.5) and the
+# newest 5.x that install on Python 3.11 (5.0: the last cp311 wheels), and
+# the newest 5.x on Python 3.13 (5.1 on are cp313 only: the Blender artists
+# download today). A venv that already holds a matching bpy is kept (no
+# network); BPY_REFRESH=1 looks again for a newer one.
+find_python() {  # X.Y -> a Python X.Y with its venv module: the system's, PATH's or pyenv's
+    local want=$1 c
+    for c in "/usr/bin/python$want" "$(command -v "python$want" || true)" "$HOME"/.pyenv/versions/"$want"*/bin/"python$want"; do
+        if [ -n "$c" ] && [ -x "$c" ] &&
+            "$c" -c "import sys, venv, ensurepip; sys.exit('%d.%d' % sys.version_info[:2] != '$want')" 2>/dev/null; then
             echo "$c"; return 0
         fi
     done
@@ -129,7 +131,12 @@ bpy_version_in() {  # venv dir -> installed bpy version, or nothing
     "$1/bin/python" -c 'import importlib.metadata as m; print(m.version("bpy"))' 2>/dev/null || true
 }
 
-bpy_venv_install() {  # python3.11, venv dir, exact bpy version
+python_version_in() {  # venv dir -> its Python's X.Y, or nothing
+    [ -x "$1/bin/python" ] || return 0
+    "$1/bin/python" -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null || true
+}
+
+bpy_venv_install() {  # python, venv dir, exact bpy version
     local py=$1 dir=$2 version=$3
     rm -rf "$dir"
     "$py" -m venv "$dir" || return 1
@@ -144,50 +151,61 @@ bpy_venv_extras() {  # venv dir: what the Blender test scripts import besides bp
         "$1/bin/python" -m pip install -q --disable-pip-version-check numpy pytest
 }
 
-bpy_available() {  # python3.11, major -> versions on the index for this Python, newest first
+bpy_available() {  # python, version regex -> matching versions on the index for this Python, newest first
     "$1" -m pip index versions bpy --disable-pip-version-check 2>/dev/null \
-        | sed -n 's/^Available versions: //p' | tr ',' '\n' | tr -d ' ' | grep -E "^$2\.[0-9]+\.[0-9]+$" || true
+        | sed -n 's/^Available versions: //p' | tr ',' '\n' | tr -d ' ' | grep -E "$2" || true
+}
+
+# The newest bpy matching a version regex that installs with one Python, in
+# build/bpy/<major.minor>/; older venvs of the same Python and series go.
+bpy_newest() {  # python X.Y, python, version regex, name for messages
+    local want=$1 py=$2 re=$3 what=$4 dir v old
+    if [ -z "${BPY_REFRESH:-}" ]; then
+        for dir in build/bpy/*/; do
+            dir=${dir%/}
+            [ "$(python_version_in "$dir")" = "$want" ] || continue
+            if [[ $(bpy_version_in "$dir") =~ $re ]]; then bpy_venv_extras "$dir"; return; fi
+        done
+    fi
+    for v in $(bpy_available "$py" "$re"); do
+        dir=build/bpy/${v%.*}
+        if [ "$(bpy_version_in "$dir")" != "$v" ] && ! bpy_venv_install "$py" "$dir" "$v"; then
+            echo "build.sh: bpy $v did not install here; trying an older one" >&2
+            continue
+        fi
+        bpy_venv_extras "$dir" || return 1
+        for old in build/bpy/*/; do
+            old=${old%/}
+            [ "$old" != "$dir" ] && [ "$(python_version_in "$old")" = "$want" ] &&
+                [[ $(bpy_version_in "$old") =~ $re ]] && rm -rf "$old"
+        done
+        return 0
+    done
+    echo "build.sh: no bpy $what installs with $py (is the package index reachable?)" >&2
+    return 1
 }
 
 bpy_venvs() {
-    local py
-    if ! py=$(find_python311); then
-        echo "build.sh: bpy 4.5 and 5.x need Python 3.11 with its venv module; none found" \
+    local py311 py313 ok=0
+    mkdir -p build/bpy
+    if py311=$(find_python 3.11); then
+        bpy_newest 3.11 "$py311" '^4\.5\.[0-9]+$' "4.5.x" || ok=1
+        bpy_newest 3.11 "$py311" '^5\.[0-9]+\.[0-9]+$' "5.x for Python 3.11" || ok=1
+    else
+        echo "build.sh: bpy 4.5 and 5.0 need Python 3.11 with its venv module; none found" \
              "(looked for /usr/bin/python3.11, python3.11 on PATH, ~/.pyenv/versions/3.11*)." \
              "Install python3.11 and python3.11-venv, or pyenv install 3.11." >&2
-        return 1
+        ok=1
     fi
-    mkdir -p build/bpy
-    local have v dir
-    # The LTS: the newest 4.5.x.
-    have=$(bpy_version_in build/bpy/4.5)
-    if [[ "$have" != 4.5.* ]]; then
-        for v in $(bpy_available "$py" 4 | grep -E '^4\.5\.'); do
-            bpy_venv_install "$py" build/bpy/4.5 "$v" && break
-            echo "build.sh: bpy $v did not install here; trying an older 4.5.x" >&2
-        done
-        [ -d build/bpy/4.5 ] || { echo "build.sh: no bpy 4.5.x installs with $py (is the package index reachable?)" >&2; return 1; }
+    if py313=$(find_python 3.13); then
+        bpy_newest 3.13 "$py313" '^5\.[0-9]+\.[0-9]+$' "5.x for Python 3.13" || ok=1
+    else
+        echo "build.sh: bpy 5.1 and later need Python 3.13 with its venv module; none found" \
+             "(looked for /usr/bin/python3.13, python3.13 on PATH, ~/.pyenv/versions/3.13*)." \
+             "Install python3.13 and python3.13-venv, or pyenv install 3.13." >&2
+        ok=1
     fi
-    bpy_venv_extras build/bpy/4.5 || return 1
-    # The newest 5.x whose wheel installs; its venv is named by what installed.
-    for dir in build/bpy/5.*; do
-        [ -d "$dir" ] || continue
-        have=$(bpy_version_in "$dir")
-        if [[ "$have" == "${dir#build/bpy/}".* ]] && [ -z "${BPY_REFRESH:-}" ]; then
-            bpy_venv_extras "$dir"; return
-        fi
-    done
-    for v in $(bpy_available "$py" 5); do
-        dir=build/bpy/${v%.*}
-        if [ "$(bpy_version_in "$dir")" = "$v" ]; then bpy_venv_extras "$dir"; return; fi
-        if bpy_venv_install "$py" "$dir" "$v"; then
-            for old in build/bpy/5.*; do [ "$old" = "$dir" ] || rm -rf "$old"; done
-            return 0
-        fi
-        echo "build.sh: bpy $v did not install here; trying an older 5.x" >&2
-    done
-    echo "build.sh: no bpy 5.x installs with $py (is the package index reachable?)" >&2
-    return 1
+    return $ok
 }
 
 # Runs each command, echoes its summary, and totals the pass/fail counts.

@@ -5,8 +5,9 @@
 #     (tests/blender/test_*.py except test_gui*) with -b, and the GUI viewport
 #     test under xvfb-run (tests/blender/test_gui*.py);
 #   * in every Blender Python module venv (build/bpy/<major.minor>/, made by
-#     ./build.sh bpy; BPY_VENVS="dir ..." picks others): the same headless
-#     scripts, run by the venv's python;
+#     ./build.sh bpy: 4.5, 5.0 and the newest 5.x on Python 3.13;
+#     BPY_VENVS="dir ..." picks others): the same headless scripts, run by the
+#     venv's python;
 #   * the extension manifest validated by each Blender that has the
 #     extension tools (4.2+).
 # Every Blender starts from factory settings with private user scripts,
@@ -23,9 +24,11 @@ PYTHON=${PYTHON:-/usr/bin/python3}
 MISSING_BPY=""
 if [ -z "${BPY_VENVS+set}" ]; then
     BPY_VENVS=$(ls -d "$ROOT"/build/bpy/*/ 2>/dev/null | sed 's:/$::')
-    # The releases every run must cover: the LTS and a 5.x.
+    # The releases every run must cover: the LTS, the last 5.x on Python
+    # 3.11 (5.0) and the newest 5.x, which is on Python 3.13.
     [ -d "$ROOT/build/bpy/4.5" ] || MISSING_BPY="$MISSING_BPY 4.5"
-    ls -d "$ROOT"/build/bpy/5.*/ >/dev/null 2>&1 || MISSING_BPY="$MISSING_BPY 5.x"
+    [ -d "$ROOT/build/bpy/5.0" ] || MISSING_BPY="$MISSING_BPY 5.0"
+    ls "$ROOT"/build/bpy/5.*/bin/python3.13 >/dev/null 2>&1 || MISSING_BPY="$MISSING_BPY 5.x-on-Python-3.13"
 fi
 
 passed=0 failed=0          # overall
@@ -179,6 +182,13 @@ for venv in $BPY_VENVS; do
         case $label in test_gui*) continue ;; esac  # no window in a module
         run_script "$tag" "$label" "$py" "$script"
     done
+    # Blender 5.2 on: a background script that draws calls gpu.init() first;
+    # F12 and its composite must work after it too.
+    if "$py" -c 'import sys, bpy, gpu; sys.exit(not hasattr(gpu, "init"))' 2>/dev/null; then
+        for label in test_render test_f12_untouched; do
+            run_script "$tag-gpu-init" "$label" env VOXLIGHT_TEST_GPU_INIT=1 "$py" "$ROOT/tests/blender/$label.py"
+        done
+    fi
     if at_least_4_2 "$version"; then
         # The module has no --command; its extension tool is the same script.
         ext=$("$py" -c 'import bpy, os; print(os.path.join(bpy.utils.system_resource("SCRIPTS"), "addons_core", "bl_pkg", "cli", "blender_ext.py"))' 2>/dev/null)

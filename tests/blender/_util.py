@@ -22,6 +22,14 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "python"))
 
 from nifti_write import phantom, write_nifti  # noqa: E402,F401
 
+# VOXLIGHT_TEST_GPU_INIT=1: initialise the gpu module first, as a background
+# script that draws with it must in Blender 5.2 and later (gpu.init()); the
+# add-on's renders must work with and without that. tools/run_blender_tests.sh
+# sets it only where gpu.init exists, so a missing one fails here.
+if os.environ.get("VOXLIGHT_TEST_GPU_INIT") == "1":
+    import gpu
+    gpu.init()
+
 CH2 = "/usr/share/mricron/templates/ch2better.nii.gz"
 TMP = tempfile.mkdtemp(prefix="voxlight-blender-test-")
 _tests = []

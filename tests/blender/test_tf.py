@@ -302,11 +302,13 @@ def _box_pixels(ob, camera, w, h):
     pts = (clip[:, :2] / clip[:, 3:4] * 0.5 + 0.5) * [w, h]
     pts = sorted(map(tuple, pts))
 
+    def cross(u, v):  # 2D: numpy 2 refuses np.cross of 2-vectors
+        return u[0] * v[1] - u[1] * v[0]
+
     def half(ps):  # Andrew's monotone chain
         out = []
         for q in ps:
-            while len(out) >= 2 and np.cross(np.subtract(out[-1], out[-2]),
-                                             np.subtract(q, out[-2])) <= 0:
+            while len(out) >= 2 and cross(np.subtract(out[-1], out[-2]), np.subtract(q, out[-2])) <= 0:
                 out.pop()
             out.append(q)
         return out[:-1]

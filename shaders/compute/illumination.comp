@@ -103,11 +103,10 @@ void main()
 #ifdef LABEL_SHADOWS
                 LabelRay lr = label_ray(p, vec3(0.0, 0.0, 1.0), 0.0, 1.0);
                 LabelHit h = label_at(lr, label_q(p));
-#if LABEL_SHADOWS == 1
-                a = h.id == LABEL_NONE ? 0.0 : h.color.a; // SURFACE: the label's own opacity, per voxel of path
-#else
-                if (h.id == LABEL_NONE) a = 0.0; // MASK, TINT: only inside shown labels
-#endif
+                // only inside shown labels; what is shown keeps the transfer function's
+                // opacity in every mode (a surface label's own alpha, taken per voxel of
+                // path, darkened the label's own surface: it is drawn once per crossing)
+                if (h.id == LABEL_NONE) a = 0.0;
 #endif
                 // a = 1 is opaque: 1e-4 left after one voxel is dark enough
                 depth -= log(max(1.0 - a, 1e-4));

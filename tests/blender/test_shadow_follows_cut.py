@@ -67,6 +67,10 @@ def _scene():
     ob = u.import_volume(_atlas())
     assert ob.voxlight_labels.enabled, "the atlas imports as a label map"
     ob.voxlight.jitter = False
+    # Shown labels shadow with the transfer function's opacity: a window
+    # below both ids makes both balls opaque.
+    ob.voxlight.window_low, ob.voxlight.window_high = 0.0, 0.5
+    ob.voxlight.opacity_scale = 8.0
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.data.energy = 3.0
     sun.data.angle = 0.0

@@ -143,8 +143,12 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         snprintf(defines, sizeof defines, "#define CACHE_FORMAT %s\n", cache_formats[flags & 3]);
         rc = compile(g, GL_COMPUTE_SHADER, "compute/decode_bricks.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
-    case VXL_PROG_ILLUMINATION: /* illumination.c: flags & 3 the pass, bits 2-3 the gradient-opacity mode, plus the storage's sample flags */
-        snprintf(defines, sizeof defines, "%s#define PASS %u\n#define GOPACITY %u\n", paged, flags & 3, (flags >> 2) & 3);
+    case VXL_PROG_ILLUMINATION: /* illumination.c: flags & 3 the pass, bits 2-3 the gradient-opacity mode, plus the storage's sample flags; the extinction's cut (CUT_CONVEX) and label mode (LABELS bits) */
+        snprintf(defines, sizeof defines, "%s#define PASS %u\n#define GOPACITY %u\n%s", paged, flags & 3, (flags >> 2) & 3,
+                 (flags & VXL_FLAG_CUT_CONVEX) ? "#define CUT_KEEPS 1\n" : "");
+        if ((flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* the extinction leaves hidden labels out: label mode + 1 */
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABEL_SHADOWS %u\n",
+                     (flags >> VXL_FLAG_LABELS_SHIFT) & 3);
         rc = compile(g, GL_COMPUTE_SHADER, "compute/illumination.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_SLICE_PLANE: /* slice_plane.c: flags & 3 the interpolation (VXL_INTERP_*), plus the sample flags */

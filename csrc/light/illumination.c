@@ -30,7 +30,8 @@ void vxl_illumination_release(vxl_illumination_state *s)
     if (s->scene_depth_tex) s->gpu->gl.DeleteTextures(1, &s->scene_depth_tex);
     if (s->transmittance_tex) s->gpu->gl.DeleteTextures(1, &s->transmittance_tex);
     vxl_shadow_maps_release(&s->shadows);
-    vxl_illumination_state kept = {.gpu = s->gpu, .storage = s->storage, .builds = s->builds, .shadows = s->shadows};
+    vxl_illumination_state kept = {.gpu = s->gpu, .storage = s->storage, .builds = s->builds, .shadows = s->shadows,
+                                   .bind_labels = s->bind_labels, .labels_ctx = s->labels_ctx};
     *s = kept;
 }
 
@@ -156,10 +157,11 @@ static int allocate(vxl_illumination_state *s, const uint32_t ext_cells[3], cons
 }
 
 /* A pass's program with the grid's uniforms set (and in use). */
-static int pass_program(vxl_illumination_state *s, uint32_t pass, uint32_t gopacity, const uint32_t cells[3], GLuint *prog)
+static int pass_program(vxl_illumination_state *s, uint32_t pass, uint32_t extinction_flags, const uint32_t cells[3],
+                        GLuint *prog)
 {
     vxl_gl *gl = &s->gpu->gl;
-    uint32_t flags = pass | (pass == PASS_EXTINCTION ? gopacity << 2 | s->storage->ops->sample_flags(s->storage) : 0);
+    uint32_t flags = pass | (pass == PASS_EXTINCTION ? extinction_flags | s->storage->ops->sample_flags(s->storage) : 0);
     int rc = vxl_program_get(s->gpu, VXL_PROG_ILLUMINATION, 0, flags, prog);
     if (rc) return rc;
     if (pass == PASS_EXTINCTION) {
@@ -205,12 +207,45 @@ static void dispatch_cells(vxl_illumination_state *s, const uint32_t c[3])
     s->gpu->gl.MemoryBarrier(AFTER_IMAGE_STORES);
 }
 
+/* Whether the frame's clip planes or crop box cut the volume: what they
+ * remove casts no shadow, on the volume itself nor on the scene. The
+ * cutter meshes are peeled from the camera per pixel and have no voxel-space
+ * form here, so they do not cut the shadows (docs/scene_shadows.md). */
+static int cuts_convex(const vxl_frame *f) { return f->cut.any && (f->cut.plane_count || f->cut.has_crop); }
+
+/* Whether hidden labels leave the extinction (a label map that is shown). */
+static int masks_labels(const vxl_illumination_state *s, const vxl_frame *f) { return f->labels.on && s->bind_labels; }
+
+/* The clip planes' and crop box's uniforms, as cut/cutaway.c hands the ray
+ * caster the same numbers (voxel space; shaders/compute/illumination.comp's
+ * cut_keeps reads them). */
+static void bind_cut(vxl_illumination_state *s, GLuint prog, const vxl_frame *f)
+{
+    vxl_gl *gl = &s->gpu->gl;
+    const vxl_frame_cut *c = &f->cut;
+    float planes[VXL_MAX_CLIP_PLANES][4] = {{0}}, thick[VXL_MAX_CLIP_PLANES] = {0}, crop[16];
+    for (uint32_t i = 0; i < c->plane_count; i++) {
+        for (int k = 0; k < 4; k++) planes[i][k] = (float)c->plane[i][k];
+        thick[i] = (float)c->thickness[i];
+    }
+    vxl_uniform_i(s->gpu, prog, "u_cut_plane_count", (int)c->plane_count);
+    gl->Uniform4fv(gl->GetUniformLocation(prog, "u_cut_planes"), VXL_MAX_CLIP_PLANES, &planes[0][0]);
+    gl->Uniform1fv(gl->GetUniformLocation(prog, "u_cut_thickness"), VXL_MAX_CLIP_PLANES, thick);
+    vxl_uniform_i(s->gpu, prog, "u_cut_has_crop", c->has_crop);
+    vxl_mat4_to_float(crop, c->crop);
+    gl->UniformMatrix4fv(gl->GetUniformLocation(prog, "u_cut_crop"), 1, GL_FALSE, crop);
+}
+
 static int build_extinction(vxl_illumination_state *s, const vxl_frame *f)
 {
     vxl_gl *gl = &s->gpu->gl;
     GLuint prog;
-    int rc = pass_program(s, PASS_EXTINCTION, f->gopacity, s->extinction_cells, &prog);
+    uint32_t flags = f->gopacity << 2 | (cuts_convex(f) ? VXL_FLAG_CUT_CONVEX : 0) |
+                     (masks_labels(s, f) ? (f->labels.mode + 1u) << VXL_FLAG_LABELS_SHIFT : 0);
+    int rc = pass_program(s, PASS_EXTINCTION, flags, s->extinction_cells, &prog);
     if (rc) return rc;
+    if (cuts_convex(f)) bind_cut(s, prog, f);
+    if (masks_labels(s, f) && (rc = s->bind_labels(s->labels_ctx, f, prog))) return rc;
     /* the classification uniforms of lib/classify.glsl; the table is on its unit */
     vxl_uniform_i(s->gpu, prog, "u_tf", VXL_TF_UNIT);
     vxl_uniform_f(s->gpu, prog, "u_tf_size", (float)f->tf_size);
@@ -363,6 +398,16 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
         const float g[4] = {(float)f->gopacity, f->gopacity == VXL_GOPACITY_ISO ? f->iso_pos : f->gradient_ref,
                             f->gopacity == VXL_GOPACITY_ISO ? f->iso_thickness : f->gradient_exp, f->sample_distance};
         key = vxl_fnv(key, g, sizeof g);
+    }
+    if (cuts_convex(f)) { /* what is cut away casts no shadow */
+        key = vxl_fnv(key, f->cut.plane, sizeof f->cut.plane);
+        key = vxl_fnv(key, f->cut.thickness, sizeof f->cut.thickness);
+        key = vxl_fnv(key, &f->cut.plane_count, sizeof f->cut.plane_count);
+        if (f->cut.has_crop) key = vxl_fnv(key, f->cut.crop, sizeof f->cut.crop);
+    }
+    if (masks_labels(s, f)) { /* nor do hidden labels */
+        key = vxl_fnv(key, &f->labels.key, sizeof f->labels.key);
+        key = vxl_fnv(key, &f->labels.mode, sizeof f->labels.mode);
     }
     const int keep = keeps_extinction(s, key, cells, blocks);
     if ((rc = allocate(s, keep ? s->extinction_cells : cells, cells, blocks))) return rc;

@@ -61,6 +61,12 @@ typedef struct vxl_illumination_state {
     GLuint scene_depth_tex, transmittance_tex;
     uint32_t image_w, image_h;
     uint64_t image_bytes;
+    /* Hidden labels cast no shadow: the extinction pass reads the label
+     * volume through the labels' own binding (labels/ is a peer of light/,
+     * so the renderer hands it over here). NULL: frames with labels shadow
+     * as if every voxel were shown. */
+    int (*bind_labels)(void *ctx, const vxl_frame *f, GLuint prog);
+    void *labels_ctx;
 } vxl_illumination_state;
 
 /* Wires s to the GL services and the storage, and registers its bytes with the budget. */

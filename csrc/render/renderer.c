@@ -96,6 +96,14 @@ static int job_close(void *p)
     return VXL_OK;
 }
 
+/* The label volume on an illumination program (light/ may not include
+ * labels/): its extinction then leaves hidden labels out. */
+static int bind_labels_for_shadows(void *ctx, const vxl_frame *f, GLuint prog)
+{
+    vxl_renderer *r = ctx;
+    return vxl_labels_prepare(&r->labels, f, prog, r->storage.geom.affine);
+}
+
 int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
 {
     if (!out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
@@ -113,6 +121,8 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     vxl_modes_init(&r->modes, &r->gpu, &r->skipping, &r->storage);
     vxl_matcap_init(&r->matcap, &r->gpu);
     vxl_labels_init(&r->labels, &r->gpu); /* issue 20 label maps */
+    r->illumination.bind_labels = bind_labels_for_shadows; /* hidden labels cast no shadow */
+    r->illumination.labels_ctx = r;
     vxl_overlays_init(&r->overlays, &r->gpu); /* issue 20 overlays */
     r->gpu.budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
     if (opt && opt->struct_size >= offsetof(vxl_renderer_options, page_brick) + sizeof opt->page_brick) {

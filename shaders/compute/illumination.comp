@@ -33,6 +33,15 @@
 #include "lib/gradients.glsl"
 #endif
 #include "lib/classify.glsl"
+#ifdef LABEL_SHADOWS
+// Hidden labels cast no shadow: the label at a sample as the ray caster
+// finds it (lib/labels.glsl's label_at, whatever the mode), and what the
+// mode's march needs declared for its other functions, unused here.
+#define LABELS 2
+const int u_max_steps = 1;
+vec4 g_label_material = vec4(-1.0);
+#include "lib/labels.glsl"
+#endif
 #endif
 
 #if PASS == 1
@@ -50,6 +59,26 @@ vec3 cell_centre(ivec3 c) { return (vec3(c) + 0.5) * u_cell - 0.5; }
 layout(r32f, binding = VXL_IMAGE_OUT) writeonly uniform image3D u_dst;
 uniform ivec3 u_sub;          // samples per cell along each axis
 
+#ifdef CUT_KEEPS
+// What the clip planes and the crop box remove casts no shadow: the numbers
+// lib/cut.glsl's cut_convex narrows the rays by (csrc/light/illumination.c
+// sets them as csrc/cut/cutaway.c does), asked of one point.
+uniform int u_cut_plane_count;
+uniform vec4 u_cut_planes[6];     // voxel space: dot(xyz, p) + w = signed world distance, kept >= 0
+uniform float u_cut_thickness[6]; // > 0: kept only up to it (a slab)
+uniform int u_cut_has_crop;
+uniform mat4 u_cut_crop;          // voxel -> box space, kept inside [-1, 1]^3
+
+bool cut_keeps(vec3 p)
+{
+    for (int i = 0; i < u_cut_plane_count; i++) {
+        float d = dot(u_cut_planes[i].xyz, p) + u_cut_planes[i].w;
+        if (d < 0.0 || (u_cut_thickness[i] > 0.0 && d > u_cut_thickness[i])) return false;
+    }
+    return u_cut_has_crop == 0 || all(lessThanEqual(abs((u_cut_crop * vec4(p, 1.0)).xyz), vec3(1.0)));
+}
+#endif
+
 void main()
 {
     ivec3 c = ivec3(gl_GlobalInvocationID);
@@ -59,6 +88,9 @@ void main()
         for (int y = 0; y < u_sub.y; y++)
             for (int x = 0; x < u_sub.x; x++) {
                 vec3 p = (vec3(c) + (vec3(x, y, z) + 0.5) / vec3(u_sub)) * u_cell - 0.5;
+#ifdef CUT_KEEPS
+                if (!cut_keeps(p)) continue; // no optical depth
+#endif
                 float v = sample_value(p);
 #if GOPACITY == 2
                 float a = gradient_opacity(classify(u_gopacity_param.x).a, v, length(gradient_at(p, v)));
@@ -67,6 +99,14 @@ void main()
 #if GOPACITY == 1
                 a = gradient_opacity(a, v, length(gradient_at(p, v)));
 #endif
+#endif
+#ifdef LABEL_SHADOWS
+                LabelRay lr = label_ray(p, vec3(0.0, 0.0, 1.0), 0.0, 1.0);
+                LabelHit h = label_at(lr, label_q(p));
+                // only inside shown labels; what is shown keeps the transfer function's
+                // opacity in every mode (a surface label's own alpha, taken per voxel of
+                // path, darkened the label's own surface: it is drawn once per crossing)
+                if (h.id == LABEL_NONE) a = 0.0;
 #endif
                 // a = 1 is opaque: 1e-4 left after one voxel is dark enough
                 depth -= log(max(1.0 - a, 1e-4));

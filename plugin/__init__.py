@@ -96,4 +96,5 @@ def unregister():
         return
     for m in reversed(_modules):
         m.unregister()
-    runtime.release_all()
+    for msg in runtime.release_all():
+        print("Voxlight: %s" % msg)

@@ -23,6 +23,11 @@ from . import budget_split, frames, label_import, label_runtime, native, tf_fit
 from .native_volume import ERR_CANCELLED
 
 _lock = threading.Lock()
+
+# How long closing a renderer waits for the render band in flight: a band
+# takes about Worker.target_seconds, so a call still running after this has
+# hung, and the wait ends with a message instead of freezing Blender.
+CLOSE_WAIT_S = 30.0
 render_count = 0
 call_count = 0
 cancelled_count = 0
@@ -154,8 +159,11 @@ class Worker:
                 else:
                     self._finish(job, cancelled=error is None)
 
-    def close(self):
-        """Stop the thread; waits for the band in flight (if any)."""
+    def close(self, timeout=None):
+        """Stop the thread; waits for the band in flight (if any), at most
+        `timeout` seconds (CLOSE_WAIT_S by default). Returns True once the
+        thread has ended; False when a job is still inside the library: its
+        renderer must then stay open, since the call in flight uses it."""
         with self._cond:
             self._stop = True
             for job in self._queue.values():
@@ -164,8 +172,10 @@ class Worker:
             if self._running is not None:
                 self._running.cancelled = True
             self._cond.notify_all()
-        if self._thread is not threading.current_thread():
-            self._thread.join()
+        if self._thread is threading.current_thread():
+            return True
+        self._thread.join(CLOSE_WAIT_S if timeout is None else timeout)
+        return not self._thread.is_alive()
 
 
 # Frames of 4D volumes, shared by every entry (frames.py).
@@ -243,14 +253,22 @@ class VolumeEntry:
     def busy(self):
         return self._worker is not None and self._worker.busy()
 
-    def close(self):
+    def close(self, timeout=None):
+        """Close the worker and the renderer. Returns "" when done, else why
+        the renderer was left open: a render in flight did not let go within
+        the bound (Worker.close), and destroying the renderer under it would
+        crash Blender; a hang waits no longer than the bound."""
         if self._worker is not None:
-            self._worker.close()
+            if not self._worker.close(timeout):
+                return ("the Voxlight renderer of %s is still busy after %.0f s: a render in flight did not "
+                        "stop; it is left open (its memory is freed when Blender quits)"
+                        % (os.path.basename(self.path), CLOSE_WAIT_S if timeout is None else timeout))
             self._worker = None
         if self.pending_frame is not None:  # opened but never adopted
             self.pending_frame.close()
             self.pending_frame = None
         self.renderer.close()
+        return ""
 
 
 _entries = {}   # (absolute path, DICOM series) -> VolumeEntry
@@ -443,12 +461,13 @@ def busy():
 
 
 def release_all():
-    """Close every renderer and its worker (unregister, exit)."""
-    for entry in _entries.values():
-        entry.close()
+    """Close every renderer and its worker (unregister, exit). Returns the
+    messages of those left open (VolumeEntry.close), for the caller to show."""
+    left = [m for m in (entry.close() for entry in _entries.values()) if m]
     _entries.clear()
     _failures.clear()
     frame_cache.clear()
+    return left
 
 
 atexit.register(release_all)

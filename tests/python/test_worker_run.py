@@ -68,3 +68,28 @@ def test_errors_are_kept_for_the_main_thread():
         assert isinstance(job.error, ZeroDivisionError) and job.result is None
     finally:
         w.close()
+
+
+class _Renderer:
+    closed = False
+
+    def close(self):
+        self.closed = True
+
+
+def test_closing_waits_for_a_stuck_job_only_as_long_as_its_bound():
+    """A job that does not let go (a hung library call) must not freeze the
+    caller of close(): the wait ends after its bound, and the renderer the
+    call still uses stays open; once the job ends, closing completes."""
+    release = threading.Event()
+    entry = runtime.VolumeEntry("/data/scan.nii.gz", _Renderer(), info={})
+    job = runtime.Job("owner", "key", None)
+    job.run = lambda stop: release.wait(600)  # ignores stop(), as a hung call would
+    entry.worker.submit(job)
+    _wait(lambda: entry.worker.busy() and not entry.worker._queue)
+    msg = entry.close(timeout=0.2)
+    assert "scan.nii.gz" in msg and "still busy after 0 s" in msg and "left open" in msg, msg
+    assert not entry.renderer.closed
+    release.set()
+    assert entry.close(timeout=60.0) == ""
+    assert entry.renderer.closed

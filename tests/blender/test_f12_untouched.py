@@ -237,4 +237,53 @@ def an_intensity_volume_beside_a_folder_wide_labels_txt_renders_as_intensity():
     _same(_f12(scene, "sphere_again"), img, "intensity again: the first render")
 
 
+def _animation(scene, name):
+    """Renders frames frame_start..frame_end as an animation (the render
+    job changes frames itself) and returns them as arrays."""
+    scene.render.filepath = os.path.join(u.TMP, name + "_####")
+    bpy.ops.render.render(animation=True)
+    return [u.load_png(os.path.join(u.TMP, "%s_%04d.png" % (name, f)))
+            for f in range(scene.frame_start, scene.frame_end + 1)]
+
+
+@test
+def an_animation_whose_camera_passes_through_behind_and_away_never_gets_a_damaged_frame():
+    """The camera flies at the volume, through it, past it (the volume
+    behind it) and turns away. Where the volume is out of view, a frame
+    equals the scene without it; inside it, the frame shows the volume over
+    the scene, never a black or broken frame."""
+    scene = _lit_scene()
+    ob = u.import_volume(u.ball_file())
+    ob.voxlight.jitter = False
+    cam = scene.camera
+    half = 0.5 * max(ob.dimensions)
+    shots = (("in_view", (0.0, -4.0, 0.3), (np.pi / 2, 0.0, 0.0)),
+             ("inside", (0.0, 0.0, 0.0), (np.pi / 2, 0.0, 0.0)),
+             ("behind", (0.0, 1.5 * half + 1.0, 0.3), (np.pi / 2, 0.0, 0.0)),
+             ("away", (0.0, -4.0, 0.3), (np.pi / 2, 0.0, np.pi)))
+    scene.frame_start, scene.frame_end = 1, len(shots)
+    for f, (_tag, loc, rot) in enumerate(shots, start=1):
+        cam.location, cam.rotation_euler = loc, rot
+        cam.keyframe_insert("location", frame=f)
+        cam.keyframe_insert("rotation_euler", frame=f)
+    for fc in cam.animation_data.action.fcurves:
+        for k in fc.keyframe_points:
+            k.interpolation = "CONSTANT"
+    _forget_images()
+    frames = _animation(scene, "fly")
+    for ob_ in (ob,):
+        ob_.hide_render = True
+    try:
+        plain = _animation(scene, "fly_plain")
+    finally:
+        ob.hide_render = False
+    for (tag, _l, _r), img, ref in zip(shots, frames, plain):
+        assert np.isfinite(img).all() and img[..., :3].max() > 1.0 / 255, (tag, "a black or broken frame")
+        if tag in ("behind", "away"):
+            _same(img, ref, tag + ": the scene without the volume")
+        else:
+            assert np.abs(img - ref).max() > 0.05, (tag, "the volume shows")
+            assert (img[..., 3] == 1.0).all(), (tag, "holes in the frame's alpha")
+
+
 u.run("test_f12_untouched")

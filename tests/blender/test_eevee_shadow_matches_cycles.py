@@ -28,7 +28,7 @@ import _util as u  # noqa: E402
 from _util import test  # noqa: E402
 
 vx = u.install_addon()
-W, H = 240, 180
+W, H = 192, 144
 EEVEE = "BLENDER_EEVEE_NEXT" if (4, 2, 0) <= bpy.app.version < (5, 0, 0) else "BLENDER_EEVEE"
 
 

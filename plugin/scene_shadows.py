@@ -22,7 +22,7 @@ import numpy as np
 from bpy.app.handlers import persistent
 
 from . import compositor
-from .core import facing
+from .core import facing, light_shares
 from .core import lights as _lights
 from .core import native, scene_geometry, shadow_plan
 
@@ -173,19 +173,12 @@ def _plan_lights(scene):
             for o in scene.objects if o.type == "LIGHT" and not o.hide_render]
 
 
-def _set_passes(scene, view_layer, on):
-    """Turn on (or back off) the direct diffuse and glossy passes the
-    fallback reads; only switches the add-on turned on are turned off."""
+def _restore_passes(scene):
+    """Turn back off the direct diffuse and glossy passes an earlier
+    version of the add-on turned on for EEVEE (recorded on the scene):
+    only switches it turned on are turned off."""
     key = "voxlight_shadow_passes"
-    done = list(scene.get(key, []))
-    if on:
-        for sw in shadow_plan.PASS_SWITCHES:
-            if not getattr(view_layer, sw):
-                setattr(view_layer, sw, True)
-                done.append("%s/%s" % (view_layer.name, sw))
-        scene[key] = done
-        return
-    for item in done:
+    for item in list(scene.get(key, [])):
         layer, _s, sw = item.partition("/")
         vl = scene.view_layers.get(layer)
         if vl is not None and hasattr(vl, sw):
@@ -197,7 +190,7 @@ def _set_passes(scene, view_layer, on):
 def revert(scene):
     """Take back everything the shadows set up: the compositor chain, the
     light groups the add-on gave lights (unless the user changed them since)
-    and made, and the passes it turned on."""
+    and made, and passes an earlier version turned on."""
     compositor.remove_shadow_chain(scene)
     lights = [shadow_plan.Light(o.name, getattr(o, "lightgroup", ""),
                                 str(o.get(shadow_plan.ASSIGNED_PROP, "")))
@@ -215,7 +208,7 @@ def revert(scene):
     for o in scene.objects:
         if o.type == "LIGHT" and shadow_plan.ASSIGNED_PROP in o:
             del o[shadow_plan.ASSIGNED_PROP]
-    _set_passes(scene, None, False)
+    _restore_passes(scene)
 
 
 def _remove_lightgroup(scene, view_layer, name):
@@ -252,7 +245,7 @@ def prepare_render(scene, width, height):
     vl = _render_layer(scene)
     mode, why = shadow_plan.choose_mode(scene.render.engine, hasattr(vl, "lightgroups"))
     if mode == shadow_plan.MODE_LIGHT_GROUPS:
-        _set_passes(scene, vl, False)
+        _restore_passes(scene)
         plan = shadow_plan.plan_groups(_plan_lights(scene), [g.name for g in vl.lightgroups])
         for g in plan.create:
             vl.lightgroups.add(name=g)
@@ -264,7 +257,6 @@ def prepare_render(scene, width, height):
         images = [shadow_plan.image_name(g) for g in groups]
     else:
         revert(scene)
-        _set_passes(scene, vl, True)
         groups = {}
         images = [shadow_plan.KEY_IMAGE]
         note = why
@@ -300,6 +292,40 @@ def transmittances(frame, depth, width, height):
     return out
 
 
+def world_light(scene):
+    """The world's radiance as one number (the mean of its colour times
+    strength): its Background node's when the colour is not linked, else
+    the world's viewport colour (a texture's mean is not known here)."""
+    world = scene.world
+    if world is None:
+        return 0.0
+    tree = world.node_tree if getattr(world, "use_nodes", True) else None
+    bg = None
+    if tree is not None:
+        bg = next((n for n in tree.nodes if n.bl_idname == "ShaderNodeBackground"), None)
+    if bg is not None and not bg.inputs["Color"].is_linked and not bg.inputs["Strength"].is_linked:
+        c = bg.inputs["Color"].default_value
+        return float(np.mean(c[:3])) * float(bg.inputs["Strength"].default_value)
+    return float(np.mean(world.color[:3]))
+
+
+def _direct_shadow(scene, frame, trans, width, height):
+    """F = sum_l w_l (1 - T_l), each light's shadow weighted by its share
+    of every pixel's light (core/light_shares.py), or None (no shadow)."""
+    if not trans:
+        return None
+    surface = frame.get("surface")
+    depth = frame["depth"]
+    if surface is None or surface[0] is None:
+        return None
+    tris, ids, view, proj = surface
+    positions = facing.pixel_positions(depth, view, proj)
+    normals = facing.surface_normals(tris, ids, depth, view, proj)
+    lights = [l for _n, _g, l in frame["named_lights"]]
+    w = light_shares.shares(lights, positions, normals, world_light(scene))
+    return light_shares.shadow_amount(w, trans)
+
+
 def write_render(scene, frame, width, height):
     """frame_change_post of an F12 render: fill the shadow images of the
     plan prepare_render made from the frame's z-buffer and lights."""
@@ -312,9 +338,8 @@ def write_render(scene, frame, width, height):
     index = {name: i for i, (name, _g, _l) in enumerate(named)}
     weight = {name: _weight(l) for name, _g, l in named}
     if mode == shadow_plan.MODE_DIRECT:
-        t = trans.get(0)  # the key light: the strongest
-        compositor.write_shadow_image(shadow_plan.KEY_IMAGE, width, height,
-                                      None if t is None else 1.0 - t)
+        amount = _direct_shadow(scene, frame, trans, width, height)
+        compositor.write_shadow_image(shadow_plan.KEY_IMAGE, width, height, amount)
         return
     for g, members in groups.items():
         members = [m for m in members if m in index and index[m] in trans]

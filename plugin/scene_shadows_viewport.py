@@ -4,17 +4,20 @@ multiply layer drawn by the viewport's draw handler before the volumes
 
 From the scene depth the handler already read, at a quarter of the view's
 resolution (the shadow is soft; the texture is filtered up), the library
-gives each light's transmittance from every visible scene point through
-each volume that casts shadows (vxl_scene_transmittance). The layer is
+gives each light's transmittance T_l from every visible scene point through
+the volumes that cast shadows (vxl_scene_transmittance, the product over
+volumes). The layer is
 
-    T = prod over volumes of  sum_i  share_i * T_i
+    1 - sum_l w_l (1 - T_l)
 
-with share_i the light's part of the lights' intensity (intensity times its
-brightest colour channel), and the view's colours are multiplied by it.
-Approximate, as a preview: Blender's viewport gives no per-light passes, so
-the ambient and world light and the meshes' own shading are darkened by the
-lights' share of T, not only the direct light (F12 is exact for direct
-light: compositor.py). A depth pixel is one sample at the quarter
+with w_l light l's share of the point's light, from the point's place and
+normal (normals from the depth's neighbours), the lights and the world's
+light (core/light_shares.py, as EEVEE's F12): each light's shadow darkens
+only its own share, and the world's light stays, so a shadow is as dark as
+the light the volume takes away and keeps its penumbra where the volume is
+translucent. Approximate, as a preview: Blender's viewport gives no
+per-light passes; specular light is shared like the diffuse, and a mesh's
+own shadow is not known. A depth pixel is one sample at the quarter
 resolution, so edges of meshes in front of a shadow are soft.
 
 Cost: the transmittance is computed on the renderer's background worker
@@ -31,9 +34,9 @@ import bpy
 import gpu
 import numpy as np
 
-from . import gpu_quad, params
+from . import gpu_quad, params, scene_shadows
 from .core import depth as _depth
-from .core import native, runtime
+from .core import facing, light_shares, native, runtime
 
 SCALE = 0.25
 OWNER = "scene shadows"
@@ -69,23 +72,20 @@ def _get_shader():
     return _shader, _batch
 
 
-def _combine(entries_params, weights, stop):
-    """Worker side: the layer T from (entry, params) per casting volume."""
-    total = None
+def _combine(entries_params, lights, ambient, view, proj, planar, stop):
+    """Worker side: the layer 1 - F from (entry, params) per casting volume."""
+    trans = {}
     for entry, p in entries_params:
-        t = None
-        for i, share in enumerate(weights):
+        for i in range(len(lights)):
             if stop():
                 return None
-            part = share * entry.renderer.scene_transmittance(p, i)
-            t = part if t is None else t + part
-        total = t if total is None else total * t
-    return total
-
-
-def _weights(lights):
-    w = np.array([max(float(l[2]) * max(l[1]), 0.0) for l in lights], np.float64)
-    return (w / w.sum()) if w.sum() > 0 else np.full(len(w), 1.0 / max(len(w), 1))
+            t = entry.renderer.scene_transmittance(p, i)
+            trans[i] = t if i not in trans else trans[i] * t
+    positions = facing.pixel_positions(planar, view, proj)
+    normals = facing.depth_normals(positions, view)
+    amount = light_shares.shadow_amount(
+        light_shares.shares(lights, positions, normals, ambient), trans)
+    return None if amount is None else 1.0 - amount
 
 
 def draw_layer(scene, depsgraph, objs, window_depth, W, H, view, proj, lights, region_ptr):
@@ -99,7 +99,8 @@ def draw_layer(scene, depsgraph, objs, window_depth, W, H, view, proj, lights, r
         return
     w, h = max(1, round(W * SCALE)), max(1, round(H * SCALE))
     digest = hashlib.blake2b(digest_size=16)
-    digest.update(repr((window_depth.crc, w, h, [repr(l) for l in lights])).encode())
+    ambient = scene_shadows.world_light(scene)
+    digest.update(repr((window_depth.crc, w, h, [repr(l) for l in lights], ambient)).encode())
     digest.update(np.asarray(view, np.float64).tobytes() + np.asarray(proj, np.float64).tobytes())
     built = []
     for ob in casters:
@@ -133,9 +134,10 @@ def draw_layer(scene, depsgraph, objs, window_depth, W, H, view, proj, lights, r
             planar = _depth.window_to_planar(win, proj)
             pairs = [(entry, params.build(ob, w, h, view, proj, scene_depth=planar, lights=lights))
                      for ob, entry in built]
-            weights = _weights(lights)
             job = runtime.Job((region_ptr, OWNER), key, None)
-            job.run = lambda stop, pairs=pairs, weights=weights: _combine(pairs, weights, stop)
+            job.run = lambda stop, pairs=pairs, lights=list(lights), args=(
+                ambient, np.array(view, np.float64), np.array(proj, np.float64), planar): \
+                _combine(pairs, lights, *args, stop)
             st.job, st.job_key = built[0][1].worker.submit(job), key
             _wake(0.05)
     if st.shown_key == key and st.texture is not None:

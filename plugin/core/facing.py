@@ -31,14 +31,12 @@ def pixel_positions(depth, view, proj):
     return pts[..., :3]
 
 
-def faces_light(triangles, ids, depth, view, proj, light_position):
-    """(height, width) bool: True where the visible surface's side that
-    faces the camera faces the light too, or where there is no surface
-    (ids < 0). light_position: a library light's (x, y, z, w): w = 0 a
-    direction towards a sun, else a point."""
+def surface_normals(triangles, ids, depth, view, proj):
+    """(height, width, 3) unit normals of the visible triangles, turned to
+    the camera's side; NaN where there is no surface (ids < 0)."""
     tris = np.asarray(triangles, np.float64).reshape(-1, 3, 3)
     ids = np.asarray(ids)
-    out = np.ones(ids.shape, bool)
+    out = np.full(ids.shape + (3,), np.nan)
     hit = (ids >= 0) & np.isfinite(depth)
     if not hit.any() or not len(tris):
         return out
@@ -47,6 +45,47 @@ def faces_light(triangles, ids, depth, view, proj, light_position):
     p = pixel_positions(depth, view, proj)[hit]
     eye = np.linalg.inv(np.asarray(view, np.float64))[:3, 3]
     n *= np.where(np.einsum("ij,ij->i", n, eye - p) < 0.0, -1.0, 1.0)[:, None]
+    length = np.linalg.norm(n, axis=1)[:, None]
+    out[hit] = n / np.where(length > 0.0, length, 1.0)
+    return out
+
+
+def depth_normals(positions, view):
+    """(height, width, 3) unit normals from the world positions of a depth
+    image (pixel_positions): the cross product of its neighbours'
+    differences (the smaller one each way, so an edge does not bend a
+    face), turned to the camera's side; NaN where a neighbour is missing.
+    For a view that has no triangle per pixel (the viewport)."""
+    p = np.asarray(positions, np.float64)
+    pad = np.pad(p, ((1, 1), (1, 1), (0, 0)), constant_values=np.nan)
+
+    def shorter(a, b):
+        la = np.nan_to_num(np.linalg.norm(a, axis=-1), nan=np.inf)
+        lb = np.nan_to_num(np.linalg.norm(b, axis=-1), nan=np.inf)
+        return np.where((la <= lb)[..., None], a, b)
+
+    dx = shorter(pad[1:-1, 2:] - p, p - pad[1:-1, :-2])
+    dy = shorter(pad[2:, 1:-1] - p, p - pad[:-2, 1:-1])
+    n = np.cross(dx, dy)
+    eye = np.linalg.inv(np.asarray(view, np.float64))[:3, 3]
+    n *= np.where(np.einsum("...i,...i", n, eye - p) < 0.0, -1.0, 1.0)[..., None]
+    length = np.linalg.norm(n, axis=-1)[..., None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(length > 0.0, n / length, np.nan)
+
+
+def faces_light(triangles, ids, depth, view, proj, light_position):
+    """(height, width) bool: True where the visible surface's side that
+    faces the camera faces the light too, or where there is no surface
+    (ids < 0). light_position: a library light's (x, y, z, w): w = 0 a
+    direction towards a sun, else a point."""
+    ids = np.asarray(ids)
+    out = np.ones(ids.shape, bool)
+    hit = (ids >= 0) & np.isfinite(depth)
+    if not hit.any() or not len(np.asarray(triangles).reshape(-1)):
+        return out
+    n = surface_normals(triangles, ids, depth, view, proj)[hit]
+    p = pixel_positions(depth, view, proj)[hit]
     lp = np.asarray(light_position, np.float64)
     to_light = np.broadcast_to(lp[:3], p.shape) if lp[3] == 0.0 else lp[:3] - p
     out[hit] = np.einsum("ij,ij->i", n, to_light) > 0.0

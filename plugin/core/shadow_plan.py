@@ -15,11 +15,16 @@ shadow amount, stored in the image "Voxlight Shadow <g>"):
 
 so each group's light is multiplied by its transmittance and everything not
 in a group (the world, emission, lights the add-on does not shadow) stays.
-Where an engine has no light groups (EEVEE), the direct diffuse and glossy
-light, as Blender combines them (DiffDir * DiffCol + GlossDir * GlossCol),
-is multiplied by the key light's transmittance instead:
+Where an engine has no light groups (EEVEE), the whole image is multiplied
+by one factor per pixel, 1 - F with F = sum_l w_l (1 - T_l) and w_l each
+light's share of the pixel's light, from geometry (core/light_shares.py;
+F is stored in the image KEY_IMAGE):
 
-    result = Image - (DiffDir * DiffCol + GlossDir * GlossCol) * S_key
+    result = Image - Image * F
+
+Subtracting EEVEE's direct-light passes times the shadow instead striped
+the shadows: the passes hold about 1 % precision, and where direct light is
+nearly all the light, what is left after the subtraction is that rounding.
 
 Light groups. A light the user put in a group keeps it (the group is then
 shadowed as a whole, by its lights' transmittances weighted by intensity).
@@ -141,9 +146,6 @@ PASS_SOCKETS = {
     "glossy_direct": ("GlossDir", "Glossy Direct"),
     "glossy_color": ("GlossCol", "Glossy Color"),
 }
-# The view layer switches that make them.
-PASS_SWITCHES = ("use_pass_diffuse_direct", "use_pass_diffuse_color",
-                 "use_pass_glossy_direct", "use_pass_glossy_color")
 
 
 def lightgroup_socket(group):
@@ -153,8 +155,8 @@ def lightgroup_socket(group):
 def node_plan(mode, groups=(), origin=(0.0, 0.0)):
     """The chain's nodes, in build order; the last is NODE_OUT. mode
     MODE_LIGHT_GROUPS: one multiply and one subtract per group in `groups`
-    (a group's pass is ("pass", "Combined_<g>")); MODE_DIRECT: the direct
-    diffuse and glossy light times the key light's shadow."""
+    (a group's pass is ("pass", "Combined_<g>")); MODE_DIRECT: the image
+    times 1 - F, F the per-light shadow weighted by each light's share."""
     x, y = origin
     nodes = []
     if mode == MODE_LIGHT_GROUPS:
@@ -176,18 +178,11 @@ def node_plan(mode, groups=(), origin=(0.0, 0.0)):
     if mode == MODE_DIRECT:
         img = NODE_PREFIX + " Image Key"
         return [
-            Node(img, "image", (KEY_IMAGE,), (x + 200, y - 450)),
-            Node(NODE_PREFIX + " Diffuse", "MULTIPLY",
-                 (("pass", "diffuse_direct"), ("pass", "diffuse_color")), (x + 200, y - 150)),
-            Node(NODE_PREFIX + " Glossy", "MULTIPLY",
-                 (("pass", "glossy_direct"), ("pass", "glossy_color")), (x + 200, y - 300)),
-            Node(NODE_PREFIX + " Direct", "ADD",
-                 (("node", NODE_PREFIX + " Diffuse"), ("node", NODE_PREFIX + " Glossy")),
+            Node(img, "image", (KEY_IMAGE,), (x + 200, y - 300)),
+            Node(NODE_PREFIX + " Multiply", "MULTIPLY", (("origin",), ("node", img)),
                  (x + 400, y - 200)),
-            Node(NODE_PREFIX + " Multiply", "MULTIPLY",
-                 (("node", NODE_PREFIX + " Direct"), ("node", img)), (x + 550, y - 250)),
             Node(NODE_OUT, "SUBTRACT", (("origin",), ("node", NODE_PREFIX + " Multiply")),
-                 (x + 700, y)),
+                 (x + 600, y)),
         ]
     raise ValueError("unknown shadow mode %r" % (mode,))
 
@@ -198,9 +193,9 @@ def choose_mode(engine, has_lightgroups):
     the panel and the console show for the fallback (None when exact)."""
     if engine == "CYCLES" and has_lightgroups:
         return MODE_LIGHT_GROUPS, None
-    return MODE_DIRECT, ("%s has no light group passes: the volume's shadow multiplies the "
-                         "direct diffuse and glossy light by the key light's transmittance"
-                         % _ENGINE_NAMES.get(engine, engine))
+    return MODE_DIRECT, ("%s has no light group passes: the volume's shadow darkens each "
+                         "light's estimated share of the light (specular, area lights and "
+                         "the meshes' own shadows approximate)" % _ENGINE_NAMES.get(engine, engine))
 
 
 _ENGINE_NAMES = {"BLENDER_EEVEE": "EEVEE", "BLENDER_EEVEE_NEXT": "EEVEE",

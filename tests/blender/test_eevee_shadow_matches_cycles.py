@@ -124,4 +124,4 @@ def eevee_shadow_of_two_lights_is_smooth_and_matches_cycles():
 
 
 if __name__ == "__main__":
-    u.run(__file__)
+    u.run("test_eevee_shadow_matches_cycles")

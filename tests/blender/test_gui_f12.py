@@ -25,7 +25,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import _gui  # noqa: E402
 import _util as u  # noqa: E402
 
-HANG_S = 1200  # generous: each of the 12 renders takes seconds under Xvfb
+HANG_S = 560  # under the runner's 600 s per script; each of the 12 renders takes seconds
 faulthandler.dump_traceback_later(HANG_S, exit=True)
 RUN = _gui.Run("test_gui_f12", limit_s=HANG_S)
 check = RUN.check

@@ -189,3 +189,14 @@ int vxl_frame_cut_interval(const vxl_frame_cut *c, const double o[3], const doub
         }
     return *t0 < *t1;
 }
+
+void vxl_frame_cut_plane_floats(const vxl_frame_cut *c, float planes[VXL_MAX_CLIP_PLANES][4],
+                                float thickness[VXL_MAX_CLIP_PLANES])
+{
+    memset(planes, 0, sizeof(float[VXL_MAX_CLIP_PLANES][4]));
+    memset(thickness, 0, sizeof(float[VXL_MAX_CLIP_PLANES]));
+    for (uint32_t i = 0; i < c->plane_count && i < VXL_MAX_CLIP_PLANES; i++) {
+        for (int k = 0; k < 4; k++) planes[i][k] = (float)c->plane[i][k];
+        thickness[i] = (float)c->thickness[i];
+    }
+}

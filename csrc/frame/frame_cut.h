@@ -46,6 +46,11 @@ int vxl_frame_cut_resolve(vxl_frame_cut *c, const vxl_render_params *p, const do
  * kept part through at the new *t0 (the gradient of the plane's or box
  * face's function in voxel space, as a data gradient would be), or zero
  * when *t0 did not move. Cutters are not looked at. */
+/* The clip planes as the shaders take them (u_cut_planes, u_cut_thickness):
+ * floats, slots past plane_count zero. */
+void vxl_frame_cut_plane_floats(const vxl_frame_cut *c, float planes[VXL_MAX_CLIP_PLANES][4],
+                                float thickness[VXL_MAX_CLIP_PLANES]);
+
 int vxl_frame_cut_interval(const vxl_frame_cut *c, const double o[3], const double dir[3], double *t0, double *t1,
                            double cap[3]);
 

@@ -223,11 +223,8 @@ static void bind_cut(vxl_illumination_state *s, GLuint prog, const vxl_frame *f)
 {
     vxl_gl *gl = &s->gpu->gl;
     const vxl_frame_cut *c = &f->cut;
-    float planes[VXL_MAX_CLIP_PLANES][4] = {{0}}, thick[VXL_MAX_CLIP_PLANES] = {0}, crop[16];
-    for (uint32_t i = 0; i < c->plane_count; i++) {
-        for (int k = 0; k < 4; k++) planes[i][k] = (float)c->plane[i][k];
-        thick[i] = (float)c->thickness[i];
-    }
+    float planes[VXL_MAX_CLIP_PLANES][4], thick[VXL_MAX_CLIP_PLANES], crop[16];
+    vxl_frame_cut_plane_floats(c, planes, thick);
     vxl_uniform_i(s->gpu, prog, "u_cut_plane_count", (int)c->plane_count);
     gl->Uniform4fv(gl->GetUniformLocation(prog, "u_cut_planes"), VXL_MAX_CLIP_PLANES, &planes[0][0]);
     gl->Uniform1fv(gl->GetUniformLocation(prog, "u_cut_thickness"), VXL_MAX_CLIP_PLANES, thick);

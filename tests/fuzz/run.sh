@@ -189,7 +189,11 @@ fuzz_fixed() {  # target bin leaks crash_dir
     # they were made.
     mkdir "$work/seeds"
     find "build/fuzz/seeds/$t" -maxdepth 1 -type f -print0 | sort -z | xargs -0 -r cp -t "$work/seeds"
-    (cd "$work" && VOXLIGHT_FUZZ_DIR=. $NO_ASLR env ASAN_OPTIONS=detect_leaks=$leaks "$root/$bin" -seed=$CI_SEED \
+    # the target runs as ./fuzz from there too: the library finds its reader
+    # helpers beside the program that loaded it, and a missing helper's
+    # message holds that path (libFuzzer saw its length in one branch)
+    cp "$bin" "$work/fuzz"
+    (cd "$work" && VOXLIGHT_FUZZ_DIR=. $NO_ASLR env ASAN_OPTIONS=detect_leaks=$leaks ./fuzz -seed=$CI_SEED \
         -runs="$runs" -use_cmp=0 -reload=0 -timeout=60 -rss_limit_mb=0 -malloc_limit_mb=2048 -detect_leaks=$leaks \
         -print_final_stats=1 \
         -artifact_prefix="$crash_dir/" "$corpus" seeds) >"$log" 2>&1

@@ -15,7 +15,9 @@ Light groups the add-on makes are recorded on each light and taken back by
 revert() when no volume casts shadows any more.
 """
 
+import functools
 import hashlib
+import threading
 
 import bpy
 import numpy as np
@@ -213,7 +215,13 @@ def revert(scene):
 
 def _remove_lightgroup(scene, view_layer, name):
     """Remove one light group: the collection's remove() where it has one
-    (4.x+), else (3.x) the operator on the view layer's active group."""
+    (4.x+), else (3.x) the operator on the view layer's active group. An
+    operator must not run on Blender's render thread, where render_init
+    and render_pre run for an F12 in the GUI: it rebuilt the depsgraph
+    beside the render's and crashed Blender 3.4 ("Operation already
+    exists", then SIGSEGV). There the removal waits for the main thread,
+    after the render; a light group left for one render changes nothing in
+    its image (Combined still holds every light)."""
     groups = view_layer.lightgroups
     g = groups.get(name)
     if g is None:
@@ -221,9 +229,25 @@ def _remove_lightgroup(scene, view_layer, name):
     if hasattr(groups, "remove"):
         groups.remove(g)
         return
+    if threading.current_thread() is not threading.main_thread():
+        bpy.app.timers.register(functools.partial(_remove_lightgroup_later, scene.name, view_layer.name, name),
+                                first_interval=0.0)
+        return
     view_layer.active_lightgroup_index = [x.name for x in groups].index(name)
     with bpy.context.temp_override(scene=scene, view_layer=view_layer):
         bpy.ops.scene.view_layer_remove_lightgroup()
+
+
+def _remove_lightgroup_later(scene_name, layer_name, name):
+    """Timer on the main thread: _remove_lightgroup once no render runs
+    (returns the seconds to the next try, or None when done)."""
+    if bpy.app.is_job_running("RENDER"):
+        return 0.5
+    scene = bpy.data.scenes.get(scene_name)
+    vl = scene.view_layers.get(layer_name) if scene is not None else None
+    if vl is not None and getattr(vl, "lightgroups", None) is not None:
+        _remove_lightgroup(scene, vl, name)
+    return None
 
 
 _plan = {}  # scene name -> (mode, {group: [light names]}) of the render being made

@@ -520,6 +520,18 @@ def _report(e):
     last_error = str(e)
 
 
+def _rendering():
+    """True while an F12 render job runs. Blender's render thread then runs
+    this add-on's render handlers, which wait for Python's lock, while
+    holding scene data; a redraw that evaluates the viewport's depsgraph
+    (evaluated_depsgraph_get) waits for that data while it holds Python's
+    lock: Blender froze for good (test_gui_f12 caught it in 1 run of 3, in
+    Workbench, after renders in every engine). So the viewport draws no
+    volume until the render ends; Blender redraws it then."""
+    running = getattr(bpy.app, "is_job_running", None)
+    return bool(running and running("RENDER"))
+
+
 def _draw():
     global draw_count, culled_count, last_error
     t_draw = time.perf_counter()
@@ -530,6 +542,8 @@ def _draw():
     ctx = bpy.context
     scene = ctx.scene
     if scene is None or not scene.voxlight.viewport_enabled:
+        return
+    if _rendering():
         return
     region, rv3d, space = ctx.region, ctx.region_data, ctx.space_data
     if rv3d is None or region is None:

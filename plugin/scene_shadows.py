@@ -246,7 +246,10 @@ def _remove_lightgroup_later(scene_name, layer_name, name):
     scene = bpy.data.scenes.get(scene_name)
     vl = scene.view_layers.get(layer_name) if scene is not None else None
     if vl is not None and getattr(vl, "lightgroups", None) is not None:
-        _remove_lightgroup(scene, vl, name)
+        try:
+            _remove_lightgroup(scene, vl, name)
+        except AttributeError:  # "Writing to ID classes in this context is not allowed": the job is ending
+            return 0.5
     return None
 
 

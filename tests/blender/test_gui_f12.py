@@ -65,7 +65,9 @@ def steps():
                 del done[:]
                 t = time.time()
                 bpy.ops.render.render("INVOKE_DEFAULT")
-                while not done and time.time() - t < HANG_S / 12:
+                # until the job has ended, not only rendered: Blender refuses
+                # writes to the scene while its render thread is still closing
+                while (not done or bpy.app.is_job_running("RENDER")) and time.time() - t < HANG_S / 12:
                     yield 0.25
                 check("f12_%s_finishes" % name, done, "%.1f s" % (time.time() - t))
                 check("f12_%s_no_error" % name, not vx.render_hooks.last_error, vx.render_hooks.last_error)

@@ -106,12 +106,13 @@ def alpha_over_sockets(node):
 def alpha_over_premultiplied(node):
     """Make an Alpha Over a plain premultiplied 'over' (our image is
     premultiplied already)."""
+    from . import id_writes  # here: on an unsupported Blender only this module loads
     straight = node.inputs.get("Straight Alpha")
     if straight is not None:
-        straight.default_value = False
+        id_writes.assign(straight, "default_value", False)
     if hasattr(node, "use_premultiply"):  # up to 4.5
-        node.use_premultiply = False
-        node.premul = 0.0
+        id_writes.assign(node, "use_premultiply", False)
+        id_writes.assign(node, "premul", 0.0)
 
 
 def mix_color_node(tree, blend_type):

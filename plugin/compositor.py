@@ -33,7 +33,7 @@ compat.py hides both.
 import bpy
 import numpy as np
 
-from . import compat
+from . import compat, id_writes
 from .core import shadow_plan
 
 IMAGE_NAME = "Voxlight Render"
@@ -48,7 +48,7 @@ PASSES = (PASS_COLOR, PASS_ALPHA, PASS_DEPTH)
 NO_DEPTH = 1e10  # what Blender's own Depth pass holds where nothing is
 
 
-def ensure_image(width, height, name=IMAGE_NAME):
+def ensure_image(width, height, name=IMAGE_NAME, alpha_mode="PREMUL", is_data=None):
     """The float image `name` at width x height. A new or resized one holds
     nothing (clear_image): Blender fills new images with opaque black, which
     the Alpha Over would lay over the whole frame whenever a render writes
@@ -64,10 +64,13 @@ def ensure_image(width, height, name=IMAGE_NAME):
     if img is None:
         img = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
     # The library's colour is premultiplied; alpha and depth are data.
-    img.alpha_mode = "PREMUL"
-    if name in (PASS_ALPHA, PASS_DEPTH):
-        img.colorspace_settings.is_data = True
-    img.use_fake_user = False
+    # Written only when they differ (id_writes.py: the render thread).
+    id_writes.assign(img, "alpha_mode", alpha_mode)
+    if is_data is None:
+        is_data = name in (PASS_ALPHA, PASS_DEPTH)
+    if is_data:
+        id_writes.assign(img.colorspace_settings, "is_data", True)
+    id_writes.assign(img, "use_fake_user", False)
     if fresh:
         clear_image(img)
     return img
@@ -132,8 +135,7 @@ def _route_through(tree, over):
 def ensure_nodes(scene, image):
     """Idempotent: builds the nodes on first use, then re-points them and
     routes new links from Render Layers' Image through the Alpha Over."""
-    if scene.render.use_compositing is False:
-        scene.render.use_compositing = True
+    id_writes.assign(scene.render, "use_compositing", True)
     tree = compat.compositor_tree(scene)
     over = tree.nodes.get(NODE_OVER)
     if over is None:
@@ -154,7 +156,7 @@ def ensure_nodes(scene, image):
     _route_through(tree, over)
     # The image is already premultiplied: a plain premultiplied 'over'.
     compat.alpha_over_premultiplied(over)
-    over.mute = False
+    id_writes.assign(over, "mute", False)
     return tree
 
 
@@ -226,7 +228,7 @@ def mute(scene):
     if tree is not None:
         over = tree.nodes.get(NODE_OVER)
         if over is not None:
-            over.mute = True
+            id_writes.assign(over, "mute", True)
 
 
 # ------------------------------------------------- the volume's shadows
@@ -269,17 +271,59 @@ def _pass_socket(rl, source):
     return None
 
 
+def _source_socket(rl, origin, built, source):
+    """The output socket a chain input `source` reads: the chain's origin,
+    a Render Layers pass, or an earlier node of the chain (in `built`)."""
+    if source[0] == "origin":
+        return origin
+    if source[0] == "pass":
+        return _pass_socket(rl, source)
+    node = built.get(source[1])
+    if node is None:
+        return None
+    return node.outputs[0] if node.type == "IMAGE" else compat.mix_sockets(node)[2]
+
+
+def _chain_matches(tree, nodes, rl, origin, background):
+    """Whether the tree already holds exactly the chain of plan `nodes`:
+    the same nodes, images and links, its end feeding `background`. Then
+    nothing is rebuilt (so a render on a ready scene writes no node)."""
+    present = {n.name: n for n in tree.nodes if _is_shadow_node(n)}
+    if set(present) != {spec.name for spec in nodes}:
+        return False
+    for spec in nodes:
+        node = present[spec.name]
+        if spec.kind == "image":
+            if node.type != "IMAGE" or node.image is None or node.image.name != spec.inputs[0]:
+                return False
+            continue
+        if node.type == "IMAGE":
+            return False
+        for sock, source in zip(compat.mix_sockets(node)[:2], spec.inputs):
+            want = _source_socket(rl, origin, present, source)
+            if want is None or not sock.is_linked or sock.links[0].from_socket != want:
+                return False
+    end = compat.mix_sockets(present[shadow_plan.NODE_OUT])[2]
+    return background.is_linked and background.links[0].from_socket == end
+
+
 def ensure_shadow_chain(scene, nodes):
     """Build the chain of plan `nodes` (shadow_plan.node_plan) between what
     feeds the Alpha Over's background (Render Layers' Image) and it,
-    replacing an older chain. Returns "" when built, else why not (the
-    chain is then gone and the render untouched)."""
+    replacing an older chain unless it is already this one. Returns ""
+    when built, else why not (the chain is then gone and the render
+    untouched)."""
     tree = compat.compositor_tree(scene)
-    remove_shadow_chain(scene)
     over = tree.nodes.get(NODE_OVER)
     if over is None or not nodes:
+        remove_shadow_chain(scene)
         return "no Voxlight nodes in the compositor" if over is None else ""
     background, _foreground = compat.alpha_over_sockets(over)
+    origin = _chain_origin(background)
+    if origin is not None and origin.node.bl_idname == "CompositorNodeRLayers" \
+            and _chain_matches(tree, nodes, origin.node, origin, background):
+        return ""
+    remove_shadow_chain(scene)
     origin = _chain_origin(background)
     if origin is None or origin.node.bl_idname != "CompositorNodeRLayers":
         return "the Alpha Over's background is not fed by Render Layers"
@@ -304,13 +348,7 @@ def ensure_shadow_chain(scene, nodes):
         if spec.kind == "image":
             continue
         for sock, source in zip(compat.mix_sockets(node)[:2], spec.inputs):
-            if source[0] == "origin":
-                out = origin
-            elif source[0] == "pass":
-                out = _pass_socket(rl, source)
-            else:
-                out = built[source[1]].outputs[0] if built[source[1]].type == "IMAGE" \
-                    else compat.mix_sockets(built[source[1]])[2]
+            out = _source_socket(rl, origin, built, source)
             if out is None:
                 remove_shadow_chain(scene)
                 return "Render Layers has no %s output" % source[1]
@@ -335,12 +373,15 @@ def remove_shadow_chain(scene):
             tree.links.new(origin, to)
 
 
+def ensure_shadow_image(name, width, height):
+    """Image `name` for a shadow: grey data, alpha unused."""
+    return ensure_image(width, height, name, alpha_mode="STRAIGHT", is_data=True)
+
+
 def write_shadow_image(name, width, height, shadow):
     """Image `name` (grey, data) holding `shadow` = 1 - transmittance,
     (height, width) float32 row 0 = bottom, or 0 everywhere when None."""
-    img = ensure_image(width, height, name)
-    img.alpha_mode = "STRAIGHT"
-    img.colorspace_settings.is_data = True
+    img = ensure_shadow_image(name, width, height)
     s = np.zeros((height, width), np.float32) if shadow is None else np.asarray(shadow, np.float32)
     one = np.ones_like(s)
     img.pixels.foreach_set(np.ascontiguousarray(np.stack([s, s, s, one], -1), np.float32).ravel())

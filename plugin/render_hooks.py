@@ -11,14 +11,10 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import compositor, offline, scene_shadows
+from . import compositor, id_writes, offline, render_setup, scene_shadows
 from .core import native
 
 last_error = ""
-
-
-def _volumes_present(scene):
-    return any(o.voxlight.is_volume and not o.hide_render for o in scene.objects)
 
 
 def display_to_linear(rgba):
@@ -38,20 +34,21 @@ def display_to_linear(rgba):
 _pending = False  # a render job is between render_pre and its compositing
 
 
-def _prepare_nodes(scene):
-    """Before the frame is evaluated: the nodes, and images that hold
-    nothing, so a frame that writes no pixels (hidden, empty, out of view,
-    failed) leaves the render exactly as it is, and nothing of the previous
-    frame shows."""
-    w, h = offline.render_size(scene)
-    if scene.voxlight.render_separate_layer:
-        compositor.ensure_pass_nodes(scene, w, h)
-    else:
-        compositor.ensure_nodes(scene, compositor.ensure_image(w, h))
-    compositor.clear_passes(scene)
-    # The volume's shadows on the scene: light groups and the chain before
-    # the Alpha Over (issue 18, scene_shadows.py).
-    scene_shadows.prepare_render(scene, w, h)
+def _prepare(scene, clear):
+    """render_setup.prepare on this (often the render job's) thread, retried
+    while Blender refuses writes (id_writes.py). False, with last_error
+    set, when it cannot: the render then stays as the engine made it."""
+    global last_error
+    try:
+        id_writes.retrying(render_setup.prepare, scene, clear)
+        return True
+    except AttributeError as e:
+        if not id_writes.refused(e):
+            raise
+        last_error = "Blender refused to set up the compositor for the volume: %s" % e
+        print("Voxlight: render failed: %s" % last_error)
+        _show_nothing(scene)
+        return False
 
 
 def _show_nothing(scene, shadows=False):
@@ -66,22 +63,23 @@ def _show_nothing(scene, shadows=False):
 @persistent
 def on_render_init(scene, *args):
     """Nodes must exist before the pipeline decides whether to composite."""
-    if scene.voxlight.render_enabled and _volumes_present(scene) and scene.camera:
-        _prepare_nodes(scene)
+    if render_setup.wanted(scene):
+        _prepare(scene, clear=False)
 
 
 @persistent
 def on_render_pre(scene, *args):
+    """Before the frame is evaluated: the nodes ready (render_setup.py),
+    and images that hold nothing, so a frame that writes no pixels (hidden,
+    empty, out of view, failed) leaves the render exactly as it is, and
+    nothing of the previous frame shows."""
     global _pending
-    s = scene.voxlight
-    if not s.render_enabled or not _volumes_present(scene) or scene.camera is None:
+    _pending = False
+    if not render_setup.wanted(scene):
         _show_nothing(scene)
-        compositor.mute(scene)  # before the frame is evaluated: it takes part
-        scene_shadows.revert(scene)
-        _pending = False
+        _prepare(scene, clear=True)  # mutes the Alpha Over before the frame is evaluated
         return
-    _prepare_nodes(scene)
-    _pending = True
+    _pending = _prepare(scene, clear=True)
 
 
 @persistent
@@ -91,10 +89,17 @@ def on_frame_change_post(scene, depsgraph=None, *args):
     rendered (render visibility, animation at that frame) and announces it
     through frame_change_post. The view-layer depsgraph that render_pre
     could use lags one frame behind in animation renders."""
-    global _pending, last_error
+    global _pending
     if not _pending or depsgraph is None or depsgraph.mode != "RENDER":
         return
     _pending = False
+    render_frame(scene, depsgraph)
+
+
+def render_frame(scene, depsgraph):
+    """Render the volumes of `depsgraph`'s frame into the images that
+    on_render_pre prepared. Writes pixels only (see compositor.py)."""
+    global last_error
     s = scene.voxlight
     w, h = offline.render_size(scene)
     camera = scene.camera

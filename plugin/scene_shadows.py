@@ -17,13 +17,12 @@ revert() when no volume casts shadows any more.
 
 import functools
 import hashlib
-import threading
 
 import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import compositor
+from . import compositor, id_writes
 from .core import facing, light_shares
 from .core import lights as _lights
 from .core import native, scene_geometry, shadow_plan
@@ -194,6 +193,11 @@ def revert(scene):
     light groups the add-on gave lights (unless the user changed them since)
     and made, and passes an earlier version turned on."""
     compositor.remove_shadow_chain(scene)
+    _revert_lights(scene)
+
+
+def _revert_lights(scene):
+    """revert() but for the compositor chain: the light groups and passes."""
     lights = [shadow_plan.Light(o.name, getattr(o, "lightgroup", ""),
                                 str(o.get(shadow_plan.ASSIGNED_PROP, "")))
               for o in scene.objects if o.type == "LIGHT"]
@@ -229,7 +233,7 @@ def _remove_lightgroup(scene, view_layer, name):
     if hasattr(groups, "remove"):
         groups.remove(g)
         return
-    if threading.current_thread() is not threading.main_thread():
+    if not id_writes.on_main_thread():
         bpy.app.timers.register(functools.partial(_remove_lightgroup_later, scene.name, view_layer.name, name),
                                 first_interval=0.0)
         return
@@ -256,10 +260,11 @@ def _remove_lightgroup_later(scene_name, layer_name, name):
 _plan = {}  # scene name -> (mode, {group: [light names]}) of the render being made
 
 
-def prepare_render(scene, width, height):
-    """render_init / render_pre: light groups (or passes), shadow images
-    cleared to no shadow, and the compositor chain, when a volume casts
-    shadows; otherwise revert(). Sets `note` for the fallback."""
+def prepare_render(scene, width, height, clear=True):
+    """Light groups (or passes), the shadow images (cleared to no shadow
+    when `clear`: the start of a frame) and the compositor chain, when a
+    volume casts shadows; otherwise revert(). Writes only what differs
+    (render_setup.py). Sets `note` for the fallback."""
     global note
     note = ""
     _plan.pop(scene.name, None)
@@ -278,23 +283,27 @@ def prepare_render(scene, width, height):
             vl.lightgroups.add(name=g)
         for name, g in plan.assign.items():
             ob = scene.objects[name]
-            ob.lightgroup = g
-            ob[shadow_plan.ASSIGNED_PROP] = g
+            id_writes.assign(ob, "lightgroup", g)
+            if ob.get(shadow_plan.ASSIGNED_PROP) != g:
+                ob[shadow_plan.ASSIGNED_PROP] = g
         groups = plan.groups
         images = [shadow_plan.image_name(g) for g in groups]
     else:
-        revert(scene)
+        _revert_lights(scene)  # the chain stays: ensure_shadow_chain keeps it if it is this plan's
         groups = {}
         images = [shadow_plan.KEY_IMAGE]
         note = why
     for name in images:
-        compositor.write_shadow_image(name, width, height, None)
+        if clear:
+            compositor.write_shadow_image(name, width, height, None)
+        else:
+            compositor.ensure_shadow_image(name, width, height)
     problem = compositor.ensure_shadow_chain(scene, shadow_plan.node_plan(mode, list(groups)))
     if problem:
         note = "No volume shadows in the render: " + problem
         return
     _plan[scene.name] = (mode, groups)
-    if note:
+    if note and clear:  # once per frame, not on every set-up ahead of one
         print("Voxlight: %s" % note)
 
 

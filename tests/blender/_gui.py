@@ -45,6 +45,29 @@ def front_view(space):
     return r3d
 
 
+def write(fn, tries=100):
+    """A generator step: fn() (it writes Blender data), again on later ticks
+    while Blender refuses the write. Blender's "writes refused" flag is one
+    for the process, saved and restored around each Python panel draw and
+    around Cycles' engine being made on the render thread; when the two
+    overlap, the flag stays set on the main thread until the next panel
+    draw ends (seen once in CI, right after an F12 with Cycles). A user's
+    script meets the same; the add-on's own code is tested for it in
+    test_gui_render_writes."""
+    for _ in range(tries):
+        try:
+            fn()
+            return
+        except AttributeError as e:
+            if "not allowed" not in str(e):
+                raise
+        for win in bpy.context.window_manager.windows:
+            for area in win.screen.areas:
+                area.tag_redraw()
+        yield 0.1
+    fn()
+
+
 class Run:
     def __init__(self, name, limit_s):
         self.name = name

@@ -29,6 +29,18 @@ HANG_S = 560  # under the runner's 600 s per script; each of the 12 renders take
 faulthandler.dump_traceback_later(HANG_S, exit=True)
 RUN = _gui.Run("test_gui_f12", limit_s=HANG_S)
 check = RUN.check
+
+# Blender prints a handler's exception through sys.excepthook: keep them,
+# so one raised on the render thread fails the test (it only printed before).
+_raised = []
+
+
+def _keep(kind, value, tb):
+    _raised.append("%s: %s" % (kind.__name__, value))
+    sys.__excepthook__(kind, value, tb)
+
+
+sys.excepthook = _keep
 EEVEE = "BLENDER_EEVEE_NEXT" if (4, 2, 0) <= bpy.app.version < (5, 0, 0) else "BLENDER_EEVEE"
 
 
@@ -56,10 +68,12 @@ def steps():
     for engine in (EEVEE, "CYCLES", "BLENDER_WORKBENCH"):
         for shadows in (True, False):
             for kind in ("PERSP", "ORTHO"):
-                scene.render.engine = engine
-                ob.voxlight.cast_shadows = shadows
-                cam.data.type = kind
-                cam.data.ortho_scale = 4.0
+                def set_up():
+                    scene.render.engine = engine
+                    ob.voxlight.cast_shadows = shadows
+                    cam.data.type = kind
+                    cam.data.ortho_scale = 4.0
+                yield from _gui.write(set_up)
                 name = "%s_%s_%s" % (engine.lower().replace("blender_", ""), kind.lower(),
                                      "shadows" if shadows else "no_shadows")
                 del done[:]
@@ -70,7 +84,9 @@ def steps():
                 while (not done or bpy.app.is_job_running("RENDER")) and time.time() - t < HANG_S / 12:
                     yield 0.25
                 check("f12_%s_finishes" % name, done, "%.1f s" % (time.time() - t))
-                check("f12_%s_no_error" % name, not vx.render_hooks.last_error, vx.render_hooks.last_error)
+                check("f12_%s_no_error" % name, not vx.render_hooks.last_error and not _raised,
+                      vx.render_hooks.last_error or "; ".join(_raised))
+                del _raised[:]
                 yield 0.5
 
 

@@ -5,6 +5,15 @@ SAN ?= 0
 
 CC ?= cc
 CXX ?= g++
+# The library's C (its objects, libvoxlight.so, the CLI) is compiled by
+# LIB_CC: build.sh names zig's clang targeting glibc 2.28, the oldest glibc
+# official Blender runs on (a compiler of this Debian links its own newer
+# glibc's symbol versions); tests, helpers and benchmarks use CC. Without
+# LIB_CC on the command line a build folder keeps the compiler it was last
+# built with (its stamp below), so a later `make build/tests/x` matches.
+ifeq ($(origin LIB_CC),undefined)
+LIB_CC := $(or $(shell cat $(BUILD)/obj/lib_cc.txt 2>/dev/null),$(CC))
+endif
 WARN := -Wall -Wextra -Werror
 OPT := -O2 -g
 ifeq ($(SAN),1)
@@ -42,14 +51,14 @@ CLI_C := $(wildcard csrc/cli/*.c)
 # needs one (zarr_codecs.c), never linked, so neither links them.
 ZARR_C := csrc/io/json.c csrc/io/zarr_store.c csrc/io/zarr_chunk.c csrc/io/zarr_read.c csrc/io/zarr_codecs.c
 LIB_C := $(filter-out $(CLI_C) $(HELPER_C),$(wildcard csrc/*/*.c))
-LIBS := -ldl -lpthread -lz -lm
+LIBS := -ldl -lpthread -lm
 # shaders/lib: included code; compute/: compute programs; render/: the ray
 # caster's stages. A shader's name is its path under shaders/ (csrc/gl/shader_source.h).
 SHADERS := $(wildcard shaders/lib/*.glsl shaders/compute/*.comp shaders/render/*.vert shaders/render/*.frag)
 OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_embedded.o
 # What the helpers' readers use of the core (volume building, errors, file
 # helpers), linked into each helper, which needs no libvoxlight.so.
-HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume brick_source error loader_util)
+HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume brick_source error loader_util zlib_api dynlib_posix)
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
@@ -60,8 +69,15 @@ TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
 all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(BUILD)/voxlight-sceneshadowbench $(STUDIES) $(TESTS)
 
-$(BUILD)/obj/%.o: %.c $(wildcard csrc/*/*.h) | $(BUILD)/obj
-	$(CC) $(CFLAGS) -c $< -o $@
+# Objects are rebuilt when LIB_CC changes (the stamp holds the last one).
+LIB_CC_STAMP := $(BUILD)/obj/lib_cc.txt
+$(LIB_CC_STAMP): FORCE | $(BUILD)/obj
+	@echo '$(LIB_CC)' | cmp -s - $@ || echo '$(LIB_CC)' > $@
+FORCE:
+.PHONY: FORCE
+
+$(BUILD)/obj/%.o: %.c $(wildcard csrc/*/*.h) $(LIB_CC_STAMP) | $(BUILD)/obj
+	$(LIB_CC) $(CFLAGS) -c $< -o $@
 
 $(BUILD)/obj/%.o: %.cpp $(wildcard csrc/*/*.h) | $(BUILD)/obj
 	$(CXX) $(CXXFLAGS) -c $< -o $@
@@ -73,11 +89,11 @@ $(BUILD)/embed_files: tools/embed_files.c | $(BUILD)/obj
 $(BUILD)/gen/shaders_embedded.c: $(BUILD)/embed_files $(SHADERS) | $(BUILD)/gen
 	$(BUILD)/embed_files $@ shaders $(SHADERS)
 
-$(BUILD)/obj/shaders_embedded.o: $(BUILD)/gen/shaders_embedded.c
-	$(CC) $(CFLAGS) -c $< -o $@
+$(BUILD)/obj/shaders_embedded.o: $(BUILD)/gen/shaders_embedded.c $(LIB_CC_STAMP)
+	$(LIB_CC) $(CFLAGS) -c $< -o $@
 
 $(BUILD)/libvoxlight.so: $(OBJ)
-	$(CC) -shared $(OPT) -Wl,-soname,libvoxlight.so -Wl,--no-undefined -o $@ $^ $(LIBS)
+	$(LIB_CC) -shared $(OPT) -Wl,-soname,libvoxlight.so -Wl,--no-undefined -o $@ $^ $(LIBS)
 
 # Which library file and Debian package each helper needs, for the message a
 # user gets when one is missing (csrc/io/remote_readers.c): the SONAME of the
@@ -97,8 +113,11 @@ $(BUILD)/libvoxlight.so: $(OBJ)
 
 $(BUILD)/obj/remote_readers.o: $(BUILD)/gen/reader_packages.h
 
-$(BUILD)/voxlight: $(CLI_C) $(wildcard csrc/cli/*.h) $(BUILD)/libvoxlight.so
-	$(CC) $(CFLAGS) $(CLI_C) -o $@ -L$(BUILD) -lvoxlight -lz -lm -Wl,-rpath,'$$ORIGIN'
+# The CLI links zlib (for its MatCap PNG) from the system's library
+# folder: LIB_CC may be zig's, which searches only its own.
+SYSTEM_LIBDIR := $(shell $(CC) -print-multiarch 2>/dev/null | sed 's|^|/usr/lib/|')
+$(BUILD)/voxlight: $(CLI_C) $(wildcard csrc/cli/*.h) $(BUILD)/libvoxlight.so $(LIB_CC_STAMP)
+	$(LIB_CC) $(CFLAGS) $(CLI_C) -o $@ -L$(BUILD) -lvoxlight -L$(SYSTEM_LIBDIR) -lz -lm -Wl,-rpath,'$$ORIGIN'
 
 # The reader helpers (csrc/io/reader_stream.h): the C++ readers, the core
 # objects they use and their library; started by libvoxlight.so.
@@ -155,16 +174,21 @@ $(BUILD)/voxlight-sceneshadowbench: bench/scene_shadow_study.c bench/bench_util.
 # test_brick_cache calls the cache's internals (csrc/io/brick_cache.h), so it
 # links their objects and those its checks compare against, as well as the library.
 BRICK_CACHE_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,brick_cache brick_cache_read brick_cache_write \
-	brick_cache_format brick_source brick_levels bricks volume error paging lod brick_loader loader_util)
+	brick_cache_format brick_source brick_levels bricks volume error paging lod brick_loader loader_util zlib_api \
+	dynlib_posix crc32)
 $(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wildcard tests/*.h) $(BRICK_CACHE_TEST_OBJ) \
 		$(BUILD)/libvoxlight.so | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(BRICK_CACHE_TEST_OBJ) -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
 
 # test_gl_thread checks the GL thread's shared lock (internal), so it links
 # the thread and context objects; the backends come with context.o.
-GL_THREAD_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gl_thread context backend_osmesa backend_egl error)
+GL_THREAD_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gl_thread context backend_osmesa backend_egl error dynlib_posix)
 $(BUILD)/tests/test_gl_thread: tests/test_gl_thread.c tests/harness.h $(GL_THREAD_TEST_OBJ) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(GL_THREAD_TEST_OBJ) -o $@ -ldl -lpthread
+
+# test_crc32 checks the library's internal CRC-32 against zlib's values.
+$(BUILD)/tests/test_crc32: tests/test_crc32.c tests/harness.h $(BUILD)/obj/crc32.o | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(BUILD)/obj/crc32.o -o $@
 
 $(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h tests/fuzz/*.h) $(BUILD)/libvoxlight.so | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
@@ -188,7 +212,7 @@ FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_u
 # the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
-	brick_levels.c raw_source.c stream_load.c tiff_layout.c)
+	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c dynlib_posix.c crc32.c)
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))

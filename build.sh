@@ -100,8 +100,30 @@ install_deps() {
     echo "build.sh: Debian packages: clang runtime $rt, VTK $vtk, OSMesa $osmesa"
 }
 
+# The library and CLI are compiled for glibc 2.28, the oldest glibc official
+# Blender builds run on: Debian's compilers link this system's glibc, whose
+# newer symbol versions (pthread_create@GLIBC_2.34 ...) stop the library
+# loading there. zig's clang, from the package index, carries glibc 2.28's
+# symbol lists; the system's headers come after its own (zlib.h, GL).
+ZIG_VERSION=0.17.1
+portable_cc() {
+    local dir=build/zig py
+    if ! "$dir/bin/python" -m ziglang version 2>/dev/null | grep -qx "$ZIG_VERSION"; then
+        py=$(find_python 3.11 || find_python 3.13 || find_python "$(python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])')") || return 1
+        rm -rf "$dir"
+        "$py" -m venv "$dir" >&2 && "$dir/bin/python" -m pip install -q --disable-pip-version-check "ziglang==$ZIG_VERSION" >&2 || return 1
+    fi
+    echo "$ROOT/$dir/bin/python -m ziglang cc -target x86_64-linux-gnu.2.28 -mcpu=x86_64 -idirafter /usr/include -idirafter /usr/include/$(cc -print-multiarch)"
+}
+
 build() {
-    make -s -j"$(nproc)" BUILD=build
+    local lib_cc
+    if ! lib_cc=$(portable_cc); then
+        # still a working build for this machine; tests/cli/test_library_deps.py then fails
+        echo "build.sh: zig (pip's ziglang $ZIG_VERSION) is unavailable: the library is built for this glibc only" >&2
+        lib_cc=cc
+    fi
+    make -s -j"$(nproc)" BUILD=build LIB_CC="$lib_cc"
     if [ -x tools/package_addon.sh ]; then tools/package_addon.sh build; fi
 }
 

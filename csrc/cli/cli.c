@@ -415,7 +415,7 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (enum_option("preset", val, vxl_preset_name, vxl_preset_from_name, &p->preset)) return 1;
         } else if (!strcmp(o, "--window")) {
             NEED_VALUE();
-            char *colon = strchr(val, ':');
+            const char *colon = strchr(val, ':');
             char lo[64];
             if (!colon || colon - val >= (long)sizeof lo) return die("bad --window '%s': use LO:HI", val);
             memcpy(lo, val, (size_t)(colon - val));

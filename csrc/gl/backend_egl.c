@@ -1,7 +1,6 @@
 /* backend_egl.c - EGL with no surface: EGL_EXT_platform_device on a GPU, or
  * EGL_MESA_platform_surfaceless on Mesa. Loaded with dlopen; every EGL entry
  * point comes from libEGL's own eglGetProcAddress/dlsym. */
-#include <dlfcn.h>
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <string.h>
@@ -24,10 +23,10 @@ typedef struct egl_api {
     PFNEGLGETPLATFORMDISPLAYEXTPROC GetPlatformDisplayEXT;
 } egl_api;
 
-static int load_api(void *lib, egl_api *a)
+static int load_api(vxl_dynlib *lib, egl_api *a)
 {
     memset(a, 0, sizeof *a);
-    a->GetProcAddress = (PFNEGLGETPROCADDRESSPROC)dlsym(lib, "eglGetProcAddress");
+    a->GetProcAddress = (PFNEGLGETPROCADDRESSPROC)vxl_dynlib_symbol(lib, "eglGetProcAddress");
     if (!a->GetProcAddress) return 0;
 #define EGL_GET(name) a->name = (__typeof__(a->name))a->GetProcAddress("egl" #name)
     EGL_GET(QueryString); EGL_GET(Initialize); EGL_GET(BindAPI); EGL_GET(ChooseConfig);
@@ -94,7 +93,7 @@ static int open_gpu_device(const egl_api *a, EGLDisplay *dpy, EGLContext *ctx)
 
 static vxl_ctx_proc egl_get_proc(vxl_context *c, const char *name)
 {
-    PFNEGLGETPROCADDRESSPROC gp = (PFNEGLGETPROCADDRESSPROC)dlsym(c->lib, "eglGetProcAddress");
+    PFNEGLGETPROCADDRESSPROC gp = (PFNEGLGETPROCADDRESSPROC)vxl_dynlib_symbol(c->lib, "eglGetProcAddress");
     return gp ? (vxl_ctx_proc)gp(name) : NULL;
 }
 
@@ -111,7 +110,7 @@ static void egl_close(vxl_context *c)
 
 int vxl_egl_open(vxl_context *c, int egl_mode, vxl_err *e)
 {
-    c->lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_LOCAL);
+    c->lib = vxl_dynlib_open("libEGL.so.1", NULL, 0);
     if (!c->lib) return vxl_fail(e, VXL_ERR_BACKEND, "egl: cannot load libEGL.so.1");
     egl_api a;
     if (!load_api(c->lib, &a))

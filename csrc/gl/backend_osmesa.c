@@ -1,6 +1,5 @@
 /* backend_osmesa.c - Mesa's OSMesa (llvmpipe), loaded with dlopen so that the
  * library works where OSMesa is absent and never drags a GL into the host. */
-#include <dlfcn.h>
 #include <GL/glcorearb.h>
 #include <string.h>
 
@@ -30,15 +29,15 @@ typedef OSMESAproc (*get_proc_fn)(const char *);
 
 static vxl_ctx_proc osmesa_get_proc(vxl_context *c, const char *name)
 {
-    get_proc_fn gp = (get_proc_fn)dlsym(c->lib, "OSMesaGetProcAddress");
+    get_proc_fn gp = (get_proc_fn)vxl_dynlib_symbol(c->lib, "OSMesaGetProcAddress");
     return gp ? (vxl_ctx_proc)gp(name) : NULL;
 }
 
 static void osmesa_close(vxl_context *c)
 {
     if (c->handle_a) {
-        make_current_fn mc = (make_current_fn)dlsym(c->lib, "OSMesaMakeCurrent");
-        destroy_fn d = (destroy_fn)dlsym(c->lib, "OSMesaDestroyContext");
+        make_current_fn mc = (make_current_fn)vxl_dynlib_symbol(c->lib, "OSMesaMakeCurrent");
+        destroy_fn d = (destroy_fn)vxl_dynlib_symbol(c->lib, "OSMesaDestroyContext");
         if (mc) mc(NULL, NULL, 0, 0, 0);
         if (d) d((OSMesaContext)c->handle_a);
     }
@@ -48,11 +47,11 @@ static void osmesa_close(vxl_context *c)
 
 int vxl_osmesa_open(vxl_context *c, vxl_err *e)
 {
-    c->lib = dlopen("libOSMesa.so.8", RTLD_NOW | RTLD_LOCAL);
-    if (!c->lib) c->lib = dlopen("libOSMesa.so", RTLD_NOW | RTLD_LOCAL);
+    c->lib = vxl_dynlib_open("libOSMesa.so.8", NULL, 0);
+    if (!c->lib) c->lib = vxl_dynlib_open("libOSMesa.so", NULL, 0);
     if (!c->lib) return vxl_fail(e, VXL_ERR_BACKEND, "osmesa: cannot load libOSMesa.so.8 (install libosmesa6)");
-    create_fn create = (create_fn)dlsym(c->lib, "OSMesaCreateContextAttribs");
-    make_current_fn mc = (make_current_fn)dlsym(c->lib, "OSMesaMakeCurrent");
+    create_fn create = (create_fn)vxl_dynlib_symbol(c->lib, "OSMesaCreateContextAttribs");
+    make_current_fn mc = (make_current_fn)vxl_dynlib_symbol(c->lib, "OSMesaMakeCurrent");
     if (!create || !mc) return vxl_fail(e, VXL_ERR_BACKEND, "osmesa: libOSMesa lacks OSMesaCreateContextAttribs");
     const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_STENCIL_BITS, 0,
                            OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_CORE_PROFILE,

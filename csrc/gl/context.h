@@ -1,5 +1,5 @@
 /* context.h - an offscreen OpenGL 4.5 core context from a backend opened
- * with dlopen at run time (OSMesa or surfaceless EGL). All calls here must
+ * at run time (OSMesa or surfaceless EGL, platform/dynlib.h). All calls here must
  * happen on the renderer's GL thread. */
 #ifndef VXL_CONTEXT_H
 #define VXL_CONTEXT_H
@@ -7,6 +7,7 @@
 #include <pthread.h>
 #include <stdint.h>
 
+#include "dynlib.h"
 #include "error.h"
 
 typedef void (*vxl_ctx_proc)(void);
@@ -14,7 +15,7 @@ typedef void (*vxl_ctx_proc)(void);
 typedef struct vxl_context {
     uint32_t backend;          /* VXL_BACKEND_OSMESA or VXL_BACKEND_EGL */
     char name[32];             /* "osmesa", "egl-device", "egl-surfaceless" */
-    void *lib;                 /* dlopen handle */
+    vxl_dynlib *lib;           /* the backend's library, kept loaded */
     vxl_ctx_proc (*get_proc)(struct vxl_context *c, const char *name);
     void (*close)(struct vxl_context *c);
     /* backend-private */

@@ -15,11 +15,12 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include "brick_cache.h"
 #include "brick_cache_format.h"
+#include "crc32.h"
 #include "loader_util.h"
+#include "zlib_api.h"
 
 #define LRU_SLOTS 64
 #define TABLE_CHUNK 4096 /* entries read at a time */
@@ -74,7 +75,7 @@ static int load_index(cache_ctx *c, float **out, vxl_err *e)
         free(ix);
         return damaged(c->path, e, "its index cannot be read");
     }
-    if ((uint32_t)crc32(crc32(0L, Z_NULL, 0), (const Bytef *)ix, (uInt)c->h.index_bytes) != c->h.index_crc) {
+    if (vxl_crc32(0, ix, (size_t)c->h.index_bytes) != c->h.index_crc) {
         free(ix);
         return damaged(c->path, e, "its index fails its checksum");
     }
@@ -98,7 +99,7 @@ static int load_table(cache_ctx *c, vxl_err *e)
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the brick table of %s", c->path);
     }
     const uint64_t data_end = c->h.index_offset < c->h.table_offset ? c->h.index_offset : c->h.table_offset;
-    uLong crc = crc32(0L, Z_NULL, 0);
+    uint32_t crc = 0;
     int rc = VXL_OK;
     uint32_t level = 0;
     for (uint64_t i0 = 0; !rc && i0 < n; i0 += TABLE_CHUNK) {
@@ -107,7 +108,7 @@ static int load_table(cache_ctx *c, vxl_err *e)
             rc = damaged(c->path, e, "its brick table cannot be read");
             break;
         }
-        crc = crc32(crc, buf, (uInt)(k * VXL_CACHE_ENTRY_BYTES));
+        crc = vxl_crc32(crc, buf, k * VXL_CACHE_ENTRY_BYTES);
         for (size_t j = 0; j < k; j++) {
             const uint64_t i = i0 + j;
             while (i >= c->g.first[level + 1]) level++;
@@ -120,7 +121,7 @@ static int load_table(cache_ctx *c, vxl_err *e)
         }
     }
     free(buf);
-    if (!rc && (uint32_t)crc != c->h.table_crc) rc = damaged(c->path, e, "its brick table fails its checksum");
+    if (!rc && crc != c->h.table_crc) rc = damaged(c->path, e, "its brick table fails its checksum");
     return rc;
 }
 
@@ -186,7 +187,7 @@ static int load_brick(vxl_brick_source *s, uint32_t L, uint64_t i, uint8_t *dst,
     if (pread_all(c->fd, stored, en->size, en->offset) != 0)
         rc = vxl_fail(e, VXL_ERR_IO, "cannot read brick %llu of the brick cache %s: %s", (unsigned long long)id,
                       c->path, errno ? strerror(errno) : "the file is shorter than its table says");
-    else if ((uint32_t)crc32(crc32(0L, Z_NULL, 0), stored, en->size) != en->crc) {
+    else if (vxl_crc32(0, stored, en->size) != en->crc) {
         unlink(c->path); /* never trusted again: the next open rebuilds it */
         rc = vxl_fail(e, VXL_ERR_FORMAT,
                       "brick cache %s is damaged (brick %llu of level %u fails its checksum); it was removed and the "
@@ -197,9 +198,12 @@ static int load_brick(vxl_brick_source *s, uint32_t L, uint64_t i, uint8_t *dst,
     if (!rc && en->kind == VXL_CACHE_CONSTANT) {
         for (uint64_t k = 0; k < bytes; k += c->g.texel_bytes) memcpy(dst + k, stored, c->g.texel_bytes);
     } else if (!rc && en->kind == VXL_CACHE_ZLIB) {
+        const vxl_zlib *zl = vxl_zlib_api(e);
         uLongf n = (uLongf)bytes;
-        int z = uncompress(dst, &n, stored, en->size);
-        if (z == Z_BUF_ERROR || (z == Z_OK && n != bytes))
+        int z = zl ? zl->uncompress(dst, &n, stored, en->size) : Z_OK;
+        if (!zl)
+            rc = VXL_ERR_IO;
+        else if (z == Z_BUF_ERROR || (z == Z_OK && n != bytes))
             rc = vxl_fail(e, VXL_ERR_FORMAT, "brick cache %s: brick %llu of level %u decompresses to %s its %llu bytes",
                           c->path, (unsigned long long)i, L, z == Z_OK ? "less than" : "more than",
                           (unsigned long long)bytes);

@@ -29,7 +29,8 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
+#include "crc32.h"
+#include "zlib_api.h"
 
 #include "brick_cache.h"
 #include "brick_cache_format.h"
@@ -50,6 +51,7 @@ typedef struct writer {
     const vxl_raw_layout *l;
     const vxl_load_options *opt;
     vxl_err *e;
+    const vxl_zlib *zl;
     vxl_cache_grid g;
     vxl_cache_header h;
     uint32_t tb;          /* texel bytes */
@@ -90,6 +92,7 @@ static int report(writer *w, double done)
 #define IN_CHUNK (1u << 18)
 
 typedef struct zsrc {
+    const vxl_zlib *zl;
     FILE *f;
     z_stream z;
     int started, ended; /* ended: the last inflate ended a member */
@@ -98,7 +101,7 @@ typedef struct zsrc {
 
 static void close_source(zsrc *s)
 {
-    if (s->started) inflateEnd(&s->z);
+    if (s->started) s->zl->inflateEnd(&s->z);
     if (s->f) fclose(s->f);
     free(s->in);
     memset(s, 0, sizeof *s);
@@ -125,14 +128,14 @@ static int inflate_bytes(writer *w, zsrc *s, uint8_t *dst, uint64_t n, uint32_t 
             s->z.avail_in = (uInt)r;
         }
         if (s->ended) { /* another member follows */
-            if (inflateReset(&s->z) != Z_OK) return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "%s: zlib reset failed", w->l->path);
+            if (s->zl->inflateReset(&s->z) != Z_OK) return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "%s: zlib reset failed", w->l->path);
             s->ended = 0;
         }
         const uint64_t cap = dst ? (1u << 30) : sizeof skip; /* inflate counts in uInt */
         const uInt room = (uInt)(n < cap ? n : cap);
         s->z.next_out = dst ? dst : skip;
         s->z.avail_out = room;
-        const int zr = inflate(&s->z, Z_NO_FLUSH);
+        const int zr = s->zl->inflate(&s->z, Z_NO_FLUSH);
         const uInt got = room - s->z.avail_out;
         if (dst) dst += got;
         n -= got;
@@ -150,6 +153,7 @@ static int inflate_bytes(writer *w, zsrc *s, uint8_t *dst, uint64_t n, uint32_t 
 static int open_source(writer *w, zsrc *s)
 {
     memset(s, 0, sizeof *s);
+    s->zl = w->zl;
     s->f = fopen(w->l->path, "rb");
     if (!s->f) return vxl_fail(w->e, VXL_ERR_IO, "cannot open %s: %s", w->l->path, strerror(errno));
     if (!(s->in = malloc(IN_CHUNK))) {
@@ -161,7 +165,7 @@ static int open_source(writer *w, zsrc *s)
         return vxl_fail(w->e, VXL_ERR_FORMAT, "%s: no compressed data at byte %llu", w->l->path,
                         (unsigned long long)w->l->compressed_start);
     }
-    if (inflateInit2(&s->z, 15 + 32) != Z_OK) { /* zlib or gzip, auto-detected */
+    if (VXL_INFLATE_INIT2(s->zl, &s->z, 15 + 32) != Z_OK) { /* zlib or gzip, auto-detected */
         close_source(s);
         return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "%s: cannot start zlib", w->l->path);
     }
@@ -324,7 +328,7 @@ static int store_brick(writer *w, uint64_t id, size_t n)
         en->size = w->tb;
     } else {
         uLongf zlen = w->zcap;
-        if (compress2(w->zbuf, &zlen, w->brick_buf, (uLong)bytes, Z_BEST_SPEED) == Z_OK && zlen < bytes) {
+        if (w->zl->compress2(w->zbuf, &zlen, w->brick_buf, (uLong)bytes, Z_BEST_SPEED) == Z_OK && zlen < bytes) {
             en->kind = VXL_CACHE_ZLIB;
             en->size = (uint32_t)zlen;
             data = w->zbuf;
@@ -334,7 +338,7 @@ static int store_brick(writer *w, uint64_t id, size_t n)
         }
     }
     en->offset = w->pos;
-    en->crc = (uint32_t)crc32(crc32(0L, Z_NULL, 0), data, en->size);
+    en->crc = vxl_crc32(0, data, en->size);
     return write_bytes(w, data, en->size);
 }
 
@@ -452,22 +456,21 @@ static int write_pass(writer *w, size_t slice_bytes)
 static int finish(writer *w)
 {
     vxl_cache_header *h = &w->h;
-    const uLong crc0 = crc32(0L, Z_NULL, 0);
     h->index_offset = w->pos;
     h->index_bytes = w->g.index_count * 8;
-    h->index_crc = (uint32_t)crc32(crc0, (const Bytef *)w->index.minmax, (uInt)h->index_bytes);
+    h->index_crc = vxl_crc32(0, w->index.minmax, (size_t)h->index_bytes);
     int rc = write_bytes(w, w->index.minmax, h->index_bytes);
     h->table_offset = w->pos;
     h->table_bytes = h->brick_count * VXL_CACHE_ENTRY_BYTES;
-    uLong crc = crc0;
+    uint32_t crc = 0;
     for (uint64_t i = 0; !rc && i < h->brick_count; i++) {
         uint8_t en[VXL_CACHE_ENTRY_BYTES];
         vxl_cache_entry_encode(&w->table[i], en);
-        crc = crc32(crc, en, VXL_CACHE_ENTRY_BYTES);
+        crc = vxl_crc32(crc, en, VXL_CACHE_ENTRY_BYTES);
         rc = write_bytes(w, en, VXL_CACHE_ENTRY_BYTES);
     }
     if (rc) return rc;
-    h->table_crc = (uint32_t)crc;
+    h->table_crc = crc;
     uint8_t head[VXL_CACHE_HEADER_BYTES];
     vxl_cache_header_encode(h, head);
     if (fflush(w->f) != 0 || fseeko(w->f, 0, SEEK_SET) != 0) return fail_io(w, "seek");
@@ -533,7 +536,7 @@ static int allocate(writer *w)
         ok &= (w->lv[L].buf = malloc((size_t)SLAB_SLOTS(B) * w->g.dims[L][0] * w->g.dims[L][1] * w->tb)) != NULL;
     w->table = calloc((size_t)w->g.first[w->g.n_levels], sizeof *w->table);
     w->brick_buf = malloc(brick_bytes);
-    w->zcap = compressBound((uLong)brick_bytes);
+    w->zcap = w->zl->compressBound((uLong)brick_bytes);
     w->zbuf = malloc(w->zcap);
     w->raw = malloc((size_t)w->l->dims[0] * w->l->dims[1] * vxl_dtype_size(w->l->dtype));
     w->row = malloc((size_t)w->l->dims[0] * sizeof *w->row);
@@ -579,6 +582,7 @@ int vxl_brick_cache_write(const vxl_raw_layout *l, const vxl_load_options *opt, 
     w.l = l;
     w.opt = opt;
     w.e = e;
+    if (!(w.zl = vxl_zlib_api(e))) return VXL_ERR_IO;
     int rc = plan(&w, t);
     if (!rc) rc = allocate(&w);
     if (rc) {

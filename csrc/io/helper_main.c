@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include "reader_stream.h"
@@ -90,6 +91,23 @@ static void cap_address_space(uint64_t budget)
 #endif
 }
 
+/* Descriptors the host process left open without O_CLOEXEC (Blender's,
+ * another add-on's) are inherited by the helper; held here they could keep
+ * a pipe of the host's open for the helper's whole run. The helper is
+ * given only 0, 1 and 2, so it closes the rest first thing: the library
+ * starts it with plain posix_spawn, which on glibc 2.28 (the oldest the
+ * library supports) has no way to close them itself. Linux's close_range
+ * where the kernel has it, else every descriptor up to the limit. */
+static void close_inherited(void)
+{
+#ifdef SYS_close_range
+    if (syscall(SYS_close_range, 3u, ~0u, 0u) == 0) return;
+#endif
+    long max = sysconf(_SC_OPEN_MAX);
+    if (max < 0 || max > 65536) max = 65536;
+    for (int fd = 3; fd < max; fd++) close(fd);
+}
+
 static void volume_header(const vxl_volume *v, vxl_reader_header *h)
 {
     h->kind = VXL_REPLY_VOLUME;
@@ -125,6 +143,7 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
         fputs(")\n", stderr);
         return 2;
     }
+    close_inherited();
     /* The stream keeps stdout's pipe to itself: whatever the libraries
      * print goes to stderr instead of into the voxels. */
     int out = fcntl(1, F_DUPFD_CLOEXEC, 3);

@@ -14,7 +14,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <zlib.h>
+#include "crc32.h"
+#include "zlib_api.h"
 
 #include "error.h"
 #include "voxlight.h"
@@ -28,6 +29,7 @@
 /* A file being written: remembers the first write error so the callers can
  * write a whole section and check once. */
 typedef struct out_file {
+    const vxl_zlib *z;
     FILE *f;
     const char *path;
     int err; /* errno of the first failed write, 0 while all is well */
@@ -132,10 +134,9 @@ static void png_chunk(out_file *o, const char type[4], const uint8_t *data, uint
     uint8_t head[8], tail[4];
     put_be32(head, n);
     memcpy(head + 4, type, 4);
-    uLong crc = crc32(0L, Z_NULL, 0);
-    crc = crc32(crc, (const Bytef *)type, 4);
-    if (n) crc = crc32(crc, data, n);
-    put_be32(tail, (uint32_t)crc);
+    uint32_t crc = vxl_crc32(0, type, 4);
+    if (n) crc = vxl_crc32(crc, data, n);
+    put_be32(tail, crc);
     out_put(o, head, sizeof head);
     out_put(o, data, n);
     out_put(o, tail, sizeof tail);
@@ -177,7 +178,7 @@ static int png_deflate(out_file *o, z_stream *zs, const uint8_t *in, size_t n, i
     zs->next_in = (Bytef *)(uintptr_t)in;
     zs->avail_in = (uInt)n;
     for (;;) {
-        int rc = deflate(zs, flush);
+        int rc = o->z->deflate(zs, flush);
         if (rc != Z_OK && rc != Z_STREAM_END && rc != Z_BUF_ERROR) return -1;
         uint32_t have = PNG_IDAT_MAX - zs->avail_out;
         if (zs->avail_out == 0 || (rc == Z_STREAM_END && have)) {
@@ -196,7 +197,7 @@ static int write_png(out_file *o, const float *rgba, uint32_t w, uint32_t h)
     uint8_t *rows = malloc(2 * n), *cand = malloc(5 * (n + 1)), *buf = malloc(PNG_IDAT_MAX);
     z_stream zs;
     memset(&zs, 0, sizeof zs);
-    int zok = deflateInit(&zs, Z_DEFAULT_COMPRESSION) == Z_OK;
+    int zok = o->z->deflateInit_(&zs, Z_DEFAULT_COMPRESSION, ZLIB_VERSION, (int)sizeof zs) == Z_OK;
     int rc = VXL_OK;
     if (!rows || !cand || !buf || !zok) {
         rc = vxl_fail(NULL, VXL_ERR_NO_MEMORY, "write_image: out of memory writing %s", o->path);
@@ -244,7 +245,7 @@ static int write_png(out_file *o, const float *rgba, uint32_t w, uint32_t h)
     }
     png_chunk(o, "IEND", NULL, 0);
 done:
-    if (zok) deflateEnd(&zs);
+    if (zok) o->z->deflateEnd(&zs);
     free(rows);
     free(cand);
     free(buf);
@@ -360,7 +361,7 @@ static int write_exr(out_file *o, const float *rgba, const float *depth, uint32_
     int nch = depth ? 5 : 4;
     size_t line = (size_t)w * (depth ? 4 * 2 + 4 : 4 * 2);
     size_t raw_max = line * EXR_ZIP_LINES;
-    uLong zmax = compressBound((uLong)raw_max);
+    uLong zmax = o->z->compressBound((uLong)raw_max);
     uint32_t nblocks = (h + EXR_ZIP_LINES - 1) / EXR_ZIP_LINES;
     uint8_t *raw = malloc(raw_max), *pred = malloc(raw_max), *z = malloc(zmax);
     uint8_t *offsets = calloc(nblocks, 8);
@@ -379,7 +380,7 @@ static int write_exr(out_file *o, const float *rgba, const float *depth, uint32_
         size_t n = exr_block(rgba, depth, w, h, nch, y0, y1, raw);
         exr_zip_predict(raw, n, pred);
         uLongf zn = zmax;
-        if (compress2(z, &zn, pred, (uLong)n, Z_DEFAULT_COMPRESSION) != Z_OK) {
+        if (o->z->compress2(z, &zn, pred, (uLong)n, Z_DEFAULT_COMPRESSION) != Z_OK) {
             rc = vxl_fail(NULL, VXL_ERR_IO, "write_image: compressing %s failed", o->path);
             goto done;
         }
@@ -425,7 +426,9 @@ VXL_API int vxl_write_image(const char *path, const float *rgba, const float *de
     int exr = ends_with_ci(path, ".exr");
     if (!exr && !ends_with_ci(path, ".png"))
         return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "write_image: %s: use a .png or .exr name", path);
-    out_file o = {fopen(path, "wb"), path, 0};
+    const vxl_zlib *z = vxl_zlib_api(NULL);
+    if (!z) return VXL_ERR_IO;
+    out_file o = {z, fopen(path, "wb"), path, 0};
     if (!o.f) return vxl_fail(NULL, VXL_ERR_IO, "write_image: cannot open %s for writing: %s", path, strerror(errno));
     int rc = exr ? write_exr(&o, rgba, depth, w, h) : write_png(&o, rgba, w, h);
     if (fclose(o.f) != 0 && !o.err) o.err = errno ? errno : EIO;

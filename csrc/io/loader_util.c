@@ -9,7 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
+#include "zlib_api.h"
 
 #define IO_CHUNK (256u * 1024u)
 
@@ -208,11 +208,13 @@ int vxl_affine_from(const double dir[3][3], const double origin[3], double A[16]
 static int inflate_into(FILE *f, const char *path, uint64_t skip_after, unsigned char *buf, uint64_t nbytes,
                         vxl_err *e)
 {
+    const vxl_zlib *zl = vxl_zlib_api(e);
+    if (!zl) return VXL_ERR_IO;
     unsigned char *in = malloc(IO_CHUNK), *scratch = NULL;
     if (!in) return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for decompression", path);
     z_stream z;
     memset(&z, 0, sizeof z);
-    if (inflateInit2(&z, 15 + 32) != Z_OK) { /* zlib or gzip, auto-detected */
+    if (VXL_INFLATE_INIT2(zl, &z, 15 + 32) != Z_OK) { /* zlib or gzip, auto-detected */
         free(in);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': cannot start zlib", path);
     }
@@ -231,7 +233,7 @@ static int inflate_into(FILE *f, const char *path, uint64_t skip_after, unsigned
             z.avail_in = (uInt)r;
         }
         if (ended) { /* another gzip member follows */
-            if (inflateReset(&z) != Z_OK) break;
+            if (zl->inflateReset(&z) != Z_OK) break;
             ended = 0;
         }
         unsigned char *dst;
@@ -251,7 +253,7 @@ static int inflate_into(FILE *f, const char *path, uint64_t skip_after, unsigned
         }
         z.next_out = dst;
         z.avail_out = (uInt)room;
-        int zr = inflate(&z, Z_NO_FLUSH);
+        int zr = zl->inflate(&z, Z_NO_FLUSH);
         produced += room - z.avail_out;
         if (zr == Z_STREAM_END) {
             ended = 1;
@@ -270,7 +272,7 @@ static int inflate_into(FILE *f, const char *path, uint64_t skip_after, unsigned
                       "'%s': truncated compressed data: expected %llu bytes of voxel data, got %llu", path,
                       (unsigned long long)nbytes,
                       (unsigned long long)(produced > skip_after ? produced - skip_after : 0));
-    inflateEnd(&z);
+    zl->inflateEnd(&z);
     free(scratch);
     free(in);
     return rc;

@@ -14,6 +14,7 @@
 #include "loader_util.h"
 #include "loaders.h"
 #include "stream_load.h"
+#include "zlib_api.h"
 
 #include <errno.h>
 #include <math.h>
@@ -22,7 +23,6 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
-#include <zlib.h>
 
 #define NII1_HDR_SIZE 348
 #define NII2_HDR_SIZE 540
@@ -199,32 +199,24 @@ static char *image_path_for(const char *hdr_path)
 
 /* ------------------------------------------------------------------- I/O */
 
-static gzFile open_gz(const char *path, vxl_err *e)
+static vxl_gz *open_gz(const char *path, vxl_err *e)
 {
-    errno = 0;
-    gzFile f = gzopen(path, "rb");
-    if (!f) {
-        vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path,
-                 errno ? strerror(errno) : "out of memory");
-        return NULL;
-    }
-    gzbuffer(f, GZ_BUFFER); /* larger than zlib's 8 KiB default: fewer syscalls */
-    return f;
+    return vxl_gz_open(path, GZ_BUFFER, e); /* larger than zlib's 8 KiB default: fewer syscalls */
 }
 
 /* Reads up to n bytes; *got says how many arrived. Returns VXL_OK at EOF too
  * (the caller judges a short count), or an error for a broken stream. */
-static int read_bytes(gzFile f, void *buf, uint64_t n, uint64_t *got, const char *path, vxl_err *e)
+static int read_bytes(vxl_gz *f, void *buf, uint64_t n, uint64_t *got, const char *path, vxl_err *e)
 {
     unsigned char *p = buf;
     *got = 0;
     while (*got < n) {
         uint64_t left = n - *got;
         unsigned want = left > READ_CHUNK ? READ_CHUNK : (unsigned)left;
-        int r = gzread(f, p + *got, want);
+        int r = vxl_gz_read(f, p + *got, want);
         if (r < 0) {
             int zerr = Z_OK;
-            const char *msg = gzerror(f, &zerr);
+            const char *msg = vxl_gz_error(f, &zerr);
             if (zerr == Z_ERRNO)
                 return vxl_fail(e, VXL_ERR_IO, "read error in '%s': %s", path, strerror(errno));
             return vxl_fail(e, VXL_ERR_FORMAT, "corrupt compressed data in '%s': %s", path,
@@ -328,7 +320,7 @@ static int check_magic(const unsigned char *b, nii_header *h, const char *path, 
 }
 
 /* Reads and parses the header from f (positioned at 0). */
-static int read_header(gzFile f, const char *path, nii_header *h, vxl_err *e)
+static int read_header(vxl_gz *f, const char *path, nii_header *h, vxl_err *e)
 {
     unsigned char b[NII2_HDR_SIZE];
     uint64_t got;
@@ -536,10 +528,10 @@ static uint32_t choose_affine(const nii_header *h, const double sp[3], double A[
 
 /* For an uncompressed file the size is known up front: report truncation
  * before allocating a buffer a hostile header may have sized. */
-static int precheck_size(gzFile f, const char *path, uint64_t offset, uint64_t nbytes, vxl_err *e)
+static int precheck_size(vxl_gz *f, const char *path, uint64_t offset, uint64_t nbytes, vxl_err *e)
 {
     struct stat st;
-    if (!gzdirect(f) || stat(path, &st) != 0 || st.st_size < 0) return VXL_OK;
+    if (!vxl_gz_direct(f) || stat(path, &st) != 0 || st.st_size < 0) return VXL_OK;
     uint64_t size = (uint64_t)st.st_size;
     uint64_t have = size > offset ? size - offset : 0;
     if (have < nbytes)
@@ -551,7 +543,7 @@ static int precheck_size(gzFile f, const char *path, uint64_t offset, uint64_t n
 }
 
 /* Reads one volume's nbytes at offset into a new buffer. */
-static int read_voxels(gzFile f, const char *path, uint64_t offset, uint64_t nbytes, void **out,
+static int read_voxels(vxl_gz *f, const char *path, uint64_t offset, uint64_t nbytes, void **out,
                        vxl_err *e)
 {
     *out = NULL;
@@ -560,7 +552,7 @@ static int read_voxels(gzFile f, const char *path, uint64_t offset, uint64_t nby
     /* Forward seek only (we are at or before offset); on gzip streams zlib
      * decompresses and discards, and a seek past the end shows up as a short
      * read below. */
-    if (gzseek(f, (z_off_t)offset, SEEK_SET) < 0)
+    if (vxl_gz_seek(f, (z_off_t)offset, SEEK_SET) < 0)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot seek to vox_offset %llu", path,
                         (unsigned long long)offset);
     void *buf = malloc((size_t)nbytes);
@@ -594,14 +586,14 @@ typedef struct nii_load {
     const char *path;    /* as given by the caller */
     char *hdr_path;
     char *img_path;      /* paired files only */
-    gzFile hdr_file, img_file;
+    vxl_gz *hdr_file, *img_file;
     void *raw;
 } nii_load;
 
 static void load_cleanup(nii_load *L)
 {
-    if (L->img_file) gzclose(L->img_file);
-    if (L->hdr_file) gzclose(L->hdr_file);
+    if (L->img_file) vxl_gz_close(L->img_file);
+    if (L->hdr_file) vxl_gz_close(L->hdr_file);
     free(L->raw);
     free(L->img_path);
     free(L->hdr_path);
@@ -609,7 +601,7 @@ static void load_cleanup(nii_load *L)
 
 /* Opens the header, reads it, and opens the file holding the voxels.
  * On success data and data_path name that file. */
-static int open_files(nii_load *L, nii_header *h, gzFile *data, const char **data_path, vxl_err *e)
+static int open_files(nii_load *L, nii_header *h, vxl_gz **data, const char **data_path, vxl_err *e)
 {
     L->hdr_path = header_path_for(L->path);
     if (!L->hdr_path) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", L->path);
@@ -740,7 +732,7 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     nii_load L = {.path = path};
     nii_header h;
     memset(&h, 0, sizeof h);
-    gzFile data = NULL;
+    vxl_gz *data = NULL;
     const char *data_path = NULL;
     uint32_t dims[3], dtype = 0, frame_count = 1, frame = 0;
     uint64_t offset = 0, nbytes = 0;
@@ -754,8 +746,8 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     }
     if (!rc && stream) {
         /* the files' buffers are not needed: the source opens its own */
-        if (L.img_file) gzclose(L.img_file);
-        gzclose(L.hdr_file);
+        if (L.img_file) vxl_gz_close(L.img_file);
+        vxl_gz_close(L.hdr_file);
         L.img_file = L.hdr_file = NULL;
         rc = stream_volume(&h, data_path, dims, dtype, offset, frame_count, frame, opt, out, e);
         load_cleanup(&L);
@@ -768,8 +760,8 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     }
     /* The file handles are done with: close them before the texture is
      * allocated so their buffers do not add to the peak. */
-    if (L.img_file) gzclose(L.img_file);
-    gzclose(L.hdr_file);
+    if (L.img_file) vxl_gz_close(L.img_file);
+    vxl_gz_close(L.hdr_file);
     L.img_file = L.hdr_file = NULL;
 
     if (h.swapped) swap_voxels(L.raw, nbytes / vxl_dtype_size(dtype), vxl_dtype_size(dtype));

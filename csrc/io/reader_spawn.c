@@ -17,7 +17,6 @@
  * in-process fallback. */
 #include "reader_spawn.h"
 
-#include <dlfcn.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -32,6 +31,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "dynlib.h"
 #include "loader_util.h"
 
 extern char **environ;
@@ -47,13 +47,13 @@ static int helper_path(const vxl_reader *r, const char *path, char *out, size_t 
         if (snprintf(out, n, "%s", env) >= (int)n)
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "%s is too long", r->env);
     } else {
-        Dl_info info;
-        if (!dladdr((void *)&vxl_reader_run, &info) || !info.dli_fname)
+        char self[4096];
+        if (vxl_dynlib_path_of((const void *)&vxl_reader_run, self, sizeof self))
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot locate libvoxlight to find %s", path,
                             r->helper);
-        const char *slash = strrchr(info.dli_fname, '/');
-        int dir_len = slash ? (int)(slash - info.dli_fname) : 1;
-        if (snprintf(out, n, "%.*s/%s", dir_len, slash ? info.dli_fname : ".", r->helper) >= (int)n)
+        const char *slash = strrchr(self, '/');
+        int dir_len = slash ? (int)(slash - self) : 1;
+        if (snprintf(out, n, "%.*s/%s", dir_len, slash ? self : ".", r->helper) >= (int)n)
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': the path of %s is too long", path, r->helper);
     }
     if (access(out, F_OK))
@@ -294,8 +294,8 @@ static int spawn_helper(const vxl_reader *r, const char *helper, const char *com
     if (!rc) rc = posix_spawn_file_actions_adddup2(&fa, data_w, 1);
     if (!rc) rc = posix_spawn_file_actions_adddup2(&fa, err_w, 2);
     if (!rc) rc = posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    /* the host's own descriptors without O_CLOEXEC stay out of the helper */
-    if (!rc) rc = posix_spawn_file_actions_addclosefrom_np(&fa, 3);
+    /* the host's own descriptors without O_CLOEXEC: the helper closes them
+     * first thing (helper_main.c), as glibc 2.28's posix_spawn cannot */
     if (!rc) rc = posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
     if (!rc) rc = posix_spawnattr_setsigmask(&at, &none);
     if (!rc) rc = posix_spawnattr_setsigdefault(&at, &all);
@@ -342,6 +342,27 @@ static int collect(const vxl_reader *r, const char *path, int data_r, int err_r,
 }
 
 /* The last non-empty line of the helper's stderr, for error messages. */
+/* The name (without SIG) of the signals a crashing or killed reader dies
+ * of; glibc's sigabbrev_np is 2.32, newer than the library may need. */
+static const char *signal_name(int sig)
+{
+    switch (sig) {
+    case SIGSEGV: return "SEGV";
+    case SIGBUS: return "BUS";
+    case SIGABRT: return "ABRT";
+    case SIGFPE: return "FPE";
+    case SIGILL: return "ILL";
+    case SIGKILL: return "KILL";
+    case SIGTERM: return "TERM";
+    case SIGXCPU: return "XCPU";
+    case SIGXFSZ: return "XFSZ";
+    case SIGPIPE: return "PIPE";
+    case SIGTRAP: return "TRAP";
+    case SIGSYS: return "SYS";
+    default: return NULL;
+    }
+}
+
 static const char *last_line(reply *rp)
 {
     char *s = rp->err_tail;
@@ -382,7 +403,7 @@ static int verdict(const vxl_reader *r, const char *path, const char *helper, in
     const char *said = last_line(rp);
     if (reaped && WIFSIGNALED(status)) {
         int sig = WTERMSIG(status);
-        const char *abbrev = sigabbrev_np(sig);
+        const char *abbrev = signal_name(sig);
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s crashed (signal %d: SIG%s) - the file is corrupt "
                         "or unsupported%s%s%s", path, r->name, sig, abbrev ? abbrev : "?", *said ? " (" : "", said,
                         *said ? ")" : "");

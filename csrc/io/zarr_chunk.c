@@ -9,33 +9,34 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <zlib.h>
-
 #include "loader_util.h"
 #include "zarr.h"
 #include "zarr_codecs.h"
+#include "zlib_api.h"
 
 static int decode_zlib(const void *src, size_t n, void *out, uint64_t nbytes, const char *name, vxl_err *e)
 {
+    const vxl_zlib *zl = vxl_zlib_api(e);
+    if (!zl) return VXL_ERR_IO;
     z_stream z;
     memset(&z, 0, sizeof z);
-    if (inflateInit2(&z, 15 + 32) != Z_OK) /* 15 + 32: zlib or gzip header, detected */
+    if (VXL_INFLATE_INIT2(zl, &z, 15 + 32) != Z_OK) /* 15 + 32: zlib or gzip header, detected */
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': cannot start zlib", name);
     z.next_in = (Bytef *)src;
     z.avail_in = (uInt)n; /* the caller bounds n below 4 GiB */
     z.next_out = out;
     z.avail_out = (uInt)nbytes;
-    int r = inflate(&z, Z_FINISH);
+    int r = zl->inflate(&z, Z_FINISH);
     uint64_t got = z.total_out;
     unsigned char extra;
     if (r == Z_BUF_ERROR && z.avail_out == 0) {
         /* the output is full: is there more? */
         z.next_out = &extra;
         z.avail_out = 1;
-        r = inflate(&z, Z_FINISH);
+        r = zl->inflate(&z, Z_FINISH);
         if (z.avail_out == 0) r = Z_BUF_ERROR - 100; /* it had more */
     }
-    inflateEnd(&z);
+    zl->inflateEnd(&z);
     if (r == Z_BUF_ERROR - 100)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the chunk decompresses to more than the %llu bytes its array "
                         "metadata says", name, (unsigned long long)nbytes);

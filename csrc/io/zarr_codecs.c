@@ -3,26 +3,26 @@
  * libvoxlight.so links only the C runtime (it loads inside Blender), so the
  * two decoders Zarr chunks may need are opened by SONAME with dlopen the
  * first time a chunk compressed with them is met, and their few functions
- * are looked up on that handle (RTLD_LOCAL: nothing of theirs is added to
- * the process' global namespace, and dlsym on the handle binds to that very
- * library, not to another copy Blender may carry). A missing library fails
+ * are looked up on that handle (platform/dynlib.h: nothing of theirs joins
+ * the process' global namespace, so a lookup binds to that very library,
+ * not to another copy Blender may carry). A missing library fails
  * that chunk with a message naming the library, the codec and the Debian
  * package; stores with gzip/zlib or raw chunks never open either library.
  * The function types come from the libraries' own headers (__typeof__), so
  * a signature slip is a compile error, yet nothing of them is linked.
  * VOXLIGHT_ZARR_LIBZSTD / VOXLIGHT_ZARR_LIBBLOSC name other files to open
  * (the tests name a missing one to see the message). */
-#include <dlfcn.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "dynlib.h"
 #include "zarr_codecs.h"
 
 struct vxl_zarr_codecs {
     pthread_mutex_t lock; /* the first use of a library, from any reader thread */
-    void *zstd, *blosc;   /* dlopen handles; NULL until needed */
+    vxl_dynlib *zstd, *blosc; /* NULL until needed */
     vxl_zstd_api zstd_api;
     vxl_blosc_api blosc_api;
 };
@@ -40,8 +40,8 @@ vxl_zarr_codecs *vxl_zarr_codecs_new(void)
 void vxl_zarr_codecs_free(vxl_zarr_codecs *c)
 {
     if (!c) return;
-    if (c->zstd) dlclose(c->zstd);
-    if (c->blosc) dlclose(c->blosc);
+    vxl_dynlib_close(c->zstd);
+    vxl_dynlib_close(c->blosc);
     pthread_mutex_destroy(&c->lock);
     free(c);
 }
@@ -69,9 +69,8 @@ static const codec_library blosc_library = {VXL_BLOSC_SO, "VOXLIGHT_ZARR_LIBBLOS
                                             blosc_symbols, sizeof blosc_symbols / sizeof blosc_symbols[0]};
 
 /* Opens lib into *handle and fills table (lib->count function pointers, in
- * the order of lib->symbols) on the first call; under c->lock. The cast of
- * dlsym's void * to a function pointer is what POSIX guarantees. */
-static int open_library(vxl_zarr_codecs *c, const codec_library *lib, void **handle, void (**table)(void),
+ * the order of lib->symbols) on the first call; under c->lock. */
+static int open_library(vxl_zarr_codecs *c, const codec_library *lib, vxl_dynlib **handle, vxl_dynlib_fn *table,
                         const char *chunk, vxl_err *e)
 {
     pthread_mutex_lock(&c->lock);
@@ -80,18 +79,11 @@ static int open_library(vxl_zarr_codecs *c, const codec_library *lib, void **han
         return VXL_OK;
     }
     const char *so = library(lib->soname, lib->env);
-    void *h = dlopen(so, RTLD_NOW | RTLD_LOCAL);
     char why[256];
-    snprintf(why, sizeof why, "%s", h ? "a function is missing" : dlerror());
-    for (size_t i = 0; h && i < lib->count; i++) {
-        void *p = dlsym(h, lib->symbols[i]);
-        if (!p) {
-            snprintf(why, sizeof why, "%s lacks %s", so, lib->symbols[i]);
-            dlclose(h);
-            h = NULL;
-        } else {
-            memcpy(&table[i], &p, sizeof p);
-        }
+    vxl_dynlib *h = vxl_dynlib_open(so, why, sizeof why);
+    if (h && vxl_dynlib_symbols(h, lib->symbols, lib->count, table, why, sizeof why)) {
+        vxl_dynlib_close(h);
+        h = NULL;
     }
     *handle = h;
     pthread_mutex_unlock(&c->lock);
@@ -103,18 +95,18 @@ static int open_library(vxl_zarr_codecs *c, const codec_library *lib, void **han
 
 int vxl_zarr_zstd(vxl_zarr_codecs *c, const char *chunk, const vxl_zstd_api **api, vxl_err *e)
 {
-    _Static_assert(sizeof(vxl_zstd_api) == sizeof zstd_symbols / sizeof zstd_symbols[0] * sizeof(void (*)(void)),
+    _Static_assert(sizeof(vxl_zstd_api) == sizeof zstd_symbols / sizeof zstd_symbols[0] * sizeof(vxl_dynlib_fn),
                    "one pointer per symbol");
-    int rc = open_library(c, &zstd_library, &c->zstd, (void (**)(void))&c->zstd_api, chunk, e);
+    int rc = open_library(c, &zstd_library, &c->zstd, (vxl_dynlib_fn *)&c->zstd_api, chunk, e);
     *api = &c->zstd_api;
     return rc;
 }
 
 int vxl_zarr_blosc(vxl_zarr_codecs *c, const char *chunk, const vxl_blosc_api **api, vxl_err *e)
 {
-    _Static_assert(sizeof(vxl_blosc_api) == sizeof blosc_symbols / sizeof blosc_symbols[0] * sizeof(void (*)(void)),
+    _Static_assert(sizeof(vxl_blosc_api) == sizeof blosc_symbols / sizeof blosc_symbols[0] * sizeof(vxl_dynlib_fn),
                    "one pointer per symbol");
-    int rc = open_library(c, &blosc_library, &c->blosc, (void (**)(void))&c->blosc_api, chunk, e);
+    int rc = open_library(c, &blosc_library, &c->blosc, (vxl_dynlib_fn *)&c->blosc_api, chunk, e);
     *api = &c->blosc_api;
     return rc;
 }

@@ -295,7 +295,7 @@ case "$cmd" in
         install_deps; build ;;
     demo)
         install_deps; build
-        if [ -f tools/blender_demo.py ] && [ -f build/voxlight-blender.zip ]; then
+        if [ -f tools/blender_demo.py ] && [ -f build/voxlight-linux-x64.zip ]; then
             blender -b --factory-startup --python-exit-code 1 --python tools/blender_demo.py -- "$ROOT/demo.png"
         else
             ./build/voxlight render /usr/share/mricron/templates/ch2better.nii.gz -o demo.png --size 512x512 --azimuth 30 --elevation 15

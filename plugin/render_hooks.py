@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import compositor, id_writes, offline, render_setup, scene_shadows
+from . import app_handlers, compositor, id_writes, offline, render_setup, scene_shadows
 from .core import native
 
 last_error = ""
@@ -141,15 +141,8 @@ _handlers = ((bpy.app.handlers.render_init, on_render_init),
 
 
 def register():
-    for lst, fn in _handlers:
-        if fn not in lst:
-            lst.append(fn)
+    app_handlers.add(_handlers)
 
 
 def unregister():
-    for lst, fn in _handlers:
-        # Match by name too: a reloaded module has new function objects.
-        for h in list(lst):
-            if h is fn or getattr(h, "__name__", "") == fn.__name__ and \
-                    getattr(h, "__module__", "") == fn.__module__:
-                lst.remove(h)
+    app_handlers.remove(_handlers)

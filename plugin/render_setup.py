@@ -18,7 +18,7 @@ after a file loads, and from the render handlers (render_hooks.py).
 import bpy
 from bpy.app.handlers import persistent
 
-from . import compositor, id_writes, offline, scene_shadows
+from . import app_handlers, compositor, id_writes, offline, scene_shadows
 
 DELAY_S = 0.2       # coalesces the updates of a drag into one prepare()
 RENDER_WAIT_S = 0.5
@@ -113,17 +113,11 @@ _handlers = ((bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update),
 
 
 def register():
-    for lst, fn in _handlers:
-        if fn not in lst:
-            lst.append(fn)
+    app_handlers.add(_handlers)
 
 
 def unregister():
-    for lst, fn in _handlers:
-        for h in list(lst):
-            if h is fn or getattr(h, "__name__", "") == fn.__name__ and \
-                    getattr(h, "__module__", "") == fn.__module__:
-                lst.remove(h)
+    app_handlers.remove(_handlers)
     _pending.clear()
     if bpy.app.timers.is_registered(_run_pending):
         bpy.app.timers.unregister(_run_pending)

@@ -22,7 +22,7 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import compositor, id_writes
+from . import app_handlers, compositor, id_writes
 from .core import facing, light_shares
 from .core import lights as _lights
 from .core import native, scene_geometry, shadow_plan
@@ -402,14 +402,9 @@ def clear_render(scene):
 
 
 def register():
-    if _on_depsgraph_update not in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph_update)
+    app_handlers.add(((bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update),))
 
 
 def unregister():
-    lst = bpy.app.handlers.depsgraph_update_post
-    for h in list(lst):
-        if h is _on_depsgraph_update or getattr(h, "__name__", "") == _on_depsgraph_update.__name__ \
-                and getattr(h, "__module__", "") == _on_depsgraph_update.__module__:
-            lst.remove(h)
+    app_handlers.remove(((bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update),))
     _cache["key"] = _cache["value"] = None

@@ -21,7 +21,7 @@ import numpy as np
 from bpy.app.handlers import persistent
 from bpy.props import EnumProperty, IntProperty, PointerProperty
 
-from . import params
+from . import app_handlers, params
 from .properties import INTERPOLATION_ITEMS
 from .render_hooks import display_to_linear
 from .core import native, runtime, slice_plane
@@ -211,23 +211,13 @@ _handlers = ((bpy.app.handlers.depsgraph_update_post, on_depsgraph_update),
              (bpy.app.handlers.load_post, on_load_post))
 
 
-def _ours(h, fn):
-    """h is fn, or fn of an earlier load of this module (a reload makes new functions)."""
-    return h is fn or (getattr(h, "__name__", ""), getattr(h, "__module__", "")) == \
-        (fn.__name__, fn.__module__)
-
-
 def register():
     bpy.utils.register_class(VoxlightSliceProperties)
     bpy.types.Object.voxlight_slice = PointerProperty(type=VoxlightSliceProperties)
-    for lst, fn in _handlers:
-        if not any(_ours(h, fn) for h in lst):
-            lst.append(fn)
+    app_handlers.add(_handlers)
 
 
 def unregister():
-    for lst, fn in _handlers:
-        for h in [h for h in lst if _ours(h, fn)]:
-            lst.remove(h)
+    app_handlers.remove(_handlers)
     del bpy.types.Object.voxlight_slice
     bpy.utils.unregister_class(VoxlightSliceProperties)

@@ -52,7 +52,7 @@ import gpu
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import gpu_quad, overlay_frames, params, scene_shadows, scene_shadows_viewport
+from . import app_handlers, gpu_quad, overlay_frames, params, scene_shadows, scene_shadows_viewport
 from .core import depth as _depth
 from .core import native, resolution_policy, runtime, volume_space
 
@@ -879,8 +879,7 @@ def register():
             _profile_handles.extend([
                 ("WINDOW", bpy.types.SpaceView3D.draw_handler_add(_profile.pre_view, (), "WINDOW", "PRE_VIEW")),
                 ("WINDOW", bpy.types.SpaceView3D.draw_handler_add(_profile.post_pixel, (), "WINDOW", "POST_PIXEL"))])
-    if _on_load_pre not in bpy.app.handlers.load_pre:
-        bpy.app.handlers.load_pre.append(_on_load_pre)
+    app_handlers.add(((bpy.app.handlers.load_pre, _on_load_pre),))
 
 
 def unregister():
@@ -895,9 +894,6 @@ def unregister():
         if bpy.app.timers.is_registered(fn):
             bpy.app.timers.unregister(fn)
     _refine_pending = _poll_registered = _refine_redraw = False
-    for h in list(bpy.app.handlers.load_pre):
-        if h is _on_load_pre or (getattr(h, "__name__", "") == _on_load_pre.__name__ and
-                                 getattr(h, "__module__", "") == _on_load_pre.__module__):
-            bpy.app.handlers.load_pre.remove(h)
+    app_handlers.remove(((bpy.app.handlers.load_pre, _on_load_pre),))
     _forget_all()
     _shader = _batch = None

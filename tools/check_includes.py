@@ -44,7 +44,8 @@ LAYERS = [
     ["storage"],                      # dense/bricked/sparse/compressed
     ["gl", "io", "frame"],            # GL services; file readers; render parameters
     ["volume"],                       # CPU volumes, phantoms
-    ["core", "platform"],             # errors, math, names; the OS seams (one file per OS)
+    ["core"],                         # errors, math, names
+    ["platform"],                     # the OS seams, one file per OS
     ["include"],                      # the public headers
 ]
 

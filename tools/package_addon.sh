@@ -1,8 +1,11 @@
 #!/bin/sh
-# package_addon.sh [BUILD_DIR] - makes BUILD_DIR/voxlight-blender.zip from
-# plugin/, manifest/blender_manifest.toml, BUILD_DIR/libvoxlight.so and every
-# reader helper the library starts from its own folder (BUILD_DIR/
-# voxlight-read-*, and voxlight-vdb-read where a build still has it).
+# package_addon.sh [BUILD_DIR] - makes BUILD_DIR/voxlight-linux-x64.zip, the
+# extension for one platform, from plugin/, manifest/blender_manifest.toml
+# (its `platforms` set to that platform alone), BUILD_DIR/libvoxlight.so and
+# every reader helper the library starts from its own folder (BUILD_DIR/
+# voxlight-read-*, and voxlight-vdb-read where a build still has it): only
+# that platform's binaries, as Blender's extension platform is one per
+# package.
 # Blender's zip install drops the helpers' execute bit, which the add-on
 # restores when it loads the library (plugin/core/native.py).
 # Layout: voxlight/{__init__.py, ..., core/*.py, libvoxlight.so,
@@ -39,13 +42,14 @@ done
 for f in "$ROOT"/plugin/core/*.py; do
     [ -f "$f" ] && cp "$f" "$STAGE/voxlight/core/"
 done
-cp "$ROOT/manifest/blender_manifest.toml" "$STAGE/voxlight/"
+PLATFORM=linux-x64
+sed "s/^platforms = .*/platforms = [\"$PLATFORM\"]/" "$ROOT/manifest/blender_manifest.toml" >"$STAGE/voxlight/blender_manifest.toml"
 cp "$LIB" "$STAGE/voxlight/libvoxlight.so"
 for f in $HELPERS; do
     cp "$f" "$STAGE/voxlight/"
     chmod 755 "$STAGE/voxlight/$(basename "$f")"
 done
-OUT=$BUILD/voxlight-blender.zip
+OUT=$BUILD/voxlight-$PLATFORM.zip
 rm -f "$OUT.tmp"
 # Python's zipfile, not zip(1): always present where Blender's tests run.
 (cd "$STAGE" && python3 - "$OUT.tmp" <<'PY'

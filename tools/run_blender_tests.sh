@@ -42,7 +42,7 @@ if ! "$ROOT/tools/package_addon.sh" "$BUILD"; then
     echo "0 passed, 1 failed"
     exit 1
 fi
-ZIP=$BUILD/voxlight-blender.zip
+ZIP=$BUILD/voxlight-linux-x64.zip
 
 # Blender installs add-ons into the user scripts (legacy) or extensions
 # (4.2+) folder: keep them private so the tests neither see nor change the

@@ -1,15 +1,15 @@
 /* error.c - error recording. The last message is kept per thread, so the
  * library has no global mutable state shared between callers.
  *
- * The per-thread buffer hangs off a pthread key rather than a _Thread_local
+ * The per-thread buffer hangs off a thread key (vxl_tls) rather than a _Thread_local
  * array: TLS in a shared object compiles to calls of __tls_get_addr, which
  * lives in the dynamic loader and would make ld-linux a NEEDED entry of the
- * core (issue 13: the core links only the C runtime). The key is written once
- * (pthread_once) and only read after; a thread's buffer is made at its first
+ * core (the core links only the C runtime). The key is written once
+ * (vxl_once_run) and only read after; a thread's buffer is made at its first
  * failure and freed when the thread ends. */
 #include "error.h"
 
-#include <pthread.h>
+#include "threads.h"
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,30 +17,30 @@
 
 #include "voxlight.h"
 
-static pthread_once_t last_error_once = PTHREAD_ONCE_INIT;
-static pthread_key_t last_error_key;
+static vxl_once last_error_once = VXL_ONCE_INIT;
+static vxl_tls last_error_key;
 static int last_error_key_ok;
 
-static void make_last_error_key(void) { last_error_key_ok = pthread_key_create(&last_error_key, free) == 0; }
+static void make_last_error_key(void) { last_error_key_ok = vxl_tls_create(&last_error_key, free) == 0; }
 
 /* The library may be unloaded (Blender disabling the add-on) while threads
  * that hold buffers live on: without the key their destructor would call
- * into unmapped code. Those buffers then leak, as pthread_key_delete says. */
+ * into unmapped code. Those buffers then leak, as vxl_tls_delete says. */
 __attribute__((destructor)) static void delete_last_error_key(void)
 {
-    if (last_error_key_ok) pthread_key_delete(last_error_key);
+    if (last_error_key_ok) vxl_tls_delete(last_error_key);
 }
 
 /* This thread's buffer, made when create is set; NULL when there is none
  * (or no memory: the message is then lost, the error code is not). */
 static char *last_error_buffer(int create)
 {
-    pthread_once(&last_error_once, make_last_error_key);
+    vxl_once_run(&last_error_once, make_last_error_key);
     if (!last_error_key_ok) return NULL;
-    char *buf = pthread_getspecific(last_error_key);
+    char *buf = vxl_tls_get(last_error_key);
     if (!buf && create) {
         buf = calloc(1, VXL_MSG_MAX);
-        if (buf && pthread_setspecific(last_error_key, buf)) {
+        if (buf && vxl_tls_set(last_error_key, buf)) {
             free(buf);
             buf = NULL;
         }

@@ -56,13 +56,13 @@ int vxl_context_screen_kind(const char *backend_name, const char *gl_renderer)
     return 4; /* an unknown llvmpipe backend: one lock of its own, never none */
 }
 
-pthread_mutex_t *vxl_context_screen_lock(int kind)
+vxl_mutex *vxl_context_screen_lock(int kind)
 {
     /* One mutex per llvmpipe screen a process can have through us: the
      * screens are process-wide inside Mesa, so their locks are too. They
      * hold no data and need no set-up. */
-    static pthread_mutex_t locks[4] = {PTHREAD_MUTEX_INITIALIZER, PTHREAD_MUTEX_INITIALIZER,
-                                       PTHREAD_MUTEX_INITIALIZER, PTHREAD_MUTEX_INITIALIZER};
+    static vxl_mutex locks[4] = {VXL_MUTEX_INIT, VXL_MUTEX_INIT,
+                                       VXL_MUTEX_INIT, VXL_MUTEX_INIT};
     return kind >= 1 && kind <= 4 ? &locks[kind - 1] : NULL;
 }
 

@@ -4,7 +4,7 @@
 #ifndef VXL_CONTEXT_H
 #define VXL_CONTEXT_H
 
-#include <pthread.h>
+#include "threads.h"
 #include <stdint.h>
 
 #include "dynlib.h"
@@ -44,7 +44,7 @@ void vxl_context_close(vxl_context *c);
  * lock), else a small number naming the shared lock. */
 int vxl_context_screen_kind(const char *backend_name, const char *gl_renderer);
 /* The lock for that kind, NULL for 0. */
-pthread_mutex_t *vxl_context_screen_lock(int kind);
+vxl_mutex *vxl_context_screen_lock(int kind);
 
 /* Backend entry points, in backend_osmesa.c and backend_egl.c. egl_mode: 0
  * hardware device only, 1 Mesa surfaceless only, 2 device then surfaceless. */

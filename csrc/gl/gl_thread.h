@@ -9,22 +9,22 @@
 #ifndef VXL_GL_THREAD_H
 #define VXL_GL_THREAD_H
 
-#include <pthread.h>
+#include "threads.h"
 
 typedef int (*vxl_job_fn)(void *arg);
 
 typedef struct vxl_gl_thread {
-    pthread_t thread;
-    pthread_mutex_t call_lock; /* one caller at a time */
-    pthread_mutex_t lock;
-    pthread_cond_t cond;
+    vxl_thread thread;
+    vxl_mutex call_lock; /* one caller at a time */
+    vxl_mutex lock;
+    vxl_cond cond;
     vxl_job_fn job;
     void *arg;
     int result;
     int pending, done, quit, started;
     /* touched on the GL thread only: the lock every job runs under (NULL:
      * none) and the one the running job holds */
-    pthread_mutex_t *exclusive, *held;
+    vxl_mutex *exclusive, *held;
 } vxl_gl_thread;
 
 int vxl_gl_thread_start(vxl_gl_thread *t);
@@ -32,7 +32,7 @@ int vxl_gl_thread_start(vxl_gl_thread *t);
 int vxl_gl_thread_call(vxl_gl_thread *t, vxl_job_fn fn, void *arg);
 /* From inside a job: the rest of this job, and every later job of this
  * thread, runs holding m (NULL: no lock). Locks m before returning. */
-void vxl_gl_thread_hold(vxl_gl_thread *t, pthread_mutex_t *m);
+void vxl_gl_thread_hold(vxl_gl_thread *t, vxl_mutex *m);
 /* Runs fn(arg) (may be NULL) as the last job, then joins the thread. */
 void vxl_gl_thread_stop(vxl_gl_thread *t, vxl_job_fn fn, void *arg);
 

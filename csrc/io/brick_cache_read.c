@@ -9,7 +9,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
-#include <pthread.h>
+#include "threads.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,7 +38,7 @@ typedef struct cache_ctx {
     vxl_cache_grid g;
     vxl_cache_entry *table;
     int built;
-    pthread_mutex_t lock;
+    vxl_mutex lock;
     uint64_t clock;
     lru_slot lru[LRU_SLOTS];
 } cache_ctx;
@@ -139,7 +139,7 @@ int vxl_brick_cache_read_open(const char *path, const vxl_raw_layout *l, uint32_
     s->ops = &cache_ops;
     s->ctx = c;
     c->fd = -1;
-    pthread_mutex_init(&c->lock, NULL);
+    vxl_mutex_init(&c->lock);
     snprintf(c->path, sizeof c->path, "%s", path);
     int rc = VXL_OK;
     struct stat st;
@@ -250,7 +250,7 @@ static void covering(uint32_t lo, uint32_t size, uint32_t B, uint32_t n, uint32_
 static int copy_cached(cache_ctx *c, uint64_t id, const uint32_t blo[3], const uint32_t bsz[3], const uint32_t lo[3],
                        const uint32_t size[3], uint8_t *out)
 {
-    pthread_mutex_lock(&c->lock);
+    vxl_mutex_lock(&c->lock);
     lru_slot *hit = NULL;
     for (int k = 0; k < LRU_SLOTS && !hit; k++)
         if (c->lru[k].id == id) hit = &c->lru[k];
@@ -258,7 +258,7 @@ static int copy_cached(cache_ctx *c, uint64_t id, const uint32_t blo[3], const u
         hit->stamp = ++c->clock;
         copy_overlap(hit->data, blo, bsz, lo, size, out, c->g.texel_bytes);
     }
-    pthread_mutex_unlock(&c->lock);
+    vxl_mutex_unlock(&c->lock);
     return hit != NULL;
 }
 
@@ -298,7 +298,7 @@ static int cache_read(vxl_brick_source *s, uint32_t level, const uint32_t lo[3],
                     return rc;
                 }
                 copy_overlap(data, blo, bsz, lo, size, out, c->g.texel_bytes);
-                pthread_mutex_lock(&c->lock);
+                vxl_mutex_lock(&c->lock);
                 lru_slot *oldest = &c->lru[0];
                 for (int k = 1; k < LRU_SLOTS; k++)
                     if (c->lru[k].stamp < oldest->stamp) oldest = &c->lru[k];
@@ -306,7 +306,7 @@ static int cache_read(vxl_brick_source *s, uint32_t level, const uint32_t lo[3],
                 oldest->data = data;
                 oldest->id = id;
                 oldest->stamp = ++c->clock;
-                pthread_mutex_unlock(&c->lock);
+                vxl_mutex_unlock(&c->lock);
             }
     return VXL_OK;
 }
@@ -318,7 +318,7 @@ static void cache_close(vxl_brick_source *s)
     if (c->fd >= 0) close(c->fd);
     for (int k = 0; k < LRU_SLOTS; k++) free(c->lru[k].data);
     free(c->table);
-    pthread_mutex_destroy(&c->lock);
+    vxl_mutex_destroy(&c->lock);
     free(c);
     s->ctx = NULL;
 }

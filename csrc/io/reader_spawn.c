@@ -389,6 +389,23 @@ static int missing_library(const vxl_reader *r, const char *path, const reply *r
                     "that provides %s", path, r->formats, r->library, r->soname, len, at, r->soname);
 }
 
+/* The dynamic loader refused the helper because it needs a newer C library
+ * than this system has ("...: version `GLIBC_2.34' not found (required by
+ * ...)"): the OpenImageIO and dcmtk helpers link Debian's libraries, so they
+ * run only on a Linux as new as the one that built them, while the library
+ * itself needs only glibc 2.28. VXL_OK when that is not what happened. */
+static int too_new_for_this_system(const vxl_reader *r, const char *path, const reply *rp, vxl_err *e)
+{
+    const char *at = strstr(rp->err_tail, "version `");
+    if (!at || !strstr(at, "' not found")) return VXL_OK;
+    at += strlen("version `");
+    int len = (int)strcspn(at, "'\n");
+    if (len > 64) len = 64;
+    return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': %s need %s, and the helper %s was built for a newer Linux "
+                    "than this one (it needs %.*s): these formats are read on Debian 12 or 13 with %s installed",
+                    path, r->formats, r->library, r->helper, len, at, r->package[0] ? r->package : r->soname);
+}
+
 /* Turns how the helper ended and what it sent into our result. */
 static int verdict(const vxl_reader *r, const char *path, const char *helper, int status, int reaped,
                    int timed_out, double limit, reply *rp, vxl_err *e)
@@ -398,6 +415,10 @@ static int verdict(const vxl_reader *r, const char *path, const char *helper, in
                         r->name, limit);
     if (reaped && WIFEXITED(status) && WEXITSTATUS(status) == 127 && rp->h_got == 0) {
         int rc = missing_library(r, path, rp, e);
+        if (rc) return rc;
+    }
+    if (reaped && WIFEXITED(status) && WEXITSTATUS(status) != 0 && rp->h_got == 0) {
+        int rc = too_new_for_this_system(r, path, rp, e);
         if (rc) return rc;
     }
     const char *said = last_line(rp);

@@ -12,7 +12,7 @@
  * a signature slip is a compile error, yet nothing of them is linked.
  * VOXLIGHT_ZARR_LIBZSTD / VOXLIGHT_ZARR_LIBBLOSC name other files to open
  * (the tests name a missing one to see the message). */
-#include <pthread.h>
+#include "threads.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,7 +21,7 @@
 #include "zarr_codecs.h"
 
 struct vxl_zarr_codecs {
-    pthread_mutex_t lock; /* the first use of a library, from any reader thread */
+    vxl_mutex lock; /* the first use of a library, from any reader thread */
     vxl_dynlib *zstd, *blosc; /* NULL until needed */
     vxl_zstd_api zstd_api;
     vxl_blosc_api blosc_api;
@@ -30,7 +30,7 @@ struct vxl_zarr_codecs {
 vxl_zarr_codecs *vxl_zarr_codecs_new(void)
 {
     vxl_zarr_codecs *c = calloc(1, sizeof *c);
-    if (c && pthread_mutex_init(&c->lock, NULL)) {
+    if (c && vxl_mutex_init(&c->lock)) {
         free(c);
         return NULL;
     }
@@ -42,7 +42,7 @@ void vxl_zarr_codecs_free(vxl_zarr_codecs *c)
     if (!c) return;
     vxl_dynlib_close(c->zstd);
     vxl_dynlib_close(c->blosc);
-    pthread_mutex_destroy(&c->lock);
+    vxl_mutex_destroy(&c->lock);
     free(c);
 }
 
@@ -73,9 +73,9 @@ static const codec_library blosc_library = {VXL_BLOSC_SO, "VOXLIGHT_ZARR_LIBBLOS
 static int open_library(vxl_zarr_codecs *c, const codec_library *lib, vxl_dynlib **handle, vxl_dynlib_fn *table,
                         const char *chunk, vxl_err *e)
 {
-    pthread_mutex_lock(&c->lock);
+    vxl_mutex_lock(&c->lock);
     if (*handle) {
-        pthread_mutex_unlock(&c->lock);
+        vxl_mutex_unlock(&c->lock);
         return VXL_OK;
     }
     const char *so = library(lib->soname, lib->env);
@@ -86,7 +86,7 @@ static int open_library(vxl_zarr_codecs *c, const codec_library *lib, vxl_dynlib
         h = NULL;
     }
     *handle = h;
-    pthread_mutex_unlock(&c->lock);
+    vxl_mutex_unlock(&c->lock);
     if (!h)
         return vxl_fail(e, VXL_ERR_IO, "'%s': a %s-compressed chunk needs %s, which cannot be loaded (%s): apt-get "
                         "install %s", chunk, lib->codec, so, why, lib->package);

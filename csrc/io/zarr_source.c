@@ -24,7 +24,7 @@
  * apron they fall in: the same min-max vxl_bricks_minmax_cpu gives over the
  * whole level, so no visible brick is ever skipped. */
 #include <math.h>
-#include <pthread.h>
+#include "threads.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,7 +51,7 @@ typedef struct zarr_ctx {
     uint32_t dtype;
     double lo, inv;                       /* 32-bit texels: t = (value - lo) * inv, clamped */
     vxl_zarr_codecs *codecs;
-    pthread_mutex_t lock;                 /* the cache */
+    vxl_mutex lock;                 /* the cache */
     cache_slot slot[CACHE_SLOTS];
     uint64_t cache_cap, cache_bytes, tick;
 } zarr_ctx;
@@ -218,14 +218,14 @@ static int with_chunk(vxl_brick_source *s, uint32_t level, const uint64_t *idx, 
     zarr_ctx *c = s->ctx;
     const vxl_zarr_array *a = &c->store->level[c->array_of[level]];
     const uint32_t bpv = s->texture_bits / 8;
-    pthread_mutex_lock(&c->lock);
+    vxl_mutex_lock(&c->lock);
     cache_slot *hit = cache_find(c, level, idx, a->ndim);
     if (hit) {
         copy_box(c, a, idx, hit->data, ext, lo, hi, bpv, out);
-        pthread_mutex_unlock(&c->lock);
+        vxl_mutex_unlock(&c->lock);
         return VXL_OK;
     }
-    pthread_mutex_unlock(&c->lock);
+    vxl_mutex_unlock(&c->lock);
     const uint64_t nbytes = vxl_zarr_chunk_bytes(a);
     unsigned char *chunk = malloc((size_t)nbytes);
     if (!chunk)
@@ -236,10 +236,10 @@ static int with_chunk(vxl_brick_source *s, uint32_t level, const uint64_t *idx, 
         free(chunk);
         return rc;
     }
-    pthread_mutex_lock(&c->lock);
+    vxl_mutex_lock(&c->lock);
     copy_box(c, a, idx, chunk, ext, lo, hi, bpv, out);
     const int kept = !cache_find(c, level, idx, a->ndim) && cache_put(s, c, level, idx, a->ndim, chunk, nbytes);
-    pthread_mutex_unlock(&c->lock);
+    vxl_mutex_unlock(&c->lock);
     if (!kept) free(chunk);
     return VXL_OK;
 }
@@ -285,7 +285,7 @@ static void zarr_close(vxl_brick_source *s)
     if (!c) return;
     for (int i = 0; i < CACHE_SLOTS; i++) free(c->slot[i].data);
     vxl_zarr_codecs_free(c->codecs);
-    pthread_mutex_destroy(&c->lock);
+    vxl_mutex_destroy(&c->lock);
     free(c->store);
     free(c);
     s->ctx = NULL;
@@ -536,7 +536,7 @@ int vxl_zarr_open_source(const char *path, const vxl_load_options *opt, vxl_bric
     zarr_ctx *c = calloc(1, sizeof *c);
     vxl_zarr_store *st = calloc(1, sizeof *st);
     vxl_zarr_codecs *codecs = vxl_zarr_codecs_new();
-    if (!s || !c || !st || !codecs || pthread_mutex_init(&c->lock, NULL)) {
+    if (!s || !c || !st || !codecs || vxl_mutex_init(&c->lock)) {
         free(s);
         free(c);
         free(st);

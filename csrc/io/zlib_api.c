@@ -1,12 +1,12 @@
 /* zlib_api.c - zlib_api.h: libz.so.1 opened once per process.
  *
- * The table is process-wide and written exactly once (pthread_once), then
+ * The table is process-wide and written exactly once (vxl_once_run), then
  * only read: zlib's functions are the same for every caller, and a table
  * per volume or renderer would have to be threaded through every reader
  * that may meet a compressed file. The library handle is kept for the
  * process' life: a table's functions may be running on another thread. */
 #include <errno.h>
-#include <pthread.h>
+#include "threads.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,7 +27,7 @@ typedef struct zlib_state {
 } zlib_state;
 
 static zlib_state state;
-static pthread_once_t once = PTHREAD_ONCE_INIT;
+static vxl_once once = VXL_ONCE_INIT;
 
 static void load(void)
 {
@@ -52,7 +52,7 @@ static void load(void)
 
 const vxl_zlib *vxl_zlib_api(vxl_err *e)
 {
-    pthread_once(&once, load);
+    vxl_once_run(&once, load);
     if (state.ok) return &state.api;
     vxl_fail(e, VXL_ERR_IO, "compressed data needs zlib (%s), which cannot be loaded: %s", VXL_ZLIB_SO, state.why);
     return NULL;

@@ -7,7 +7,7 @@
  * more threads hold no more memory than the queue. */
 #include "brick_loader.h"
 
-#include <pthread.h>
+#include "threads.h"
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -20,11 +20,11 @@ struct vxl_brick_loader {
     vxl_brick_source *src;
     uint32_t brick, edge, bpv;
     size_t brick_bytes;
-    pthread_t threads[MAX_THREADS];
+    vxl_thread threads[MAX_THREADS];
     uint32_t n_threads;
-    pthread_mutex_t lock;
-    pthread_cond_t work;    /* the loaders wait here for wanted bricks or free buffers */
-    pthread_cond_t arrived; /* the renderer waits here for read bricks */
+    vxl_mutex lock;
+    vxl_cond work;    /* the loaders wait here for wanted bricks or free buffers */
+    vxl_cond arrived; /* the renderer waits here for read bricks */
     vxl_brick_key *want;
     uint32_t n_want, want_cap, next;
     vxl_loaded_brick *done; /* a ring of queue_bricks */
@@ -118,22 +118,22 @@ static uint32_t sort_coming(vxl_brick_loader *l)
 static void *loop(void *p)
 {
     vxl_brick_loader *l = p;
-    pthread_mutex_lock(&l->lock);
+    vxl_mutex_lock(&l->lock);
     for (;;) {
-        while (!l->stop && (l->next == l->n_want || !can_allocate(l) || l->rc)) pthread_cond_wait(&l->work, &l->lock);
+        while (!l->stop && (l->next == l->n_want || !can_allocate(l) || l->rc)) vxl_cond_wait(&l->work, &l->lock);
         if (l->stop) break;
         const vxl_brick_key k = l->want[l->next++];
         uint8_t *buf = buffer(l);
         if (!buf) {
             l->rc = vxl_fail(&l->err, VXL_ERR_NO_MEMORY, "out of memory for a %zu-byte brick staging buffer", l->brick_bytes);
-            pthread_cond_broadcast(&l->arrived);
+            vxl_cond_broadcast(&l->arrived);
             continue;
         }
         l->reading[l->busy++] = k;
-        pthread_mutex_unlock(&l->lock);
+        vxl_mutex_unlock(&l->lock);
         vxl_err e = {0};
         int rc = read_brick(l, k, buf, &e);
-        pthread_mutex_lock(&l->lock);
+        vxl_mutex_lock(&l->lock);
         for (uint32_t i = 0; i < l->busy; i++) /* drop k from what is being read */
             if (same_key(l->reading[i], k)) {
                 l->reading[i] = l->reading[--l->busy];
@@ -148,9 +148,9 @@ static void *loop(void *p)
         } else {
             l->done[(l->done_head + l->done_count++) % l->queue_bricks] = (vxl_loaded_brick){k, buf};
         }
-        pthread_cond_broadcast(&l->arrived);
+        vxl_cond_broadcast(&l->arrived);
     }
-    pthread_mutex_unlock(&l->lock);
+    vxl_mutex_unlock(&l->lock);
     return NULL;
 }
 
@@ -201,15 +201,15 @@ int vxl_loader_start_threads(vxl_brick_loader **out, vxl_brick_source *src, uint
         free_loader(l);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the brick loader's queue");
     }
-    pthread_mutex_init(&l->lock, NULL);
-    pthread_cond_init(&l->work, NULL);
-    pthread_cond_init(&l->arrived, NULL);
+    vxl_mutex_init(&l->lock);
+    vxl_cond_init(&l->work);
+    vxl_cond_init(&l->arrived);
     const uint32_t want = threads_for(n_threads, l->queue_bricks);
-    while (l->n_threads < want && !pthread_create(&l->threads[l->n_threads], NULL, loop, l)) l->n_threads++;
+    while (l->n_threads < want && !vxl_thread_start(&l->threads[l->n_threads], loop, l)) l->n_threads++;
     if (!l->n_threads) {
-        pthread_cond_destroy(&l->work);
-        pthread_cond_destroy(&l->arrived);
-        pthread_mutex_destroy(&l->lock);
+        vxl_cond_destroy(&l->work);
+        vxl_cond_destroy(&l->arrived);
+        vxl_mutex_destroy(&l->lock);
         free_loader(l);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot start the brick loader thread");
     }
@@ -220,14 +220,14 @@ int vxl_loader_start_threads(vxl_brick_loader **out, vxl_brick_source *src, uint
 void vxl_loader_stop(vxl_brick_loader *l)
 {
     if (!l) return;
-    pthread_mutex_lock(&l->lock);
+    vxl_mutex_lock(&l->lock);
     l->stop = 1;
-    pthread_cond_broadcast(&l->work);
-    pthread_mutex_unlock(&l->lock);
-    for (uint32_t i = 0; i < l->n_threads; i++) pthread_join(l->threads[i], NULL); /* after the reads in progress */
-    pthread_cond_destroy(&l->work);
-    pthread_cond_destroy(&l->arrived);
-    pthread_mutex_destroy(&l->lock);
+    vxl_cond_broadcast(&l->work);
+    vxl_mutex_unlock(&l->lock);
+    for (uint32_t i = 0; i < l->n_threads; i++) vxl_thread_join(l->threads[i]); /* after the reads in progress */
+    vxl_cond_destroy(&l->work);
+    vxl_cond_destroy(&l->arrived);
+    vxl_mutex_destroy(&l->lock);
     free_loader(l);
 }
 
@@ -238,7 +238,7 @@ uint64_t vxl_loader_bytes(const vxl_brick_loader *l)
 
 int vxl_loader_want(vxl_brick_loader *l, const vxl_brick_key *keys, uint32_t n, vxl_err *e)
 {
-    pthread_mutex_lock(&l->lock);
+    vxl_mutex_lock(&l->lock);
     int rc = VXL_OK;
     if (n > l->want_cap) {
         vxl_brick_key *w = realloc(l->want, (size_t)n * sizeof *w);
@@ -256,43 +256,43 @@ int vxl_loader_want(vxl_brick_loader *l, const vxl_brick_key *keys, uint32_t n, 
             if (!c || !bsearch(&keys[i], l->coming, c, sizeof *l->coming, key_order)) l->want[m++] = keys[i];
         l->n_want = m;
         l->next = 0;
-        pthread_cond_broadcast(&l->work);
+        vxl_cond_broadcast(&l->work);
     }
-    pthread_mutex_unlock(&l->lock);
+    vxl_mutex_unlock(&l->lock);
     return rc;
 }
 
 uint32_t vxl_loader_take(vxl_brick_loader *l, vxl_loaded_brick *out, uint32_t max, int wait)
 {
-    pthread_mutex_lock(&l->lock);
+    vxl_mutex_lock(&l->lock);
     while (wait && !l->done_count && !l->rc && (l->busy || (l->next < l->n_want && can_allocate(l))))
-        pthread_cond_wait(&l->arrived, &l->lock);
+        vxl_cond_wait(&l->arrived, &l->lock);
     uint32_t n = 0;
     for (; n < max && l->done_count; n++, l->done_count--) {
         out[n] = l->done[l->done_head];
         l->done_head = (l->done_head + 1) % l->queue_bricks;
     }
-    pthread_mutex_unlock(&l->lock);
+    vxl_mutex_unlock(&l->lock);
     return n;
 }
 
 void vxl_loader_recycle(vxl_brick_loader *l, const vxl_loaded_brick *b, uint32_t n)
 {
-    pthread_mutex_lock(&l->lock);
+    vxl_mutex_lock(&l->lock);
     for (uint32_t i = 0; i < n; i++) l->spare[l->n_spare++] = b[i].texels;
-    if (n) pthread_cond_broadcast(&l->work);
-    pthread_mutex_unlock(&l->lock);
+    if (n) vxl_cond_broadcast(&l->work);
+    vxl_mutex_unlock(&l->lock);
 }
 
 int vxl_loader_error(vxl_brick_loader *l, vxl_err *e)
 {
-    pthread_mutex_lock(&l->lock);
+    vxl_mutex_lock(&l->lock);
     const int rc = l->rc;
     if (rc) {
         vxl_fail(e, rc, "%s", l->err.msg);
         l->rc = 0;
         l->n_want = l->next = 0; /* the next frame says what it still wants */
     }
-    pthread_mutex_unlock(&l->lock);
+    vxl_mutex_unlock(&l->lock);
     return rc;
 }

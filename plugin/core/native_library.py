@@ -12,9 +12,10 @@ import numpy as np
 from .native_abi import (ABI_VERSION, ENUM_FALLBACKS, FILTERS, DicomSeries, LabelEntry,
                          LibraryUnavailable, LoadOptions, PhantomDesc, RendererInfo, RendererOptions, RenderParams,
                          RenderStats, SliceParams, VolumeDesc, VolumeInfo, VoxlightError, _fptr)
+from . import platform_rules
 from .native_private_copy import helper_names, private_copy, restore_execute_bit
 
-LIBRARY_NAME = "libvoxlight.so"
+LIBRARY_NAME = platform_rules.current().library  # libvoxlight.so, voxlight.dll
 
 
 def candidate_paths(explicit=None):

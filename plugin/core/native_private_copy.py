@@ -5,12 +5,13 @@ Blender's zip install drops from the helpers.
 Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
 import errno
-import fcntl
 import hashlib
 import os
 import shutil
 import tempfile
 import time
+
+from . import platform_rules
 
 # The reader processes the library starts, found next to the library itself
 # (csrc/io/reader_spawn.c, csrc/io/reader_stream.h): voxlight-read-oiio (TIFF/PNG
@@ -30,21 +31,23 @@ OLD_VDB_HELPER_NAME = "voxlight-vdb-read"  # its name in older builds
 # it starts from its own folder (found with dladdr, csrc/io/reader_spawn.c). An
 # updated add-on has another hash, hence a new folder and a fresh dlopen
 # (dlopen of the old path would hand back the old, already loaded library).
-# Each process holds a shared flock on the folder it uses; a folder nobody
-# holds is stale and removed by the next load.
+# Each process holds the folder it uses (platform_rules: a shared flock, or
+# on Windows the lock file kept open); a folder nobody holds is stale and
+# removed by the next load.
 
 _LOCK_NAME = ".in-use"
 _held_locks = {}  # folder -> open lock file, kept for the life of the process
 
 
-def helper_names(folder):
+def helper_names(folder, rules=None):
     """The helper executables shipped next to the library in folder."""
+    rules = rules or platform_rules.current()
     try:
         names = os.listdir(folder)
     except OSError:
         return []
     return sorted(n for n in names
-                  if (n.startswith(HELPER_PREFIX) or n == OLD_VDB_HELPER_NAME)
+                  if (rules.is_helper(n, HELPER_PREFIX) or n == OLD_VDB_HELPER_NAME)
                   and os.path.isfile(os.path.join(folder, n)))
 
 
@@ -53,17 +56,18 @@ def helper_names(folder):
 CACHE_DIR = None
 
 
-def cache_roots():
+def cache_roots(rules=None, environ=None):
     """Where private copies may go, best first: VOXLIGHT_CACHE_DIR, the
-    add-on's own folder (CACHE_DIR), the XDG cache folder, then the
-    temporary folder."""
+    add-on's own folder (CACHE_DIR), the user's cache folder (XDG's, or
+    Windows' local application data), then the temporary folder."""
+    rules = rules or platform_rules.current()
+    environ = os.environ if environ is None else environ
     roots = []
-    for d in (os.environ.get("VOXLIGHT_CACHE_DIR"), CACHE_DIR):
+    for d in (environ.get("VOXLIGHT_CACHE_DIR"), CACHE_DIR):
         if d:
             roots.append(d)
-    xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    roots.append(os.path.join(xdg, "voxlight", "lib"))
-    roots.append(os.path.join(tempfile.gettempdir(), "voxlight-%d" % os.getuid(), "lib"))
+    roots.append(rules.path.join(rules.cache_base(environ), "voxlight", "lib"))
+    roots.append(platform_rules.temp_root(rules))
     return roots
 
 
@@ -78,25 +82,15 @@ def _content_key(files):
     return h.hexdigest()[:24]
 
 
-def _hold(folder):
-    """Take a shared lock on folder's lock file; False when the folder went
-    away meanwhile (a cleaner removed it)."""
+def _hold(folder, rules):
+    """Mark folder in use for this process's life; False when the folder
+    went away meanwhile (a cleaner removed it)."""
     if folder in _held_locks:
         return True
-    lock = os.path.join(folder, _LOCK_NAME)
-    try:
-        fd = os.open(lock, os.O_RDONLY)
-    except OSError:
+    handle = rules.hold(os.path.join(folder, _LOCK_NAME))
+    if handle is None:
         return False
-    try:
-        fcntl.flock(fd, fcntl.LOCK_SH)
-        st, held = os.stat(lock), os.fstat(fd)
-        if (st.st_dev, st.st_ino) != (held.st_dev, held.st_ino):
-            raise OSError(errno.ESTALE, "%s was replaced" % lock)
-    except OSError:
-        os.close(fd)
-        return False
-    _held_locks[folder] = fd
+    _held_locks[folder] = handle
     return True
 
 
@@ -106,11 +100,11 @@ def _complete(folder, files):
                for f in files)
 
 
-def _make_copy(root, key, files):
+def _make_copy(root, key, files, rules):
     """root/key holding a copy of files (made atomically by renaming a
     finished folder into place); returns the folder."""
     folder = os.path.join(root, key)
-    if os.path.isdir(folder) and _complete(folder, files) and _hold(folder):
+    if os.path.isdir(folder) and _complete(folder, files) and _hold(folder, rules):
         return folder
     os.makedirs(root, exist_ok=True)
     stage = tempfile.mkdtemp(prefix=".stage-", dir=root)
@@ -125,7 +119,7 @@ def _make_copy(root, key, files):
         except OSError:
             # Another process put it in place first, or a broken copy is in
             # the way: use this process's own copy under another name.
-            if os.path.isdir(folder) and _complete(folder, files) and _hold(folder):
+            if os.path.isdir(folder) and _complete(folder, files) and _hold(folder, rules):
                 shutil.rmtree(stage, ignore_errors=True)
                 return folder
             folder = "%s-%d" % (folder, os.getpid())
@@ -134,14 +128,15 @@ def _make_copy(root, key, files):
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
-    if not _hold(folder):
+    if not _hold(folder, rules):
         raise OSError(errno.ENOENT, "%s vanished" % folder)
     return folder
 
 
-def clean_stale_copies(root):
-    """Remove copies no process holds (their flock is free). Safe while
-    other Blenders run: a held folder is never touched."""
+def clean_stale_copies(root, rules=None):
+    """Remove copies no process holds. Safe while other Blenders run: a
+    held folder is never touched."""
+    rules = rules or platform_rules.current()
     try:
         names = os.listdir(root)
     except OSError:
@@ -158,45 +153,43 @@ def clean_stale_copies(root):
             except OSError:
                 pass
             continue
-        try:
-            fd = os.open(os.path.join(folder, _LOCK_NAME), os.O_RDONLY)
-        except OSError:
+        lock = os.path.join(folder, _LOCK_NAME)
+        if not os.path.isfile(lock):
             continue  # not ours (no lock file): leave it
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
+        claim = rules.claim_unused(lock)
+        if claim is None:
             continue  # in use by a running process
         try:
-            # Unlink the lock file last, so that a loader that opened it
-            # before the removal sees it gone (_hold compares inodes).
+            # The lock file goes last, so that a loader that opened it
+            # before the removal sees it gone (rules.hold).
             for entry in os.listdir(folder):
                 if entry != _LOCK_NAME:
                     os.unlink(os.path.join(folder, entry))
-            os.unlink(os.path.join(folder, _LOCK_NAME))
+            rules.remove_lock(lock)
             os.rmdir(folder)
         except OSError:
             pass
         finally:
-            os.close(fd)
+            rules.release_claim(claim)
 
 
-def private_copy(path):
+def private_copy(path, rules=None):
     """The path of a private copy of the library at path, with the helpers
     that sit next to it, or None when no cache folder is writable (the
     library is then loaded in place)."""
+    rules = rules or platform_rules.current()
     src = os.path.dirname(os.path.abspath(path))
-    files = [os.path.abspath(path)] + [os.path.join(src, n) for n in helper_names(src)]
+    files = [os.path.abspath(path)] + [os.path.join(src, n) for n in helper_names(src, rules)]
     try:
         key = _content_key(files)
     except OSError:
         return None
-    for root in cache_roots():
+    for root in cache_roots(rules):
         try:
-            folder = _make_copy(root, key, files)
+            folder = _make_copy(root, key, files, rules)
         except OSError:
             continue
-        clean_stale_copies(root)
+        clean_stale_copies(root, rules)
         return os.path.join(folder, os.path.basename(path))
     return None
 

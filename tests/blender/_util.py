@@ -39,7 +39,7 @@ def zip_path():
     build = os.environ.get("BUILD", "build")
     if not os.path.isabs(build):
         build = os.path.join(ROOT, build)
-    return os.environ.get("VOXLIGHT_ZIP", os.path.join(build, "voxlight-blender.zip"))
+    return os.environ.get("VOXLIGHT_ZIP", os.path.join(build, "voxlight-linux-x64.zip"))
 
 
 # The add-on's module name: "voxlight" as a legacy add-on (3.x),

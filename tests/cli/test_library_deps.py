@@ -47,8 +47,13 @@ def glibc_versions(path):
     return {tuple(int(p) for p in v.split(".")) for v in re.findall(r"GLIBC_(\d+\.\d+(?:\.\d+)?)", out)}
 
 
-def test_library_and_cli_need_no_glibc_newer_than_blenders():
-    for path in (LIB, CLI):
+def test_library_cli_and_zarr_helper_need_no_glibc_newer_than_blenders():
+    """The OpenImageIO and dcmtk helpers link Debian's libraries and are
+    exempt: on an older system they refuse with a message
+    (test_reader_helpers.py, test_a_helper_too_new_for_the_systems_glibc_says_so)."""
+    zarr = BUILD / "voxlight-read-zarr"
+    assert [n for n in needed(zarr) if not ALLOWED.match(n)] == []
+    for path in (LIB, CLI, zarr):
         versions = glibc_versions(path)
         assert versions, path  # the parse found the versions at all
         newer = sorted(v for v in versions if v[:2] > BASELINE)

@@ -90,6 +90,26 @@ def test_a_missing_library_names_its_package_and_breaks_only_its_format(inputs, 
             loads(other, inputs, env)
 
 
+@pytest.mark.parametrize("fmt, env_name, helper, needs", [
+    ("stack", "VOXLIGHT_READ_OIIO", "voxlight-read-oiio", "TIFF/PNG stacks need OpenImageIO"),
+    ("dicom", "VOXLIGHT_READ_DICOM", "voxlight-read-dicom", "DICOM series need dcmtk"),
+])
+def test_a_helper_too_new_for_the_systems_glibc_says_so(inputs, tmp_path, fmt, env_name, helper, needs):
+    """On an older Linux (glibc 2.28, where the library itself runs) the
+    dynamic loader refuses the Debian-built helper with its own words; the
+    user gets one line naming the formats and why, and the rest loads."""
+    msg = ("%s: /lib64/libc.so.6: version `GLIBC_2.34' not found (required by %s)" % (helper, helper))
+    env = {env_name: fake_helper(tmp_path, helper, "cat >&2 <<'EOF'\n%s\nEOF\nexit 1" % msg)}
+    r = run("info", inputs[fmt], env=env)
+    assert r.returncode != 0
+    assert "%s, and the helper %s was built for a newer Linux than this one (it needs GLIBC_2.34)" % (
+        needs, helper) in r.stderr, r.stderr
+    assert len([ln for ln in r.stderr.splitlines() if ln.strip()]) == 1, r.stderr
+    for other in inputs:
+        if other != fmt:
+            loads(other, inputs, env)
+
+
 def test_the_real_loader_message_for_a_missing_library(inputs, tmp_path):
     """The DICOM helper with its NEEDED entry renamed to a file that does not
     exist: the dynamic loader itself refuses to start it."""

@@ -104,6 +104,6 @@ def test_stale_copies_go_and_held_ones_stay(addon_dir, tmp_path):
 
 
 def test_unwritable_cache_falls_back_to_loading_in_place(addon_dir, tmp_path, monkeypatch):
-    monkeypatch.setattr(native, "cache_roots", lambda: [str(tmp_path / "file" / "x")])
+    monkeypatch.setattr(native, "cache_roots", lambda *a: [str(tmp_path / "file" / "x")])
     (tmp_path / "file").write_text("not a folder")
     assert native.private_copy(str(addon_dir / "libvoxlight.so")) is None

@@ -42,4 +42,7 @@ void *vxl_tls_get(vxl_tls key);
 int vxl_tls_set(vxl_tls key, void *value);
 void vxl_tls_delete(vxl_tls key);
 
+/* The processors online, at least 1. */
+unsigned vxl_cpu_count(void);
+
 #endif

@@ -1,6 +1,8 @@
 /* threads_posix.c - threads.h with POSIX threads. */
 #include "threads.h"
 
+#include <unistd.h>
+
 int vxl_mutex_init(vxl_mutex *m) { return pthread_mutex_init(m, NULL); }
 void vxl_mutex_lock(vxl_mutex *m) { pthread_mutex_lock(m); }
 void vxl_mutex_unlock(vxl_mutex *m) { pthread_mutex_unlock(m); }
@@ -20,3 +22,9 @@ int vxl_tls_create(vxl_tls *key, void (*dtor)(void *)) { return pthread_key_crea
 void *vxl_tls_get(vxl_tls key) { return pthread_getspecific(key); }
 int vxl_tls_set(vxl_tls key, void *value) { return pthread_setspecific(key, value); }
 void vxl_tls_delete(vxl_tls key) { pthread_key_delete(key); }
+
+unsigned vxl_cpu_count(void)
+{
+    const long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1u : (unsigned)n;
+}

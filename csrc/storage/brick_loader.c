@@ -10,7 +10,6 @@
 #include "threads.h"
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "paging.h"
 
@@ -170,8 +169,8 @@ static void free_loader(vxl_brick_loader *l)
 static uint32_t threads_for(uint32_t n, uint32_t queue_bricks)
 {
     if (!n) {
-        const long cores = sysconf(_SC_NPROCESSORS_ONLN);
-        n = cores < 1 ? 1 : cores > MAX_THREADS ? MAX_THREADS : (uint32_t)cores;
+        const unsigned cores = vxl_cpu_count();
+        n = cores > MAX_THREADS ? MAX_THREADS : cores;
     }
     if (n > MAX_THREADS) n = MAX_THREADS;
     return n < queue_bricks ? n : queue_bricks;

@@ -58,7 +58,10 @@ SHADERS := $(wildcard shaders/lib/*.glsl shaders/compute/*.comp shaders/render/*
 OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_embedded.o
 # What the helpers' readers use of the core (volume building, errors, file
 # helpers), linked into each helper, which needs no libvoxlight.so.
-HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume brick_source error loader_util zlib_api dynlib_posix threads_posix)
+# The platform room's files for this OS (csrc/platform/), for whatever links
+# library objects without the library.
+PLATFORM := dynlib_posix threads_posix files_posix
+HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume brick_source error loader_util zlib_api $(PLATFORM))
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
@@ -177,14 +180,14 @@ $(BUILD)/voxlight-sceneshadowbench: bench/scene_shadow_study.c bench/bench_util.
 # links their objects and those its checks compare against, as well as the library.
 BRICK_CACHE_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,brick_cache brick_cache_read brick_cache_write \
 	brick_cache_format brick_source brick_levels bricks volume error paging lod brick_loader loader_util zlib_api \
-	dynlib_posix threads_posix crc32)
+	$(PLATFORM) crc32)
 $(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wildcard tests/*.h) $(BRICK_CACHE_TEST_OBJ) \
 		$(BUILD)/libvoxlight.so | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(BRICK_CACHE_TEST_OBJ) -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
 
 # test_gl_thread checks the GL thread's shared lock (internal), so it links
 # the thread and context objects; the backends come with context.o.
-GL_THREAD_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gl_thread context backend_osmesa backend_egl error dynlib_posix threads_posix)
+GL_THREAD_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gl_thread context backend_osmesa backend_egl error $(PLATFORM))
 $(BUILD)/tests/test_gl_thread: tests/test_gl_thread.c tests/harness.h $(GL_THREAD_TEST_OBJ) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(GL_THREAD_TEST_OBJ) -o $@ -ldl -lpthread
 
@@ -214,7 +217,7 @@ FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_u
 # the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
-	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c dynlib_posix.c threads_posix.c crc32.c)
+	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c crc32.c $(PLATFORM:%=%.c))
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))

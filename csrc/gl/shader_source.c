@@ -1,5 +1,6 @@
 /* shader_source.c - assembles GLSL programs from the shader files. */
 #include "shader_source.h"
+#include "files.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -51,7 +52,7 @@ static const char *find_text(assembler *a, const char *name)
     if (a->n_owned >= MAX_INCLUDED) return NULL;
     char path[1024];
     snprintf(path, sizeof path, "%s/%s", a->dir, name);
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = vxl_fopen(path, "rb");
     if (!fp) return NULL;
     strbuf b = {0};
     char chunk[4096];

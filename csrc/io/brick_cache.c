@@ -4,15 +4,13 @@
  * detects is rebuilt, never trusted; the rebuild replaces it by rename, so
  * readers of the old file keep their own copy. */
 #include "brick_cache.h"
+#include "files.h"
 
 #include <errno.h>
-#include <limits.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "hash.h"
 
@@ -27,12 +25,10 @@ static int make_dirs(const char *dir)
     for (char *c = p + 1; *c; c++)
         if (*c == '/') {
             *c = 0;
-            if (mkdir(p, 0755) != 0 && errno != EEXIST) return -1;
+            if (vxl_mkdir(p) != 0) return -1;
             *c = '/';
         }
-    if (mkdir(p, 0755) != 0 && errno != EEXIST) return -1;
-    struct stat st;
-    return stat(p, &st) == 0 && S_ISDIR(st.st_mode) ? 0 : -1;
+    return vxl_mkdir(p);
 }
 
 /* A cache in a shared folder is named by the source's base name and a hash
@@ -42,8 +38,8 @@ static int shared_name(const char *dir, const vxl_raw_layout *l, const char *bas
 {
     if (make_dirs(dir) != 0)
         return vxl_fail(e, VXL_ERR_IO, "cannot create the cache folder %s: %s", dir, strerror(errno));
-    char abs[PATH_MAX];
-    const char *key = realpath(l->path, abs) ? abs : l->path;
+    char abs[4096];
+    const char *key = vxl_real_path(l->path, abs, sizeof abs) ? abs : l->path;
     uint64_t h = vxl_fnv(14695981039346656037ull, key, strlen(key));
     if (snprintf(out, n, "%s/%s-%016llx%s.vxlcache", dir, base, (unsigned long long)h, suffix) >= (int)n)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "the cache path in %s is too long", dir);
@@ -64,7 +60,7 @@ static int cache_path(const vxl_raw_layout *l, const vxl_load_options *opt, char
     char dir[4096];
     if (slash) snprintf(dir, sizeof dir, "%.*s", (int)(slash - l->path) ? (int)(slash - l->path) : 1, l->path);
     else snprintf(dir, sizeof dir, ".");
-    if (access(dir, W_OK) == 0) {
+    if (vxl_dir_writable(dir)) {
         if (snprintf(out, n, "%s/%s%s.vxlcache", dir, base, suffix) >= (int)n)
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "the cache path beside %s is too long", l->path);
         return VXL_OK;

@@ -7,14 +7,12 @@
  * removed so the next open rebuilds it. */
 #define _FILE_OFFSET_BITS 64
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include "threads.h"
+#include "files.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "brick_cache.h"
 #include "brick_cache_format.h"
@@ -142,20 +140,20 @@ int vxl_brick_cache_read_open(const char *path, const vxl_raw_layout *l, uint32_
     vxl_mutex_init(&c->lock);
     snprintf(c->path, sizeof c->path, "%s", path);
     int rc = VXL_OK;
-    struct stat st;
+    vxl_path_info st;
     uint8_t head[VXL_CACHE_HEADER_BYTES];
-    /* O_NONBLOCK: a FIFO in the cache's place must not hang the open */
-    if ((c->fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK)) < 0 || fstat(c->fd, &st) != 0)
+    /* nonblocking: a FIFO in the cache's place must not hang the open */
+    if ((c->fd = vxl_file_open_read(path, 1)) < 0 || vxl_file_stat(c->fd, &st) != 0)
         rc = vxl_fail(e, VXL_ERR_IO, "cannot open the brick cache %s: %s", path, strerror(errno));
-    else if (!S_ISREG(st.st_mode))
+    else if (st.kind != VXL_PATH_FILE)
         rc = vxl_fail(e, VXL_ERR_FORMAT, "brick cache %s is not a regular file", path);
-    else if ((uint64_t)st.st_size < VXL_CACHE_HEADER_BYTES || pread_all(c->fd, head, sizeof head, 0) != 0)
+    else if (st.size < VXL_CACHE_HEADER_BYTES || pread_all(c->fd, head, sizeof head, 0) != 0)
         rc = damaged(path, e, "shorter than its header");
     if (!rc) rc = vxl_cache_header_decode(head, &c->h, path, e);
     if (!rc && l && !vxl_cache_header_matches(&c->h, l))
         rc = vxl_fail(e, VXL_ERR_FORMAT, "brick cache %s was made from another version of %s (size, time or header differ)",
                       path, l->path);
-    if (!rc) rc = vxl_cache_header_check(&c->h, (uint64_t)st.st_size, max_dim, &c->g, path, e);
+    if (!rc) rc = vxl_cache_header_check(&c->h, st.size, max_dim, &c->g, path, e);
     if (!rc) rc = load_index(c, &s->minmax, e);
     if (!rc) rc = load_table(c, e);
     if (rc) {
@@ -188,7 +186,7 @@ static int load_brick(vxl_brick_source *s, uint32_t L, uint64_t i, uint8_t *dst,
         rc = vxl_fail(e, VXL_ERR_IO, "cannot read brick %llu of the brick cache %s: %s", (unsigned long long)id,
                       c->path, errno ? strerror(errno) : "the file is shorter than its table says");
     else if (vxl_crc32(0, stored, en->size) != en->crc) {
-        unlink(c->path); /* never trusted again: the next open rebuilds it */
+        vxl_remove(c->path); /* never trusted again: the next open rebuilds it */
         rc = vxl_fail(e, VXL_ERR_FORMAT,
                       "brick cache %s is damaged (brick %llu of level %u fails its checksum); it was removed and the "
                       "next open rebuilds it",
@@ -315,7 +313,7 @@ static void cache_close(vxl_brick_source *s)
 {
     cache_ctx *c = s->ctx;
     if (!c) return;
-    if (c->fd >= 0) close(c->fd);
+    vxl_file_close(c->fd);
     for (int k = 0; k < LRU_SLOTS; k++) free(c->lru[k].data);
     free(c->table);
     vxl_mutex_destroy(&c->lock);

@@ -21,15 +21,13 @@
  * and renamed into place; a failure or a cancel unlinks it. */
 #define _FILE_OFFSET_BITS 64
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include "crc32.h"
+#include "files.h"
 #include "zlib_api.h"
 
 #include "brick_cache.h"
@@ -154,13 +152,13 @@ static int open_source(writer *w, zsrc *s)
 {
     memset(s, 0, sizeof *s);
     s->zl = w->zl;
-    s->f = fopen(w->l->path, "rb");
+    s->f = vxl_fopen(w->l->path, "rb");
     if (!s->f) return vxl_fail(w->e, VXL_ERR_IO, "cannot open %s: %s", w->l->path, strerror(errno));
     if (!(s->in = malloc(IN_CHUNK))) {
         close_source(s);
         return vxl_fail(w->e, VXL_ERR_NO_MEMORY, "out of memory reading %s", w->l->path);
     }
-    if (w->l->compressed_start > (uint64_t)INT64_MAX || fseeko(s->f, (off_t)w->l->compressed_start, SEEK_SET) != 0) {
+    if (vxl_fseek(s->f, w->l->compressed_start) != 0) {
         close_source(s);
         return vxl_fail(w->e, VXL_ERR_FORMAT, "%s: no compressed data at byte %llu", w->l->path,
                         (unsigned long long)w->l->compressed_start);
@@ -473,9 +471,9 @@ static int finish(writer *w)
     h->table_crc = crc;
     uint8_t head[VXL_CACHE_HEADER_BYTES];
     vxl_cache_header_encode(h, head);
-    if (fflush(w->f) != 0 || fseeko(w->f, 0, SEEK_SET) != 0) return fail_io(w, "seek");
+    if (fflush(w->f) != 0 || vxl_fseek(w->f, 0) != 0) return fail_io(w, "seek");
     if (fwrite(head, 1, sizeof head, w->f) != sizeof head || fflush(w->f) != 0) return fail_io(w, "write");
-    if (fsync(fileno(w->f)) != 0) return fail_io(w, "fsync");
+    if (vxl_fsync(w->f) != 0) return fail_io(w, "fsync");
     return VXL_OK;
 }
 
@@ -591,18 +589,13 @@ int vxl_brick_cache_write(const vxl_raw_layout *l, const vxl_load_options *opt, 
     }
     char tmp[4200];
     snprintf(tmp, sizeof tmp, "%s.tmp-XXXXXX", cache_path);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
+    w.f = vxl_temp_file(tmp);
+    if (!w.f) {
         rc = vxl_fail(e, VXL_ERR_IO, "cannot create the brick cache %s: %s", tmp, strerror(errno));
         release(&w);
         return rc;
     }
-    fchmod(fd, 0644);
-    w.f = fdopen(fd, "wb");
-    if (!w.f) {
-        rc = fail_io(&w, "fdopen");
-        close(fd);
-    } else {
+    {
         setvbuf(w.f, NULL, _IOFBF, 1u << 20);
         static const uint8_t zero[VXL_CACHE_HEADER_BYTES];
         rc = write_bytes(&w, zero, sizeof zero); /* the header, written last */
@@ -618,8 +611,8 @@ int vxl_brick_cache_write(const vxl_raw_layout *l, const vxl_load_options *opt, 
         if (!rc) rc = finish(&w);
         if (fclose(w.f) != 0 && !rc) rc = fail_io(&w, "close");
     }
-    if (!rc && rename(tmp, cache_path) != 0) rc = vxl_fail(e, VXL_ERR_IO, "cannot rename %s to %s: %s", tmp, cache_path, strerror(errno));
-    if (rc) unlink(tmp); /* never a half cache */
+    if (!rc && vxl_rename(tmp, cache_path) != 0) rc = vxl_fail(e, VXL_ERR_IO, "cannot rename %s to %s: %s", tmp, cache_path, strerror(errno));
+    if (rc) vxl_remove(tmp); /* never a half cache */
     release(&w);
     return rc;
 }

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "crc32.h"
+#include "files.h"
 #include "zlib_api.h"
 
 #include "error.h"
@@ -428,7 +429,7 @@ VXL_API int vxl_write_image(const char *path, const float *rgba, const float *de
         return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "write_image: %s: use a .png or .exr name", path);
     const vxl_zlib *z = vxl_zlib_api(NULL);
     if (!z) return VXL_ERR_IO;
-    out_file o = {z, fopen(path, "wb"), path, 0};
+    out_file o = {z, vxl_fopen(path, "wb"), path, 0};
     if (!o.f) return vxl_fail(NULL, VXL_ERR_IO, "write_image: cannot open %s for writing: %s", path, strerror(errno));
     int rc = exr ? write_exr(&o, rgba, depth, w, h) : write_png(&o, rgba, w, h);
     if (fclose(o.f) != 0 && !o.err) o.err = errno ? errno : EIO;

@@ -17,9 +17,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/stat.h>
 
 #include "error.h"
+#include "files.h"
 #include "loader_util.h"
 #include "voxlight.h"
 
@@ -48,11 +48,7 @@ typedef struct label_rows {
 
 /* Whether path names a regular file; unlike vxl_regular_file it records no
  * error, since a missing companion file is not one. */
-static int is_regular_file(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
-}
+static int is_regular_file(const char *path) { return vxl_is_file(path); }
 
 static int has_suffix(const char *s, const char *suffix)
 {

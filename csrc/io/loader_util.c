@@ -1,5 +1,6 @@
 /* loader_util.c - see loader_util.h. */
 #include "loader_util.h"
+#include "files.h"
 
 #include <errno.h>
 #include <stddef.h>
@@ -7,8 +8,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include "zlib_api.h"
 
 #define IO_CHUNK (256u * 1024u)
@@ -22,7 +21,7 @@ int64_t vxl_pread_full(int fd, void *buf, size_t n, uint64_t off)
 {
     size_t got = 0;
     while (got < n) {
-        ssize_t r = pread(fd, (uint8_t *)buf + got, n - got, (off_t)(off + got));
+        int64_t r = vxl_file_pread(fd, (uint8_t *)buf + got, n - got, off + got);
         if (r < 0 && errno == EINTR) continue;
         if (r < 0) return -1;
         if (r == 0) break;
@@ -33,11 +32,11 @@ int64_t vxl_pread_full(int fd, void *buf, size_t n, uint64_t off)
 
 int vxl_regular_file(const char *path, uint64_t *size, vxl_err *e)
 {
-    struct stat st;
-    if (stat(path, &st) != 0) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
-    if (!S_ISREG(st.st_mode))
+    vxl_path_info st;
+    if (vxl_path_stat(path, &st) != 0) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    if (st.kind != VXL_PATH_FILE)
         return vxl_fail(e, VXL_ERR_IO, "'%s' is not a regular file", path);
-    if (size) *size = st.st_size > 0 ? (uint64_t)st.st_size : 0;
+    if (size) *size = st.size;
     return VXL_OK;
 }
 
@@ -49,7 +48,7 @@ int vxl_read_head(const char *path, char **text, size_t *len, uint64_t *file_siz
     int rc = vxl_regular_file(path, &size, e);
     if (rc) return rc;
     if (file_size) *file_size = size;
-    FILE *f = fopen(path, "rb");
+    FILE *f = vxl_fopen(path, "rb");
     if (!f) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
     size_t want = size < VXL_HEADER_MAX ? (size_t)size : VXL_HEADER_MAX;
     char *buf = malloc(want + 1);
@@ -312,9 +311,9 @@ int vxl_read_payload(const char *path, uint64_t offset, int from_end, int compre
                             "voxel data the header claims", path, (unsigned long long)have,
                             (unsigned long long)nbytes);
     }
-    FILE *f = fopen(path, "rb");
+    FILE *f = vxl_fopen(path, "rb");
     if (!f) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
-    if (offset > (uint64_t)INT64_MAX || fseeko(f, (off_t)offset, SEEK_SET) != 0) {
+    if (vxl_fseek(f, offset) != 0) {
         fclose(f);
         return vxl_fail(e, VXL_ERR_IO, "'%s': cannot seek to offset %llu", path, (unsigned long long)offset);
     }

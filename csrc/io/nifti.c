@@ -11,6 +11,7 @@
  * file's byte order is foreign -> hand over to vxl_volume_build, which owns
  * scaling, NaN handling and normalisation. */
 #include "hash.h"
+#include "files.h"
 #include "loader_util.h"
 #include "loaders.h"
 #include "stream_load.h"
@@ -22,7 +23,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/stat.h>
 
 #define NII1_HDR_SIZE 348
 #define NII2_HDR_SIZE 540
@@ -144,8 +144,8 @@ static char *replace_suffix(const char *path, const char *from, const char *to)
 
 static int file_exists(const char *path)
 {
-    struct stat st;
-    return stat(path, &st) == 0;
+    vxl_path_info st;
+    return vxl_path_stat(path, &st) == 0;
 }
 
 /* Given ".img[.gz]", the header is the matching ".hdr", preferring the same
@@ -530,9 +530,9 @@ static uint32_t choose_affine(const nii_header *h, const double sp[3], double A[
  * before allocating a buffer a hostile header may have sized. */
 static int precheck_size(vxl_gz *f, const char *path, uint64_t offset, uint64_t nbytes, vxl_err *e)
 {
-    struct stat st;
-    if (!vxl_gz_direct(f) || stat(path, &st) != 0 || st.st_size < 0) return VXL_OK;
-    uint64_t size = (uint64_t)st.st_size;
+    vxl_path_info st;
+    if (!vxl_gz_direct(f) || vxl_path_stat(path, &st) != 0) return VXL_OK;
+    uint64_t size = st.size;
     uint64_t have = size > offset ? size - offset : 0;
     if (have < nbytes)
         return vxl_fail(e, VXL_ERR_FORMAT,

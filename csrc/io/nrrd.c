@@ -22,6 +22,7 @@
 #include <strings.h>
 
 #include "hash.h"
+#include "files.h"
 #include "loader_util.h"
 #include "loaders.h"
 #include "stream_load.h"
@@ -403,9 +404,9 @@ static int geometry(const nrrd_hdr *h, const int axes[3], int nax, double sp[3],
 static int skip_lines(const char *path, uint64_t *offset, uint64_t lines, vxl_err *e)
 {
     if (!lines) return VXL_OK;
-    FILE *f = fopen(path, "rb");
+    FILE *f = vxl_fopen(path, "rb");
     if (!f) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s'", path);
-    if (*offset > (uint64_t)INT64_MAX || fseeko(f, (off_t)*offset, SEEK_SET) != 0) {
+    if (vxl_fseek(f, *offset) != 0) {
         fclose(f);
         return vxl_fail(e, VXL_ERR_IO, "'%s': cannot seek to offset %llu", path, (unsigned long long)*offset);
     }

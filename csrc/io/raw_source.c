@@ -1,16 +1,14 @@
 /* raw_source.c - an uncompressed file read by offset (raw_source.h). */
 #include "raw_source.h"
+#include "files.h"
 
 #include "brick_levels.h"
 #include "loader_util.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #define PASS_SLAB_BYTES (16u << 20) /* raw bytes per slab of the opening pass (at least one slice) */
 
@@ -50,7 +48,7 @@ static void raw_close(vxl_brick_source *s)
 {
     raw_ctx *c = s->ctx;
     if (!c) return;
-    if (c->fd >= 0) close(c->fd);
+    vxl_file_close(c->fd);
     free(c->slices);
     for (int k = 0; k < VXL_SOURCE_MAX_LEVELS; k++) free(c->levels[k]);
     free(c);
@@ -195,17 +193,20 @@ static int read_extent(vxl_brick_source *s, slab *sb, uint8_t *raw, uint64_t sta
     const uint64_t row = (uint64_t)c->l.dims[0] * c->es, end = start + len;
     uint64_t pos = start;
     while (pos < end) {
-        off_t data = lseek(c->fd, (off_t)pos, SEEK_DATA);
-        if (data < 0 && errno == ENXIO) break;  /* a hole to the end of the file */
-        if (data < 0) data = (off_t)pos;         /* no SEEK_DATA here: read it all */
-        if ((uint64_t)data >= end) break;
-        off_t hole = lseek(c->fd, data, SEEK_HOLE);
-        uint64_t stop = hole < 0 || (uint64_t)hole > end ? end : (uint64_t)hole;
-        if (stop <= (uint64_t)data) stop = end;
-        int rc = read_at(s, raw + ((uint64_t)data - start), (size_t)(stop - (uint64_t)data), (uint64_t)data, e);
+        uint64_t data, hole;
+        const int k = vxl_file_data_extent(c->fd, pos, &data, &hole);
+        if (k < 0) break; /* a hole to the end of the file */
+        if (k == 0) {     /* the file system cannot tell: read it all */
+            data = pos;
+            hole = end;
+        }
+        if (data >= end) break;
+        uint64_t stop = hole > end ? end : hole;
+        if (stop <= data) stop = end;
+        int rc = read_at(s, raw + (data - start), (size_t)(stop - data), data, e);
         if (rc) return rc;
         /* stored rows a .. b (counted from start) hold data */
-        const uint64_t a = ((uint64_t)data - start) / row, b = (stop - 1 - start) / row;
+        const uint64_t a = (data - start) / row, b = (stop - 1 - start) / row;
         for (uint64_t z = a / h; z <= b / h; z++) {
             uint64_t r0 = z == a / h ? a % h : 0, r1 = z == b / h ? b % h : h - 1;
             if (c->l.rows_top_first) { /* stored row r is voxel row h-1-r */
@@ -425,21 +426,21 @@ static int check_layout(const vxl_raw_layout *l, const vxl_load_options *opt, ui
 int vxl_raw_source_open(const vxl_raw_layout *l, const vxl_load_options *opt, vxl_brick_source **out, vxl_err *e)
 {
     *out = NULL;
-    int fd = open(l->path, O_RDONLY | O_CLOEXEC);
+    int fd = vxl_file_open_read(l->path, 0);
     if (fd < 0) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", l->path, strerror(errno));
-    struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        close(fd);
+    vxl_path_info st;
+    if (vxl_file_stat(fd, &st) != 0 || st.kind != VXL_PATH_FILE) {
+        vxl_file_close(fd);
         return vxl_fail(e, VXL_ERR_IO, "'%s' is not a regular file", l->path);
     }
-    int rc = check_layout(l, opt, st.st_size > 0 ? (uint64_t)st.st_size : 0, e);
+    int rc = check_layout(l, opt, st.size, e);
     vxl_brick_source *s = rc ? NULL : calloc(1, sizeof *s);
     raw_ctx *c = rc ? NULL : calloc(1, sizeof *c);
     if (!rc && (!s || !c)) rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", l->path);
     if (rc) {
         free(s);
         free(c);
-        close(fd);
+        vxl_file_close(fd);
         return rc;
     }
     c->fd = fd;
@@ -449,7 +450,7 @@ int vxl_raw_source_open(const vxl_raw_layout *l, const vxl_load_options *opt, vx
         if (!c->slices) {
             free(s);
             free(c);
-            close(fd);
+            vxl_file_close(fd);
             return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", l->path);
         }
         memcpy(c->slices, l->slice_offsets, (size_t)l->dims[2] * sizeof *c->slices);

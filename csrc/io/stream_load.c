@@ -1,5 +1,6 @@
 /* stream_load.c - the loaders' streaming route (stream_load.h). */
 #include "stream_load.h"
+#include "files.h"
 
 #include "brick_cache.h"
 #include "loader_util.h"
@@ -9,7 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 uint32_t vxl_load_streaming(const vxl_load_options *opt)
 {
@@ -75,9 +75,9 @@ int vxl_stream_file_holds(const char *path, uint64_t offset, int compressed, uin
                           const vxl_load_options *opt)
 {
     if (vxl_load_streaming(opt) == VXL_STREAMING_ON) return 1;
-    struct stat st;
-    if (stat(path, &st) != 0 || st.st_size < 0) return 0;
-    const uint64_t size = (uint64_t)st.st_size, have = size > offset ? size - offset : 0;
+    vxl_path_info st;
+    if (vxl_path_stat(path, &st) != 0) return 0;
+    const uint64_t size = st.size, have = size > offset ? size - offset : 0;
     if (!compressed) return have >= nbytes;
     /* deflate expands at most 1032:1 (the bound vxl_read_payload applies) */
     return size >= (UINT64_MAX - 4096) / 1032 || size * 1032 + 4096 >= nbytes + offset;
@@ -97,17 +97,17 @@ int vxl_layout_init(vxl_raw_layout *l, const char *path, uint64_t offset, const 
     memcpy(l->spacing, spacing, sizeof l->spacing);
     memcpy(l->affine, affine, sizeof l->affine);
     l->frame_count = 1;
-    struct stat st;
-    if (stat(l->path, &st) != 0) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", l->path, strerror(errno));
-    l->file_size = st.st_size > 0 ? (uint64_t)st.st_size : 0;
-    l->mtime_ns = (int64_t)st.st_mtim.tv_sec * 1000000000 + st.st_mtim.tv_nsec;
+    vxl_path_info st;
+    if (vxl_path_stat(l->path, &st) != 0) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", l->path, strerror(errno));
+    l->file_size = st.size;
+    l->mtime_ns = st.mtime_ns;
     return VXL_OK;
 }
 
 int vxl_file_is_gzip(const char *path)
 {
     unsigned char m[2] = {0, 0};
-    FILE *f = fopen(path, "rb");
+    FILE *f = vxl_fopen(path, "rb");
     if (!f) return 0;
     size_t n = fread(m, 1, 2, f);
     fclose(f);

@@ -3,18 +3,16 @@
  * against the file's size; nothing is allocated in proportion to what a
  * header claims, only to the pages actually found (at most max_dim). */
 #include "tiff_layout.h"
+#include "files.h"
 
 #include "loader_util.h"
 #include "stream_load.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #define MAX_ENTRIES 4096u   /* more tags than any real directory: a damaged one, read whole */
 #define ARRAY_CHUNK 512u    /* strip offsets/counts read this many at a time */
@@ -343,21 +341,21 @@ int vxl_tiff_layout_probe(const char *path, const vxl_load_options *opt, vxl_tif
 {
     memset(t, 0, sizeof *t);
     const uint32_t max_dim = opt && opt->max_dim ? opt->max_dim : VXL_DEFAULT_MAX_DIM;
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    int fd = vxl_file_open_read(path, 0);
     if (fd < 0) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        close(fd);
+    vxl_path_info st;
+    if (vxl_file_stat(fd, &st) != 0 || st.kind != VXL_PATH_FILE) {
+        vxl_file_close(fd);
         return vxl_fail(e, VXL_ERR_IO, "'%s' is not a regular file", path);
     }
-    tfile f = {fd, path, st.st_size > 0 ? (uint64_t)st.st_size : 0, 0, 0};
+    tfile f = {fd, path, st.size, 0, 0};
     t->file_size = f.size;
     uint8_t h[16] = {0};
     int rc = VXL_OK;
     if (f.size < 8 || read_exact(&f, h, f.size < 16 ? (size_t)f.size : 16, 0, e) != VXL_OK ||
         (memcmp(h, "II", 2) && memcmp(h, "MM", 2))) {
         why(t, "a file that is not a TIFF");
-        close(fd);
+        vxl_file_close(fd);
         return VXL_OK;
     }
     f.be = h[0] == 'M';
@@ -370,12 +368,12 @@ int vxl_tiff_layout_probe(const char *path, const vxl_load_options *opt, vxl_tif
         first = get(&f, h + 8, 8);
     } else {
         why(t, "a file that is not a TIFF");
-        close(fd);
+        vxl_file_close(fd);
         return VXL_OK;
     }
     if (!first) why(t, "TIFF without pages");
     else rc = walk(&f, first, max_dim, t, e);
-    close(fd);
+    vxl_file_close(fd);
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
     t->swap = !f.be;
 #else

@@ -5,9 +5,9 @@
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/stat.h>
 
 #include "loaders.h"
+#include "files.h"
 #include "stream_load.h"
 #include "tiff_layout.h"
 
@@ -60,9 +60,8 @@ typedef int (*vxl_loader_fn)(const char *path, const vxl_load_options *opt, vxl_
 
 static vxl_loader_fn vxl_loader_for(const char *path)
 {
-    struct stat st;
     if (vxl_zarr_path_is_zarr(path)) return vxl_zarr_load_any; /* before the folder test: "store.zarr#level=1" */
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+    if (vxl_is_dir(path))
         return vxl_dicom_path_is_dicom(path, 1) ? vxl_dicom_load : vxl_image_stack_load;
     static const struct { const char *ext; vxl_loader_fn fn; } by_ext[] = {
         {".nii", vxl_nifti_load}, {".nii.gz", vxl_nifti_load}, {".hdr", vxl_nifti_load},
@@ -76,7 +75,7 @@ static vxl_loader_fn vxl_loader_for(const char *path)
     for (size_t i = 0; i < sizeof by_ext / sizeof by_ext[0]; i++)
         if (has_suffix(path, by_ext[i].ext)) return by_ext[i].fn;
     unsigned char m[16] = {0};
-    FILE *f = fopen(path, "rb");
+    FILE *f = vxl_fopen(path, "rb");
     if (f) {
         size_t n = fread(m, 1, sizeof m, f);
         fclose(f);

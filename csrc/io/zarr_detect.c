@@ -2,9 +2,9 @@
  * volume_load.c; in the library (no process is started to decide). */
 #include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "loaders.h"
+#include "files.h"
 
 static const char *const marks[] = {"zarr.json", ".zattrs", ".zgroup"};
 
@@ -25,11 +25,10 @@ int vxl_zarr_path_is_zarr(const char *path)
     /* a file browser hands over the metadata file picked inside the store */
     char *slash = strrchr(folder, '/');
     if (slash && vxl_zarr_metadata_name(slash + 1)) *slash = '\0';
-    struct stat st;
-    if (stat(folder, &st) || !S_ISDIR(st.st_mode)) return 0;
+    if (!vxl_is_dir(folder)) return 0;
     for (size_t i = 0; i < sizeof marks / sizeof marks[0]; i++) {
         snprintf(p, sizeof p, "%s/%s", folder, marks[i]);
-        if (stat(p, &st) == 0 && S_ISREG(st.st_mode)) return 1;
+        if (vxl_is_file(p)) return 1;
     }
     return 0;
 }

@@ -8,9 +8,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "json.h"
+#include "files.h"
 #include "loader_util.h"
 #include "zarr.h"
 
@@ -18,24 +18,24 @@
 
 int vxl_zarr_read_file(const char *path, uint64_t max, char **text, size_t *len, uint64_t *size, vxl_err *e)
 {
-    struct stat st;
-    if (stat(path, &st)) {
+    vxl_path_info st;
+    if (vxl_path_stat(path, &st)) {
         if (errno == ENOENT || errno == ENOTDIR) return VXL_ZARR_FILE_MISSING;
         return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
     }
-    if (!S_ISREG(st.st_mode)) return vxl_fail(e, VXL_ERR_FORMAT, "'%s' is not a regular file", path);
-    *size = (uint64_t)st.st_size;
+    if (st.kind != VXL_PATH_FILE) return vxl_fail(e, VXL_ERR_FORMAT, "'%s' is not a regular file", path);
+    *size = st.size;
     if (*size > max) return VXL_ZARR_FILE_TOO_LARGE;
-    FILE *f = fopen(path, "rb");
+    FILE *f = vxl_fopen(path, "rb");
     if (!f) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
-    char *buf = malloc((size_t)st.st_size + 1);
+    char *buf = malloc((size_t)st.size + 1);
     if (!buf) {
         fclose(f);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory", path);
     }
-    size_t n = fread(buf, 1, (size_t)st.st_size, f);
+    size_t n = fread(buf, 1, (size_t)st.size, f);
     fclose(f);
-    if (n != (size_t)st.st_size) {
+    if (n != (size_t)st.size) {
         free(buf);
         return vxl_fail(e, VXL_ERR_IO, "'%s': short read", path);
     }
@@ -484,9 +484,9 @@ int vxl_zarr_open(const char *root, vxl_zarr_store *s, vxl_err *e)
 {
     memset(s, 0, sizeof *s);
     char p[4096 + 64];
-    struct stat st;
+    vxl_path_info st;
     snprintf(p, sizeof p, "%s/zarr.json", root);
-    const int v3 = stat(p, &st) == 0;
+    const int v3 = vxl_path_stat(p, &st) == 0;
     if (!v3) snprintf(p, sizeof p, "%s/.zattrs", root);
     int rc = parse_file(p, v3, 1, s, NULL, e);
     if (rc) return rc;

@@ -34,6 +34,7 @@ struct vxl_brick_loader {
     vxl_brick_key reading[MAX_THREADS]; /* what they read (the first busy entries, unordered) */
     vxl_brick_key *coming;  /* MAX_THREADS + queue_bricks: scratch of vxl_loader_want */
     int stop, rc;
+    uint64_t gen;           /* counts wanted lists: a read's failure counts only for its own list */
     vxl_err err;            /* the first failed read, until the renderer takes it */
 };
 
@@ -122,6 +123,7 @@ static void *loop(void *p)
         while (!l->stop && (l->next == l->n_want || !can_allocate(l) || l->rc)) vxl_cond_wait(&l->work, &l->lock);
         if (l->stop) break;
         const vxl_brick_key k = l->want[l->next++];
+        const uint64_t gen = l->gen;
         uint8_t *buf = buffer(l);
         if (!buf) {
             l->rc = vxl_fail(&l->err, VXL_ERR_NO_MEMORY, "out of memory for a %zu-byte brick staging buffer", l->brick_bytes);
@@ -140,7 +142,10 @@ static void *loop(void *p)
             }
         if (rc) {
             l->spare[l->n_spare++] = buf;
-            if (!l->rc) { /* the first error; another thread's is the same disk's */
+            /* A read the frame that wanted it no longer waits for (a newer
+             * list, or its error already reported) fails nobody: the next
+             * frame asks for the brick again if it needs it. */
+            if (!l->rc && gen == l->gen) { /* the first error; another thread's is the same disk's */
                 l->rc = rc;
                 l->err = e;
             }
@@ -255,6 +260,7 @@ int vxl_loader_want(vxl_brick_loader *l, const vxl_brick_key *keys, uint32_t n, 
             if (!c || !bsearch(&keys[i], l->coming, c, sizeof *l->coming, key_order)) l->want[m++] = keys[i];
         l->n_want = m;
         l->next = 0;
+        l->gen++;
         vxl_cond_broadcast(&l->work);
     }
     vxl_mutex_unlock(&l->lock);
@@ -291,6 +297,7 @@ int vxl_loader_error(vxl_brick_loader *l, vxl_err *e)
         vxl_fail(e, rc, "%s", l->err.msg);
         l->rc = 0;
         l->n_want = l->next = 0; /* the next frame says what it still wants */
+        l->gen++;
     }
     vxl_mutex_unlock(&l->lock);
     return rc;

@@ -60,7 +60,7 @@ OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_
 # helpers), linked into each helper, which needs no libvoxlight.so.
 # The platform room's files for this OS (csrc/platform/), for whatever links
 # library objects without the library.
-PLATFORM := dynlib_posix threads_posix files_posix
+PLATFORM := dynlib_posix threads_posix files_posix process_posix clock_posix
 HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume brick_source error loader_util zlib_api $(PLATFORM))
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr
 # One-off measurement programs behind docs/filters_on_scans.md, built with

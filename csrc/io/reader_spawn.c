@@ -5,36 +5,29 @@
  * C runtime, a missing library breaks only its own formats, and a reader
  * that crashes (Debian's libopenvdb aborts on some corrupt files,
  * tests/fuzz/upstream/README.md) cannot end the host's (Blender's) session.
- * The helper is started with posix_spawn (never a bare fork in a
- * multi-threaded host) and streams a header and a body over a pipe. Here
+ * The helper is started as a child process (platform/process.h) and
+ * streams a header and a body over a pipe. Here
  * the header is checked and a volume's size passes the memory budget
  * before anything is allocated, a short stream is an error, a crash becomes
  * a message naming the signal, a library the dynamic loader cannot find
  * becomes a message naming it and its Debian package, a hung helper is
  * killed after a time limit scaled with the input's size, and the child is
  * always reaped. Nothing is ever written to the child, so SIGPIPE cannot
- * reach this process, and every descriptor here is O_CLOEXEC. There is no
- * in-process fallback. */
+ * reach this process. There is no in-process fallback. */
 #include "reader_spawn.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
-#include <poll.h>
-#include <signal.h>
-#include <spawn.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
-#include <time.h>
-#include <unistd.h>
 
+#include "clock.h"
 #include "dynlib.h"
+#include "files.h"
+#include "process.h"
 #include "loader_util.h"
-
-extern char **environ;
 
 #define STDERR_KEEP 600          /* the tail of the helper's stderr quoted in errors */
 #define MAX_SERIES 100000u       /* dicom.cpp scans at most this many files */
@@ -56,10 +49,11 @@ static int helper_path(const vxl_reader *r, const char *path, char *out, size_t 
         if (snprintf(out, n, "%.*s/%s", dir_len, slash ? self : ".", r->helper) >= (int)n)
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': the path of %s is too long", path, r->helper);
     }
-    if (access(out, F_OK))
+    vxl_path_info st;
+    if (vxl_path_stat(out, &st) != 0)
         return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': %s are read by the helper program %s, which is missing "
                         "(it belongs next to libvoxlight.so: reinstall the add-on)", path, r->formats, out);
-    if (access(out, X_OK))
+    if (!vxl_is_program(out))
         return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': the helper program %s that reads %s is not executable "
                         "(chmod +x it)", path, out, r->formats);
     return VXL_OK;
@@ -77,13 +71,6 @@ static double time_limit(uint64_t input_bytes)
         if (!*end && isfinite(s) && s > 0) return s;
     }
     return 60.0 + (double)(input_bytes >> 22);
-}
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + t.tv_nsec * 1e-9;
 }
 
 /* What came back over the two pipes. */
@@ -203,9 +190,9 @@ static int check_body(const vxl_reader *r, const char *path, const reply *rp, vx
     return VXL_OK;
 }
 
-/* Reads what is readable on the data pipe; sets *eof at its end. */
-static int read_data(const vxl_reader *r, const char *path, int fd, reply *rp, uint32_t kind,
-                     const vxl_load_options *opt, int *eof, vxl_err *e)
+/* Reads what is readable on the data stream. */
+static int read_data(const vxl_reader *r, const char *path, vxl_child *child, reply *rp, uint32_t kind,
+                     const vxl_load_options *opt, vxl_err *e)
 {
     char scratch[256];
     void *dst;
@@ -221,15 +208,12 @@ static int read_data(const vxl_reader *r, const char *path, int fd, reply *rp, u
         dst = scratch;
         want = sizeof scratch;
     }
-    ssize_t n = read(fd, dst, want);
+    int64_t n = vxl_child_read(child, VXL_CHILD_OUT, dst, want);
     if (n < 0) {
         if (errno == EINTR || errno == EAGAIN) return VXL_OK;
         return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': reading from %s: %s", path, r->name, strerror(errno));
     }
-    if (n == 0) {
-        *eof = 1;
-        return VXL_OK;
-    }
+    if (n == 0) return VXL_OK;
     if (dst == scratch) rp->extra = 1;
     else if (rp->h_got < sizeof rp->h) {
         rp->h_got += (size_t)n;
@@ -238,35 +222,9 @@ static int read_data(const vxl_reader *r, const char *path, int fd, reply *rp, u
     return VXL_OK;
 }
 
-/* Moves a descriptor above 0..2, so that a host running with a standard
- * stream closed cannot make the helper's dup2s below overwrite each other. */
-static int above_stdio(int fd)
-{
-    if (fd > 2) return fd;
-    int moved = fcntl(fd, F_DUPFD_CLOEXEC, 3);
-    close(fd);
-    return moved;
-}
-
-/* Opens a pipe, both ends O_CLOEXEC and above 0..2. */
-static int pipe_above_stdio(int p[2])
-{
-    if (pipe2(p, O_CLOEXEC)) return -1;
-    p[0] = above_stdio(p[0]);
-    p[1] = above_stdio(p[1]);
-    if (p[0] >= 0 && p[1] >= 0) return 0;
-    int saved = errno;
-    if (p[0] >= 0) close(p[0]);
-    if (p[1] >= 0) close(p[1]);
-    errno = saved;
-    return -1;
-}
-
-/* Starts the helper with stdout on data_w, stderr on err_w, stdin on
- * /dev/null, no other descriptor of ours, default signal handling, and the
- * load options as argv (reader_stream.h). */
-static int spawn_helper(const vxl_reader *r, const char *helper, const char *command, const char *path,
-                        const vxl_load_options *opt, int data_w, int err_w, pid_t *pid, vxl_err *e)
+/* Starts the helper with the load options as argv (reader_stream.h). */
+static vxl_child *spawn_helper(const vxl_reader *r, const char *helper, const char *command, const char *path,
+                               const vxl_load_options *opt, vxl_err *e)
 {
     char max_dim[24], budget[24], vs[3][32], frame[16];
     double voxel[3];
@@ -279,90 +237,42 @@ static int spawn_helper(const vxl_reader *r, const char *helper, const char *com
     const char *series = vxl_load_series(opt);
     char *const argv[VXL_HELPER_ARGC + 1] = {(char *)helper, (char *)command, (char *)path, max_dim, budget,
                                              vs[0], vs[1], vs[2], frame, (char *)(series ? series : ""), NULL};
-    posix_spawn_file_actions_t fa;
-    posix_spawnattr_t at;
-    sigset_t none, all;
-    sigemptyset(&none);
-    sigfillset(&all);
-    int rc = posix_spawn_file_actions_init(&fa);
-    if (rc) return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': %s", path, strerror(rc));
-    rc = posix_spawnattr_init(&at);
-    if (rc) {
-        posix_spawn_file_actions_destroy(&fa);
-        return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': %s", path, strerror(rc));
-    }
-    if (!rc) rc = posix_spawn_file_actions_adddup2(&fa, data_w, 1);
-    if (!rc) rc = posix_spawn_file_actions_adddup2(&fa, err_w, 2);
-    if (!rc) rc = posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    /* the host's own descriptors without O_CLOEXEC: the helper closes them
-     * first thing (helper_main.c), as glibc 2.28's posix_spawn cannot */
-    if (!rc) rc = posix_spawnattr_setflags(&at, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
-    if (!rc) rc = posix_spawnattr_setsigmask(&at, &none);
-    if (!rc) rc = posix_spawnattr_setsigdefault(&at, &all);
-    if (!rc) rc = posix_spawn(pid, helper, &fa, &at, argv, environ);
-    posix_spawnattr_destroy(&at);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc) return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot start %s (%s): %s", path, r->name, helper,
-                            strerror(rc));
-    return VXL_OK;
+    vxl_child *c = vxl_child_start(helper, argv);
+    if (!c)
+        vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot start %s (%s): %s", path, r->name, helper,
+                 strerror(errno));
+    return c;
 }
 
 /* Collects the helper's output until both pipes close, the time limit
  * passes (*timed_out) or the stream is bad (an error: the caller kills). */
-static int collect(const vxl_reader *r, const char *path, int data_r, int err_r, double limit, uint32_t kind,
+static int collect(const vxl_reader *r, const char *path, vxl_child *child, double limit, uint32_t kind,
                    const vxl_load_options *opt, reply *rp, int *timed_out, vxl_err *e)
 {
-    const double deadline = now_s() + limit;
-    int data_eof = 0, err_eof = 0;
-    while (!data_eof || !err_eof) {
-        double left = deadline - now_s();
+    const double deadline = vxl_monotonic_s() + limit;
+    while (vxl_child_open(child, VXL_CHILD_OUT) || vxl_child_open(child, VXL_CHILD_ERR)) {
+        double left = deadline - vxl_monotonic_s();
         if (left <= 0) {
             *timed_out = 1;
             return VXL_OK;
         }
-        struct pollfd p[2] = {{.fd = data_eof ? -1 : data_r, .events = POLLIN},
-                              {.fd = err_eof ? -1 : err_r, .events = POLLIN}};
-        int n = poll(p, 2, left > 1e6 ? 1000000000 : (int)(left * 1000.0) + 1);
-        if (n < 0) {
-            if (errno == EINTR) continue;
+        int ready;
+        if (vxl_child_wait(child, left > 1e6 ? 1000000000 : (int)(left * 1000.0) + 1, &ready))
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': waiting for %s: %s", path, r->name, strerror(errno));
-        }
-        if (p[0].revents) {
-            int rc = read_data(r, path, data_r, rp, kind, opt, &data_eof, e);
+        if (ready & (1 << VXL_CHILD_OUT)) {
+            int rc = read_data(r, path, child, rp, kind, opt, e);
             if (rc) return rc;
         }
-        if (p[1].revents) {
+        if (ready & (1 << VXL_CHILD_ERR)) {
             char buf[4096];
-            ssize_t k = read(err_r, buf, sizeof buf);
+            int64_t k = vxl_child_read(child, VXL_CHILD_ERR, buf, sizeof buf);
             if (k > 0) keep_stderr(rp, buf, (size_t)k);
-            else if (k == 0 || (errno != EINTR && errno != EAGAIN)) err_eof = 1;
         }
     }
     return VXL_OK;
 }
 
 /* The last non-empty line of the helper's stderr, for error messages. */
-/* The name (without SIG) of the signals a crashing or killed reader dies
- * of; glibc's sigabbrev_np is 2.32, newer than the library may need. */
-static const char *signal_name(int sig)
-{
-    switch (sig) {
-    case SIGSEGV: return "SEGV";
-    case SIGBUS: return "BUS";
-    case SIGABRT: return "ABRT";
-    case SIGFPE: return "FPE";
-    case SIGILL: return "ILL";
-    case SIGKILL: return "KILL";
-    case SIGTERM: return "TERM";
-    case SIGXCPU: return "XCPU";
-    case SIGXFSZ: return "XFSZ";
-    case SIGPIPE: return "PIPE";
-    case SIGTRAP: return "TRAP";
-    case SIGSYS: return "SYS";
-    default: return NULL;
-    }
-}
-
 static const char *last_line(reply *rp)
 {
     char *s = rp->err_tail;
@@ -407,24 +317,24 @@ static int too_new_for_this_system(const vxl_reader *r, const char *path, const 
 }
 
 /* Turns how the helper ended and what it sent into our result. */
-static int verdict(const vxl_reader *r, const char *path, const char *helper, int status, int reaped,
+static int verdict(const vxl_reader *r, const char *path, const char *helper, const vxl_child_end *end,
                    int timed_out, double limit, reply *rp, vxl_err *e)
 {
     if (timed_out)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s took longer than %.0f s and was stopped", path,
                         r->name, limit);
-    if (reaped && WIFEXITED(status) && WEXITSTATUS(status) == 127 && rp->h_got == 0) {
+    if (end->exited && end->code == 127 && rp->h_got == 0) {
         int rc = missing_library(r, path, rp, e);
         if (rc) return rc;
     }
-    if (reaped && WIFEXITED(status) && WEXITSTATUS(status) != 0 && rp->h_got == 0) {
+    if (end->exited && end->code != 0 && rp->h_got == 0) {
         int rc = too_new_for_this_system(r, path, rp, e);
         if (rc) return rc;
     }
     const char *said = last_line(rp);
-    if (reaped && WIFSIGNALED(status)) {
-        int sig = WTERMSIG(status);
-        const char *abbrev = signal_name(sig);
+    if (end->signaled) {
+        int sig = end->signal;
+        const char *abbrev = vxl_signal_name(sig);
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s crashed (signal %d: SIG%s) - the file is corrupt "
                         "or unsupported%s%s%s", path, r->name, sig, abbrev ? abbrev : "?", *said ? " (" : "", said,
                         *said ? ")" : "");
@@ -435,9 +345,9 @@ static int verdict(const vxl_reader *r, const char *path, const char *helper, in
                                                                                              : VXL_ERR_FORMAT;
         return vxl_fail(e, code, "%.*s", (int)rp->body_len, rp->body);
     }
-    if (reaped && WIFEXITED(status) && WEXITSTATUS(status) != 0)
+    if (end->exited && end->code != 0)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s (%s) failed (exit %d)%s%s", path, r->name, helper,
-                        WEXITSTATUS(status), *said ? ": " : "", said);
+                        end->code, *said ? ": " : "", said);
     if (!complete)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': the output of %s was cut short (%llu of %llu bytes)",
                         path, r->name, (unsigned long long)(rp->h_got + rp->body_got),
@@ -454,37 +364,17 @@ int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, c
     char helper[4096];
     int rc = helper_path(r, path, helper, sizeof helper, e);
     if (rc) return rc;
-    int data[2], err[2];
-    if (pipe_above_stdio(data)) return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': pipe: %s", path, strerror(errno));
-    if (pipe_above_stdio(err)) {
-        int saved = errno;
-        close(data[0]);
-        close(data[1]);
-        return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': pipe: %s", path, strerror(saved));
-    }
-    /* a larger pipe: fewer wake-ups for the voxels (best effort; 64 KiB
-     * otherwise) */
-    (void)fcntl(data[1], F_SETPIPE_SZ, 1 << 20);
-    pid_t pid = -1;
-    rc = spawn_helper(r, helper, command, path, opt, data[1], err[1], &pid, e);
-    close(data[1]);
-    close(err[1]);
+    vxl_child *child = spawn_helper(r, helper, command, path, opt, e);
+    if (!child) return VXL_ERR_IO;
     reply rp;
     memset(&rp, 0, sizeof rp);
-    int timed_out = 0, status = 0, reaped = 0;
+    int timed_out = 0;
     const double limit = time_limit(input_bytes);
-    if (!rc) {
-        rc = collect(r, path, data[0], err[0], limit, kind, opt, &rp, &timed_out, e);
-        if (rc || timed_out) kill(pid, SIGKILL);
-        pid_t w;
-        while ((w = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {}
-        /* ECHILD: the host reaps children itself (SIGCHLD ignored); the
-         * stream alone then decides */
-        reaped = w == pid;
-        if (!rc) rc = verdict(r, path, helper, status, reaped, timed_out, limit, &rp, e);
-    }
-    close(data[0]);
-    close(err[0]);
+    rc = collect(r, path, child, limit, kind, opt, &rp, &timed_out, e);
+    if (rc || timed_out) vxl_child_kill(child);
+    vxl_child_end end;
+    vxl_child_finish(child, &end); /* not reaped: the host reaps children itself, the stream alone decides */
+    if (!rc) rc = verdict(r, path, helper, &end, timed_out, limit, &rp, e);
     if (rc) {
         free(rp.body);
         return rc;

@@ -10,6 +10,7 @@
 #include <time.h>
 
 #include "compress.h"
+#include "clock.h"
 #include "storage.h"
 
 static uint32_t palette_rows(uint32_t n) { return (n + VXL_PALETTES_PER_ROW - 1) / VXL_PALETTES_PER_ROW; }
@@ -73,12 +74,7 @@ int vxl_compressed_upload(vxl_storage_state *st)
     return vxl_gl_check(st->gpu, "uploading the compressed bricks");
 }
 
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
+static double now_ms(void) { return vxl_monotonic_s() * 1e3; }
 
 /* Deferred filtering, step one: decodes code slot source[k] into slot k of
  * the cache (pool_tex, `slots` per axis), for k < count. */

@@ -22,6 +22,7 @@
 #include <time.h>
 
 #include "brick_loader.h"
+#include "clock.h"
 #include "budget.h"
 #include "mat4.h"
 #include "storage.h"
@@ -59,12 +60,7 @@ typedef struct vxl_stream {
     double load_ms;
 } vxl_stream;
 
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
-}
+static double now_ms(void) { return vxl_monotonic_s() * 1e3; }
 
 static uint32_t clamp_voxel(int64_t i, uint32_t n) { return i < 0 ? 0 : i >= (int64_t)n ? n - 1 : (uint32_t)i; }
 

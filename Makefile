@@ -50,7 +50,8 @@ CLI_C := $(wildcard csrc/cli/*.c)
 # (whole reads); libzstd and libblosc are dlopen'ed on the first chunk that
 # needs one (zarr_codecs.c), never linked, so neither links them.
 ZARR_C := csrc/io/json.c csrc/io/zarr_store.c csrc/io/zarr_chunk.c csrc/io/zarr_read.c csrc/io/zarr_codecs.c
-LIB_C := $(filter-out $(CLI_C) $(HELPER_C),$(wildcard csrc/*/*.c))
+# csrc/platform/*_win32.c are the Windows build's (make windows).
+LIB_C := $(filter-out $(CLI_C) $(HELPER_C) %_win32.c,$(wildcard csrc/*/*.c))
 LIBS := -ldl -lpthread -lm
 # shaders/lib: included code; compute/: compute programs; render/: the ray
 # caster's stages. A shader's name is its path under shaders/ (csrc/gl/shader_source.h).
@@ -60,7 +61,7 @@ OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_
 # helpers), linked into each helper, which needs no libvoxlight.so.
 # The platform room's files for this OS (csrc/platform/), for whatever links
 # library objects without the library.
-PLATFORM := dynlib_posix threads_posix files_posix process_posix clock_posix
+PLATFORM := dynlib dynlib_posix threads_posix files files_posix process_posix clock_posix os_posix
 HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume brick_source error loader_util zlib_api $(PLATFORM))
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr
 # One-off measurement programs behind docs/filters_on_scans.md, built with
@@ -190,6 +191,29 @@ $(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wild
 GL_THREAD_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gl_thread context backend_osmesa backend_egl error $(PLATFORM))
 $(BUILD)/tests/test_gl_thread: tests/test_gl_thread.c tests/harness.h $(GL_THREAD_TEST_OBJ) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(GL_THREAD_TEST_OBJ) -o $@ -ldl -lpthread
+
+# test_platform checks the platform room's seams (the same file is built for
+# Windows below).
+$(BUILD)/tests/test_platform: tests/test_platform.c tests/harness.h $(PLATFORM:%=$(BUILD)/obj/%.o) | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(PLATFORM:%=$(BUILD)/obj/%.o) -o $@ -ldl -lpthread
+
+# ---- Windows x64 (make windows WIN_CC="zig cc -target x86_64-windows-gnu"):
+# the platform room's Windows files and the tests that need only them, run
+# under Wine by ./build.sh test.
+WIN_BUILD := $(BUILD)/windows-x64
+WIN_PLATFORM_C := $(addprefix csrc/platform/,dynlib.c dynlib_win32.c threads_win32.c files.c files_win32.c \
+	clock_win32.c os_win32.c utf16_win32.c)
+WIN_CFLAGS := -std=c11 $(WARN) -O2 -g0 -Icsrc/platform -Icsrc/core -Itests
+windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/test_crc32.exe
+.PHONY: windows
+
+$(WIN_BUILD)/tests/test_platform.exe: tests/test_platform.c tests/harness.h $(WIN_PLATFORM_C) $(wildcard csrc/platform/*.h)
+	@mkdir -p $(@D)
+	$(WIN_CC) $(WIN_CFLAGS) $< $(WIN_PLATFORM_C) -o $@
+
+$(WIN_BUILD)/tests/test_crc32.exe: tests/test_crc32.c tests/harness.h csrc/core/crc32.c csrc/core/crc32_tables.h
+	@mkdir -p $(@D)
+	$(WIN_CC) $(WIN_CFLAGS) $< csrc/core/crc32.c -o $@
 
 # test_crc32 checks the library's internal CRC-32 against zlib's values.
 $(BUILD)/tests/test_crc32: tests/test_crc32.c tests/harness.h $(BUILD)/obj/crc32.o | $(BUILD)/tests

@@ -27,7 +27,8 @@ ROOT=$(pwd)
 NEEDS=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
        libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev libzstd-dev libblosc-dev mricron-data blender
        xvfb xauth python3 python3-numpy python3-pytest zip unzip clang clang-rt llvm
-       python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv" "?python3.13-venv")
+       python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv" "?python3.13-venv"
+       "wine64|wine")
 
 # (output captured, not piped into grep -q: under pipefail an early grep exit
 # would fail the pipeline)
@@ -124,6 +125,11 @@ build() {
         lib_cc=cc
     fi
     make -s -j"$(nproc)" BUILD=build LIB_CC="$lib_cc"
+    # Windows x64, cross-compiled by the same zig (its MinGW-w64 runtime):
+    # the platform room's Windows files and their tests, run under Wine
+    if [ "$lib_cc" != cc ]; then
+        make -s -j"$(nproc)" BUILD=build windows WIN_CC="$ROOT/build/zig/bin/python -m ziglang cc -target x86_64-windows-gnu"
+    fi
     if [ -x tools/package_addon.sh ]; then tools/package_addon.sh build; fi
 }
 
@@ -262,13 +268,16 @@ run_suite() {
     rm -f "$log"
 }
 
+# run_c_tests DIR [LAUNCHER...]: every DIR/tests/test_* program (through
+# LAUNCHER, e.g. Wine, when given), counting their summary lines.
 run_c_tests() {
     local dir=$1 fails=0 p=0 f=0
+    shift
     for t in "$dir"/tests/test_*; do
         [ -x "$t" ] || continue
         local out t0=$SECONDS
         set +e
-        out=$("$t" 2>&1)
+        out=$("$@" "$t" 2>&1)
         local rc=$?
         set -e
         echo "$out" | grep -E 'FAIL|CHECK failed|REQUIRE failed|ERROR|runtime error|^software backend:' || true
@@ -287,6 +296,34 @@ run_c_tests() {
     done
     echo "$p passed, $f failed"
     [ $f -eq 0 ]
+}
+
+# Debian 12's wine64 has /usr/lib/wine/wine64; later Wines run 64-bit
+# programs with plain wine.
+wine_binary() {
+    local c
+    for c in /usr/lib/wine/wine64 "$(command -v wine64 || true)" "$(command -v wine || true)"; do
+        if [ -n "$c" ] && [ -x "$c" ]; then echo "$c"; return 0; fi
+    done
+    return 1
+}
+
+# The Windows test programs of build/windows-x64/tests under Wine, in a
+# Wine prefix of their own under build/ (made on the first run; console
+# programs need no display).
+run_wine_tests() {
+    local dir=$1 wine
+    if ! wine=$(wine_binary); then
+        echo "build.sh: no Wine to run the Windows tests (apt-get install wine64)"
+        echo "0 passed, 1 failed"
+        return 1
+    fi
+    if ! compgen -G "$dir/tests/test_*.exe" >/dev/null; then
+        echo "build.sh: no Windows test programs in $dir/tests (zig unavailable?)"
+        echo "0 passed, 1 failed"
+        return 1
+    fi
+    WINEPREFIX="$ROOT/build/wine" WINEDEBUG=-all run_c_tests "$dir" timeout 600 "$wine"
 }
 
 cmd=${1:-build}
@@ -309,6 +346,7 @@ case "$cmd" in
         # files or folders, each folder above the ones it uses
         run_suite "Include cycles and layers (csrc/)" /usr/bin/python3 tools/check_includes.py
         run_suite "C tests" run_c_tests build
+        run_suite "Windows x64 tests under Wine" run_wine_tests build/windows-x64
         # Mesa and LLVM keep allocations until exit: their leaks are suppressed
         # by library name (tests/lsan.supp); ours are not. Freed memory is
         # filled with 0xbe, so a read of freed memory inside a library ASan

@@ -25,19 +25,6 @@ vxl_dynlib_fn vxl_dynlib_symbol(vxl_dynlib *lib, const char *name)
     return f;
 }
 
-int vxl_dynlib_symbols(vxl_dynlib *lib, const char *const *names, size_t count, vxl_dynlib_fn *table, char *why,
-                       size_t why_size)
-{
-    for (size_t i = 0; i < count; i++) {
-        table[i] = vxl_dynlib_symbol(lib, names[i]);
-        if (!table[i]) {
-            if (why_size) snprintf(why, why_size, "it lacks %s", names[i]);
-            return -1;
-        }
-    }
-    return 0;
-}
-
 void vxl_dynlib_close(vxl_dynlib *lib)
 {
     if (lib) dlclose((void *)lib);

@@ -27,18 +27,6 @@ int vxl_path_stat(const char *path, vxl_path_info *out)
     return 0;
 }
 
-int vxl_is_file(const char *path)
-{
-    vxl_path_info i;
-    return vxl_path_stat(path, &i) == 0 && i.kind == VXL_PATH_FILE;
-}
-
-int vxl_is_dir(const char *path)
-{
-    vxl_path_info i;
-    return vxl_path_stat(path, &i) == 0 && i.kind == VXL_PATH_DIR;
-}
-
 int vxl_file_open_read(const char *path, int nonblock)
 {
     return open(path, O_RDONLY | O_CLOEXEC | (nonblock ? O_NONBLOCK : 0));

@@ -1,11 +1,24 @@
 /* threads.h - threads, locks, condition variables, run-once and per-thread
  * values: the library's one seam to the OS's threads. One implementation
- * per OS (threads_posix.c); nothing else includes <pthread.h>. The types
+ * per OS (threads_posix.c, threads_win32.c); nothing else includes
+ * <pthread.h>. The types
  * are the OS's own, so a lock costs no extra allocation and can be
  * initialised statically (VXL_MUTEX_INIT, VXL_ONCE_INIT). */
 #ifndef VXL_THREADS_H
 #define VXL_THREADS_H
 
+#ifdef _WIN32
+/* SRWLOCK, CONDITION_VARIABLE and INIT_ONCE are one pointer each, zero
+ * when unused (threads_win32.c checks the sizes); <windows.h> stays out of
+ * every file that takes a lock. */
+typedef struct vxl_mutex { void *p; } vxl_mutex;
+typedef struct vxl_cond { void *p; } vxl_cond;
+typedef struct vxl_thread { void *handle; } vxl_thread;
+typedef struct vxl_once { void *p; } vxl_once;
+typedef unsigned long vxl_tls;
+#define VXL_MUTEX_INIT {0}
+#define VXL_ONCE_INIT {0}
+#else
 #include <pthread.h>
 
 typedef pthread_mutex_t vxl_mutex;
@@ -15,6 +28,7 @@ typedef pthread_once_t vxl_once;
 typedef pthread_key_t vxl_tls;
 #define VXL_MUTEX_INIT PTHREAD_MUTEX_INITIALIZER
 #define VXL_ONCE_INIT PTHREAD_ONCE_INIT
+#endif
 
 /* 0 on success, else the OS's error number (nothing to destroy then). */
 int vxl_mutex_init(vxl_mutex *m);

@@ -194,22 +194,30 @@ $(BUILD)/tests/test_gl_thread: tests/test_gl_thread.c tests/harness.h $(GL_THREA
 
 # test_platform checks the platform room's seams (the same file is built for
 # Windows below).
-$(BUILD)/tests/test_platform: tests/test_platform.c tests/harness.h $(PLATFORM:%=$(BUILD)/obj/%.o) | $(BUILD)/tests
+$(BUILD)/tests/test_platform: tests/test_platform.c tests/harness.h $(PLATFORM:%=$(BUILD)/obj/%.o) \
+		$(BUILD)/tests/child_program | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(PLATFORM:%=$(BUILD)/obj/%.o) -o $@ -ldl -lpthread
+
+$(BUILD)/tests/child_program: tests/child_program.c | $(BUILD)/tests
+	$(CC) -std=c11 $(WARN) -O1 $< -o $@
 
 # ---- Windows x64 (make windows WIN_CC="zig cc -target x86_64-windows-gnu"):
 # the platform room's Windows files and the tests that need only them, run
 # under Wine by ./build.sh test.
 WIN_BUILD := $(BUILD)/windows-x64
 WIN_PLATFORM_C := $(addprefix csrc/platform/,dynlib.c dynlib_win32.c threads_win32.c files.c files_win32.c \
-	clock_win32.c os_win32.c utf16_win32.c)
+	clock_win32.c os_win32.c utf16_win32.c process_win32.c)
 WIN_CFLAGS := -std=c11 $(WARN) -O2 -g0 -Icsrc/platform -Icsrc/core -Itests
-windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/test_crc32.exe
+windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/child_program.exe $(WIN_BUILD)/tests/test_crc32.exe
 .PHONY: windows
 
 $(WIN_BUILD)/tests/test_platform.exe: tests/test_platform.c tests/harness.h $(WIN_PLATFORM_C) $(wildcard csrc/platform/*.h)
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_CFLAGS) $< $(WIN_PLATFORM_C) -o $@
+
+$(WIN_BUILD)/tests/child_program.exe: tests/child_program.c
+	@mkdir -p $(@D)
+	$(WIN_CC) $(WIN_CFLAGS) $< -o $@
 
 $(WIN_BUILD)/tests/test_crc32.exe: tests/test_crc32.c tests/harness.h csrc/core/crc32.c csrc/core/crc32_tables.h
 	@mkdir -p $(@D)

@@ -4,7 +4,9 @@
  * ./build.sh test. Threads, locks, run-once and per-thread values under
  * contention; a system library opened and a function found; files and
  * folders with non-ASCII UTF-8 names written, renamed, listed, read at
- * offsets and removed; the monotonic clock and the processor count. */
+ * offsets and removed; a child program's output, exit code and kill (the
+ * child is tests/child_program.c, built next to this test); the monotonic
+ * clock and the processor count. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,6 +17,7 @@
 #include "files.h"
 #include "harness.h"
 #include "os.h"
+#include "process.h"
 #include "threads.h"
 
 #define THREADS 8
@@ -191,11 +194,92 @@ TEST(files_with_utf8_names_are_written_renamed_listed_and_read)
     CHECK(vxl_file_open_read(final, 0) < 0);
 }
 
+/* tests/child_program next to this program. */
+static int child_path(char *out, size_t n)
+{
+    char self[4096];
+    if (vxl_dynlib_path_of((const void *)&vxl_os_name, self, sizeof self)) return -1;
+    char *slash = strrchr(self, '/'), *back = strrchr(self, '\\');
+    if (back > slash) slash = back;
+    if (slash) *slash = 0;
+    const int windows = !strcmp(vxl_os_name(), "windows");
+    return snprintf(out, n, "%s/child_program%s", slash ? self : ".", windows ? ".exe" : "") < (int)n ? 0 : -1;
+}
+
+typedef struct output {
+    char out[400000], err[4096];
+    size_t n_out, n_err;
+} output;
+
+/* Everything the child writes, until both streams end. */
+static int drain(vxl_child *c, output *o)
+{
+    while (vxl_child_open(c, VXL_CHILD_OUT) || vxl_child_open(c, VXL_CHILD_ERR)) {
+        int ready;
+        if (vxl_child_wait(c, 60000, &ready)) return -1;
+        if (!ready) return -1; /* a minute without a byte: the child hangs */
+        if (ready & (1 << VXL_CHILD_OUT)) {
+            int64_t k = vxl_child_read(c, VXL_CHILD_OUT, o->out + o->n_out, sizeof o->out - o->n_out);
+            if (k > 0) o->n_out += (size_t)k;
+        }
+        if (ready & (1 << VXL_CHILD_ERR)) {
+            int64_t k = vxl_child_read(c, VXL_CHILD_ERR, o->err + o->n_err, sizeof o->err - 1 - o->n_err);
+            if (k > 0) o->n_err += (size_t)k;
+        }
+    }
+    return 0;
+}
+
+TEST(a_child_program_writes_exits_and_is_killed)
+{
+    char prog[4200];
+    REQUIRE(child_path(prog, sizeof prog) == 0);
+    REQUIRE(vxl_is_program(prog));
+    static output o;
+    memset(&o, 0, sizeof o);
+    char *const argv[] = {prog, "out:hello \"quoted\" words\\", "err:oops", "bytes:300000", "exit:3", NULL};
+    vxl_child *c = vxl_child_start(prog, argv);
+    REQUIRE(c != NULL);
+    CHECK(drain(c, &o) == 0);
+    vxl_child_end end;
+    vxl_child_finish(c, &end);
+    CHECK(end.reaped && end.exited && end.code == 3);
+    const char *line = "hello \"quoted\" words\\";
+    const size_t head = strlen(line);
+    CHECKF(o.n_out >= head + 1 && !memcmp(o.out, line, head), "%.*s", (int)(o.n_out < 60 ? o.n_out : 60), o.out);
+    /* text-mode stdout on Windows may turn \n into \r\n: skip the line's end */
+    size_t at = head;
+    while (at < o.n_out && (o.out[at] == '\r' || o.out[at] == '\n')) at++;
+    int same = o.n_out - at == 300000;
+    for (size_t k = 0; same && k < 300000; k++) same = o.out[at + k] == 'a' + (int)(k % 26);
+    CHECKF(same, "%zu bytes after the line", o.n_out - at);
+    o.err[o.n_err] = 0;
+    CHECK(strstr(o.err, "oops") != NULL);
+
+    char *const hang[] = {prog, "hang", NULL};
+    c = vxl_child_start(prog, hang);
+    REQUIRE(c != NULL);
+    vxl_child_kill(c);
+    vxl_child_finish(c, &end);
+    CHECK(end.reaped && (end.signaled || end.exited));
+
+    char missing[4300];
+    snprintf(missing, sizeof missing, "%s-missing", prog);
+    char *const none[] = {missing, NULL};
+    CHECK(!vxl_is_program(missing));
+    c = vxl_child_start(missing, none);
+    if (c) { /* POSIX starts it and the exec fails in the child: exit 127 */
+        vxl_child_finish(c, &end);
+        CHECK(end.exited && end.code == 127);
+    }
+}
+
 int main(void)
 {
     RUN(threads_take_turns_and_keep_their_own_values);
     RUN(a_system_library_opens_and_a_missing_one_says_why);
     RUN(the_clock_never_goes_back);
     RUN(files_with_utf8_names_are_written_renamed_listed_and_read);
+    RUN(a_child_program_writes_exits_and_is_killed);
     return TEST_SUMMARY();
 }

@@ -120,7 +120,7 @@ static void point_frustum(vxl_shadow_light *L, const float pos[3], double corner
         dist += axis[a] * axis[a];
     }
     dist = sqrt(dist);
-    double near = INFINITY, far = 0, tan_max = 0;
+    double z_near = INFINITY, z_far = 0, tan_max = 0;
     int single = dist > 1e-6 * radius;
     if (single) {
         up_for(axis, up);
@@ -134,14 +134,14 @@ static void point_frustum(vxl_shadow_light *L, const float pos[3], double corner
                 break;
             }
             tan_max = fmax(tan_max, fmax(fabs(v[0]), fabs(v[1])) / ahead);
-            near = fmin(near, ahead);
-            far = fmax(far, ahead);
+            z_near = fmin(z_near, ahead);
+            z_far = fmax(z_far, ahead);
         }
         single = single && tan_max * (1 + MARGIN) < MAX_HALF_ANGLE_TAN;
     }
     if (single) {
         double t = fmax(tan_max * (1 + MARGIN), 1e-3);
-        vxl_mat4_perspective(proj, 2 * atan(t), 1, 0.5 * near, far * (1 + MARGIN));
+        vxl_mat4_perspective(proj, 2 * atan(t), 1, 0.5 * z_near, z_far * (1 + MARGIN));
         store_view(L, 0, proj, view);
         L->views = 1;
         L->texel_world = (float)(2 * t * dist / size);
@@ -150,13 +150,13 @@ static void point_frustum(vxl_shadow_light *L, const float pos[3], double corner
     /* the cube: the six axis directions, 90 degrees each; its far plane
      * reaches the farthest corner, its near plane is small, and occluders
      * nearer than it clamp to depth 0 (they block) */
-    far = 0;
+    z_far = 0;
     for (int c = 0; c < 8; c++) {
         double d2 = 0;
         for (int a = 0; a < 3; a++) d2 += (corner[c][a] - eye[a]) * (corner[c][a] - eye[a]);
-        far = fmax(far, sqrt(d2));
+        z_far = fmax(z_far, sqrt(d2));
     }
-    vxl_mat4_perspective(proj, M_PI / 2, 1, 0.01 * radius, far * (1 + MARGIN) + 0.01 * radius);
+    vxl_mat4_perspective(proj, M_PI / 2, 1, 0.01 * radius, z_far * (1 + MARGIN) + 0.01 * radius);
     for (int v = 0; v < 6; v++) {
         double dir[3] = {0, 0, 0}, at[3];
         dir[v / 2] = v % 2 ? -1 : 1;
@@ -254,14 +254,14 @@ static int rasterise(vxl_shadow_maps_state *s, const vxl_shadow_light *L)
     gl->DepthFunc(GL_LESS);
     gl->DepthMask(GL_TRUE);
     gl->BindVertexArray(s->vao);
-    const float far = 1;
+    const float z_far = 1;
     for (uint32_t v = 0; v < L->views; v++) {
         gl->FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, s->tex, 0, (GLint)(L->first_layer + v));
         if (v == 0 && gl->CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
             rc = vxl_fail(&s->gpu->err, VXL_ERR_GL, "the %u^2 shadow map framebuffer is incomplete", s->size);
             break;
         }
-        gl->ClearBufferfv(GL_DEPTH, 0, &far);
+        gl->ClearBufferfv(GL_DEPTH, 0, &z_far);
         gl->UniformMatrix4fv(loc, 1, GL_FALSE, L->matrix[v]);
         gl->DrawElements(GL_TRIANGLES, (GLsizei)(s->triangle_count * 3), GL_UNSIGNED_INT, NULL);
     }

@@ -71,7 +71,7 @@ STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlig
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
-all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(BUILD)/voxlight-sceneshadowbench $(STUDIES) $(TESTS)
+all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/tests/render_scene $(BUILD)/tests/child_program $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(BUILD)/voxlight-sceneshadowbench $(STUDIES) $(TESTS)
 
 # Objects are rebuilt when LIB_CC changes (the stamp holds the last one).
 LIB_CC_STAMP := $(BUILD)/obj/lib_cc.txt
@@ -188,7 +188,7 @@ $(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wild
 
 # test_gl_thread checks the GL thread's shared lock (internal), so it links
 # the thread and context objects; the backends come with context.o.
-GL_THREAD_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gl_thread context backend_osmesa backend_egl error $(PLATFORM))
+GL_THREAD_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gl_thread context backends_posix backend_osmesa backend_egl error $(PLATFORM))
 $(BUILD)/tests/test_gl_thread: tests/test_gl_thread.c tests/harness.h $(GL_THREAD_TEST_OBJ) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(GL_THREAD_TEST_OBJ) -o $@ -ldl -lpthread
 
@@ -197,6 +197,11 @@ $(BUILD)/tests/test_gl_thread: tests/test_gl_thread.c tests/harness.h $(GL_THREA
 $(BUILD)/tests/test_platform: tests/test_platform.c tests/harness.h $(PLATFORM:%=$(BUILD)/obj/%.o) \
 		$(BUILD)/tests/child_program | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(PLATFORM:%=$(BUILD)/obj/%.o) -o $@ -ldl -lpthread
+
+# render_scene renders one fixed scene for the Linux/Windows comparison
+# (tests/cli/test_windows_render.py; its Windows twin is built below).
+$(BUILD)/tests/render_scene: tests/render_scene.c $(BUILD)/libvoxlight.so | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< -o $@ -L$(BUILD) -lvoxlight -Wl,-rpath,'$$ORIGIN/..'
 
 $(BUILD)/tests/child_program: tests/child_program.c | $(BUILD)/tests
 	$(CC) -std=c11 $(WARN) -O1 $< -o $@
@@ -208,7 +213,27 @@ WIN_BUILD := $(BUILD)/windows-x64
 WIN_PLATFORM_C := $(addprefix csrc/platform/,dynlib.c dynlib_win32.c threads_win32.c files.c files_win32.c \
 	clock_win32.c os_win32.c utf16_win32.c process_win32.c)
 WIN_CFLAGS := -std=c11 $(WARN) -O2 -g0 -Icsrc/platform -Icsrc/core -Itests
-windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/child_program.exe $(WIN_BUILD)/tests/test_crc32.exe
+windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/child_program.exe $(WIN_BUILD)/tests/test_crc32.exe \
+	$(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/render_scene.exe
+
+# beside voxlight.dll, where Windows looks for it first
+$(WIN_BUILD)/render_scene.exe: tests/render_scene.c $(WIN_BUILD)/voxlight.dll
+	$(WIN_CC) -std=c11 $(WARN) -O2 -g0 -Icsrc/include -Itests $< -o $@ -L$(WIN_BUILD) -lvoxlight
+
+# voxlight.dll: the library's C for Windows (the *_win32.c files in place of
+# the POSIX ones, WGL in place of OSMesa and EGL); it exports what the
+# public headers mark VXL_API (a .def made from them: the headers carry no
+# Windows-only markup), and links only Windows' own gdi32 and user32.
+WIN_LIB_C := $(filter-out $(CLI_C) $(HELPER_C) %_posix.c %/backend_osmesa.c %/backend_egl.c,$(wildcard csrc/*/*.c))
+WIN_LIB_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) -O2 -g0 -Icsrc/include $(CSRC_INC) -I$(BUILD)/gen \
+	-idirafter /usr/include -idirafter /usr/include/$(shell $(CC) -print-multiarch)
+$(WIN_BUILD)/voxlight.def: $(wildcard csrc/include/*.h)
+	@mkdir -p $(@D)
+	@{ echo 'LIBRARY voxlight.dll'; echo 'EXPORTS'; \
+	  sed -nE 's/^VXL_API[^(]*[ *](vxl_[a-z0-9_]+)\(.*/    \1/p' csrc/include/*.h | sort -u; } > $@
+$(WIN_BUILD)/voxlight.dll: $(WIN_LIB_C) $(wildcard csrc/*/*.h) $(BUILD)/gen/shaders_embedded.c $(WIN_BUILD)/voxlight.def
+	$(WIN_CC) $(WIN_LIB_CFLAGS) -shared $(WIN_LIB_C) $(BUILD)/gen/shaders_embedded.c $(WIN_BUILD)/voxlight.def \
+		-o $@ -Wl,--out-implib,$(WIN_BUILD)/libvoxlight.dll.a -lgdi32 -luser32
 .PHONY: windows
 
 $(WIN_BUILD)/tests/test_platform.exe: tests/test_platform.c tests/harness.h $(WIN_PLATFORM_C) $(wildcard csrc/platform/*.h)

@@ -91,6 +91,7 @@ _BACKEND_UI = {
     "auto": ("Auto", "EGL on a GPU, then OSMesa, then EGL on Mesa"),
     "osmesa": ("OSMesa", "Software rendering (llvmpipe)"),
     "egl": ("EGL", "EGL without a window (GPU or Mesa surfaceless)"),
+    "wgl": ("WGL", "Windows' OpenGL (the GPU's driver)"),
 }
 _STORAGE_UI = {
     "auto": ("Auto", "One texture when it fits the texture limit and the budget, else bricked"),

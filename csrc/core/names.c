@@ -19,7 +19,7 @@ static const char *const interpolation_names[VXL_INTERP_COUNT] = {"nearest", "li
 static const char *const label_mode_names[VXL_LABEL_MODE_COUNT] = {"surface", "mask", "tint"};
 static const char *const streaming_names[VXL_STREAMING_COUNT] = {"auto", "off", "on"};
 static const char *const blend_names[VXL_BLEND_COUNT] = {"over", "add", "max"};
-static const char *const backend_names[VXL_BACKEND_COUNT] = {"auto", "osmesa", "egl"};
+static const char *const backend_names[VXL_BACKEND_COUNT] = {"auto", "osmesa", "egl", "wgl"};
 static const char *const dtype_names[VXL_DTYPE_COUNT] = {NULL,    "uint8", "int8",    "uint16", "int16",
                                                          "uint32", "int32", "float32", "float64"};
 

@@ -1,4 +1,5 @@
-/* context.c - backend selection. */
+/* context.c - the backend asked for (the environment may override AUTO);
+ * which backends each OS has is backends_posix.c's or backends_win32.c's. */
 #include "context.h"
 
 #include <stdlib.h>
@@ -14,37 +15,14 @@ static uint32_t backend_from_env(uint32_t requested)
     if (!env || !*env || !strcasecmp(env, "auto")) return VXL_BACKEND_AUTO;
     if (!strcasecmp(env, "osmesa")) return VXL_BACKEND_OSMESA;
     if (!strcasecmp(env, "egl")) return VXL_BACKEND_EGL;
+    if (!strcasecmp(env, "wgl")) return VXL_BACKEND_WGL;
     return 0xFFFFFFFFu;
 }
 
 int vxl_context_open(vxl_context *c, uint32_t backend, vxl_err *e)
 {
     memset(c, 0, sizeof *c);
-    uint32_t b = backend_from_env(backend);
-    switch (b) {
-    case VXL_BACKEND_OSMESA: return vxl_osmesa_open(c, e);
-    case VXL_BACKEND_EGL: return vxl_egl_open(c, 2, e);
-    case VXL_BACKEND_AUTO: {
-        /* A real GPU first; then OSMesa (the tested software path); then
-         * Mesa's surfaceless EGL, which outlives OSMesa (removed in Mesa 25.1). */
-        char why[3][VXL_MSG_MAX];
-        vxl_err sub;
-        if (vxl_egl_open(c, 0, &sub) == VXL_OK) return VXL_OK;
-        memcpy(why[0], sub.msg, VXL_MSG_MAX);
-        memset(c, 0, sizeof *c);
-        if (vxl_osmesa_open(c, &sub) == VXL_OK) return VXL_OK;
-        memcpy(why[1], sub.msg, VXL_MSG_MAX);
-        memset(c, 0, sizeof *c);
-        if (vxl_egl_open(c, 1, &sub) == VXL_OK) return VXL_OK;
-        memcpy(why[2], sub.msg, VXL_MSG_MAX);
-        memset(c, 0, sizeof *c);
-        return vxl_fail(e, VXL_ERR_BACKEND, "no OpenGL 4.5 backend: egl gpu: %.150s; osmesa: %.150s; egl mesa: %.150s",
-                        why[0], why[1], why[2]);
-    }
-    default:
-        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT,
-                        "unknown backend (VOXLIGHT_BACKEND must be auto, osmesa or egl)");
-    }
+    return vxl_context_open_backend(c, backend_from_env(backend), e);
 }
 
 int vxl_context_screen_kind(const char *backend_name, const char *gl_renderer)

@@ -48,7 +48,12 @@ vxl_mutex *vxl_context_screen_lock(int kind);
 
 /* Backend entry points, in backend_osmesa.c and backend_egl.c. egl_mode: 0
  * hardware device only, 1 Mesa surfaceless only, 2 device then surfaceless. */
+/* Opens backend b (not AUTO's environment override: context.c applies it)
+ * from this OS's list (backends_posix.c, backends_win32.c). */
+int vxl_context_open_backend(vxl_context *c, uint32_t b, vxl_err *e);
+
 int vxl_osmesa_open(vxl_context *c, vxl_err *e);
 int vxl_egl_open(vxl_context *c, int egl_mode, vxl_err *e);
+int vxl_wgl_open(vxl_context *c, vxl_err *e);
 
 #endif

@@ -73,10 +73,11 @@ extern "C" {
 VXL_API const char *vxl_dtype_name(uint32_t dtype);
 
 /* ---- backends ---- */
-#define VXL_BACKEND_AUTO 0   /* EGL on a GPU, then OSMesa, then EGL on Mesa */
+#define VXL_BACKEND_AUTO 0   /* Linux: EGL on a GPU, then OSMesa, then EGL on Mesa; Windows: WGL */
 #define VXL_BACKEND_OSMESA 1
 #define VXL_BACKEND_EGL 2
-#define VXL_BACKEND_COUNT 3
+#define VXL_BACKEND_WGL 3    /* Windows' OpenGL */
+#define VXL_BACKEND_COUNT 4
 VXL_API const char *vxl_backend_name(uint32_t backend); /* "auto", "osmesa", "egl" */
 VXL_API int vxl_backend_from_name(const char *name, uint32_t *out);
 

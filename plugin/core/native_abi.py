@@ -21,7 +21,7 @@ ABI_VERSION = 1
 FILTERS = ("central", "forward3", "sobel8", "sobel14", "sobel26", "precomputed", "cubic",
            "cubic-smooth")
 PRESETS = ("auto", "gray", "bone", "hot", "mri", "ct")
-BACKENDS = ("auto", "osmesa", "egl")
+BACKENDS = ("auto", "osmesa", "egl", "wgl")
 STORAGES = ("auto", "dense", "bricked", "sparse", "compressed")  # VXL_STORAGE_*
 CLASSIFY_MODES = ("post", "pre", "preint")  # VXL_CLASSIFY_*
 GRADIENT_OPACITY_MODES = ("off", "boundary", "iso")  # VXL_GOPACITY_*

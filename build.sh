@@ -22,13 +22,14 @@ ROOT=$(pwd)
 # entry is one need: alternatives separated by '|', of which the first
 # installed, else the first the apt lists offer, is used. '?' marks a need a
 # release may not offer at all: OSMesa left Mesa in 25.1, and without it the
-# library (and every test) renders through Mesa's surfaceless EGL. "clang-rt"
+# library (and every test) renders through Mesa's surfaceless EGL; without
+# Wine only the Windows tests cannot run (their suite says so). "clang-rt"
 # stands for the sanitizer/libFuzzer runtime of clang's major version.
 NEEDS=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
        libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev libzstd-dev libblosc-dev mricron-data blender
        xvfb xauth python3 python3-numpy python3-pytest zip unzip clang clang-rt llvm
        python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv" "?python3.13-venv"
-       "wine64|wine")
+       "?wine64|wine")
 
 # (output captured, not piped into grep -q: under pipefail an early grep exit
 # would fail the pipeline)

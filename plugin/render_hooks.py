@@ -75,11 +75,8 @@ def on_render_pre(scene, *args):
     nothing of the previous frame shows."""
     global _pending
     _pending = False
-    if not render_setup.wanted(scene):
-        _show_nothing(scene)
-        _prepare(scene, clear=True)  # mutes the Alpha Over before the frame is evaluated
-        return
-    _pending = _prepare(scene, clear=True)
+    ready = _prepare(scene, clear=True)  # with no volume: empties the images, mutes the Alpha Over
+    _pending = ready and render_setup.wanted(scene)
 
 
 @persistent

@@ -18,7 +18,7 @@ after a file loads, and from the render handlers (render_hooks.py).
 import bpy
 from bpy.app.handlers import persistent
 
-from . import app_handlers, compositor, id_writes, offline, scene_shadows
+from . import app_handlers, compat, compositor, id_writes, offline, scene_shadows
 
 DELAY_S = 0.2       # coalesces the updates of a drag into one prepare()
 RENDER_WAIT_S = 0.5
@@ -44,6 +44,7 @@ def prepare(scene, clear=False):
     if not wanted(scene):
         if clear:
             compositor.clear_passes(scene)
+            scene_shadows.clear_render(scene)
         compositor.mute(scene)
         scene_shadows.revert(scene)
         return
@@ -62,7 +63,6 @@ def _tracked(scene):
     (to mute them once the volumes are gone)."""
     if volumes_present(scene):
         return True
-    from . import compat
     tree = compat.compositor_tree(scene, create=False)
     return tree is not None and compositor.NODE_OVER in tree.nodes
 
@@ -70,8 +70,9 @@ def _tracked(scene):
 def _run_pending():
     if bpy.app.is_job_running("RENDER"):
         return RENDER_WAIT_S
-    names, _ = set(_pending), _pending.clear()
-    for name in sorted(names):
+    names = sorted(_pending)
+    _pending.clear()
+    for name in names:
         scene = bpy.data.scenes.get(name)
         if scene is None or not _tracked(scene):
             continue
@@ -91,9 +92,8 @@ def schedule(scene):
     may register timers)."""
     if not id_writes.on_main_thread():
         return
-    first = not _pending
     _pending.add(scene.name)
-    if first and not bpy.app.timers.is_registered(_run_pending):
+    if not bpy.app.timers.is_registered(_run_pending):
         bpy.app.timers.register(_run_pending, first_interval=DELAY_S)
 
 

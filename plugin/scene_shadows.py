@@ -252,8 +252,10 @@ def _remove_lightgroup_later(scene_name, layer_name, name):
     if vl is not None and getattr(vl, "lightgroups", None) is not None:
         try:
             _remove_lightgroup(scene, vl, name)
-        except AttributeError:  # "Writing to ID classes in this context is not allowed": the job is ending
-            return 0.5
+        except AttributeError as e:
+            if not id_writes.refused(e):
+                raise
+            return 0.5  # Blender still refuses writes: the job is ending
     return None
 
 

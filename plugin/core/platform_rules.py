@@ -98,9 +98,8 @@ class WindowsRules:
         return name.startswith(prefix) and name.lower().endswith(".exe")
 
     def cache_base(self, environ):
-        base = environ.get("LOCALAPPDATA") or self.path.join(
+        return environ.get("LOCALAPPDATA") or self.path.join(
             environ.get("USERPROFILE") or self.path.expanduser("~"), "AppData", "Local")
-        return base
 
     def user_tag(self):
         return os.environ.get("USERNAME") or "user"

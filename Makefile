@@ -62,7 +62,8 @@ OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_
 # The platform room's files for this OS (csrc/platform/), for whatever links
 # library objects without the library.
 PLATFORM := dynlib dynlib_posix threads_posix files files_posix process_posix clock_posix os_posix
-HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,helper_main volume brick_source error loader_util zlib_api $(PLATFORM))
+HELPER_CORE_NAMES := helper_main volume brick_source error loader_util zlib_api
+HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,$(HELPER_CORE_NAMES) helper_self_posix $(PLATFORM))
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
@@ -117,11 +118,12 @@ $(BUILD)/libvoxlight.so: $(OBJ)
 
 $(BUILD)/obj/remote_readers.o: $(BUILD)/gen/reader_packages.h
 
-# The CLI links zlib (for its MatCap PNG) from the system's library
-# folder: LIB_CC may be zig's, which searches only its own.
-SYSTEM_LIBDIR := $(shell $(CC) -print-multiarch 2>/dev/null | sed 's|^|/usr/lib/|')
-$(BUILD)/voxlight: $(CLI_C) $(wildcard csrc/cli/*.h) $(BUILD)/libvoxlight.so $(LIB_CC_STAMP)
-	$(LIB_CC) $(CFLAGS) $(CLI_C) -o $@ -L$(BUILD) -lvoxlight -L$(SYSTEM_LIBDIR) -lz -lm -Wl,-rpath,'$$ORIGIN'
+# The CLI: the public API from libvoxlight, plus its own copy of the
+# platform room (UTF-8 arguments, files, the clock, opening zlib for its
+# MatCap PNG), which the library keeps to itself.
+$(BUILD)/voxlight: $(CLI_C) $(wildcard csrc/cli/*.h) $(BUILD)/libvoxlight.so $(PLATFORM:%=$(BUILD)/obj/%.o) $(LIB_CC_STAMP)
+	$(LIB_CC) $(CFLAGS) $(CLI_C) $(PLATFORM:%=$(BUILD)/obj/%.o) -o $@ -L$(BUILD) -lvoxlight -ldl -lpthread -lm \
+		-Wl,-rpath,'$$ORIGIN'
 
 # The reader helpers (csrc/io/reader_stream.h): the C++ readers, the core
 # objects they use and their library; started by libvoxlight.so.
@@ -210,11 +212,63 @@ $(BUILD)/tests/child_program: tests/child_program.c | $(BUILD)/tests
 # the platform room's Windows files and the tests that need only them, run
 # under Wine by ./build.sh test.
 WIN_BUILD := $(BUILD)/windows-x64
+# the import-library maker of the same toolchain (build.sh names zig's)
+WIN_DLLTOOL ?= x86_64-w64-mingw32-dlltool
 WIN_PLATFORM_C := $(addprefix csrc/platform/,dynlib.c dynlib_win32.c threads_win32.c files.c files_win32.c \
 	clock_win32.c os_win32.c utf16_win32.c process_win32.c)
 WIN_CFLAGS := -std=c11 $(WARN) -O2 -g0 -Icsrc/platform -Icsrc/core -Itests
+# zlib for Windows: Debian's libz-mingw-w64 build, shipped beside
+# voxlight.dll (which opens it from its own folder, os.h) and beside the
+# test programs that use the library's zlib table.
+WIN_ZLIB := /usr/x86_64-w64-mingw32/lib/zlib1.dll
+WIN_ZLIB_DLLS := $(WIN_BUILD)/zlib1.dll $(WIN_BUILD)/tests/zlib1.dll
+$(WIN_ZLIB_DLLS): $(WIN_ZLIB)
+	@mkdir -p $(@D)
+	cp $< $@
+# An import library for the test programs that write gzip files with zlib
+# (the library itself opens zlib1.dll at run time): made from the DLL's
+# export table, as the package ships none.
+$(WIN_BUILD)/libz.dll.a: $(WIN_ZLIB)
+	@mkdir -p $(@D)
+	@{ echo 'LIBRARY zlib1.dll'; echo 'EXPORTS'; \
+	  objdump -p $< | sed -n '/\[Ordinal\/Name Pointer\] Table/,/^$$/p' | sed -nE 's/^\s*\[\s*[0-9]+\] (\w+)$$/    \1/p'; \
+	} > $(WIN_BUILD)/zlib1.def
+	$(WIN_DLLTOOL) -d $(WIN_BUILD)/zlib1.def -l $@ -m i386:x86-64
+
+# The C tests of the public API that build for Windows as they are (the
+# platform room standing in for POSIX calls); the rest reach into POSIX
+# (fork, truncate, pwrite, symlinks), the Linux backends, or Python (test_zarr
+# writes its stores with tests/zarr_write.py: tests/cli/test_windows_cli.py
+# reads such stores with the Windows build).
+WIN_API_TESTS := test_accuracy test_api test_budget test_classification test_cut test_gradients test_kernels \
+	test_labels test_modes test_overlays test_paging test_reference_light test_render test_scene_shadows test_shadows \
+	test_skipping test_slice_plane test_slices test_streaming test_stripes
 windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/child_program.exe $(WIN_BUILD)/tests/test_crc32.exe \
-	$(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/render_scene.exe
+	$(WIN_BUILD)/tests/test_gz_reader.exe $(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/voxlight.exe $(WIN_BUILD)/render_scene.exe \
+	$(WIN_ZLIB_DLLS) $(WIN_API_TESTS:%=$(WIN_BUILD)/tests/%.exe) $(WIN_BUILD)/tests/voxlight.dll \
+	$(WIN_BUILD)/voxlight-read-zarr.exe
+
+# The OME-Zarr helper is our C alone, so Windows has it too (its blosc and
+# zstd codecs are opened at run time, where a system has them); the
+# OpenImageIO and dcmtk helpers need C++ libraries with no Windows build
+# here, and the library refuses their formats on Windows by name.
+WIN_ZARR_HELPER_C := $(wildcard csrc/*/helper_zarr.c) $(ZARR_C) $(wildcard csrc/*/zarr_detect.c) \
+	$(foreach n,$(HELPER_CORE_NAMES),$(wildcard csrc/*/$(n).c)) csrc/platform/helper_self_win32.c $(WIN_PLATFORM_C)
+$(WIN_BUILD)/voxlight-read-zarr.exe: $(WIN_ZARR_HELPER_C) $(wildcard csrc/*/*.h)
+	@mkdir -p $(@D)
+	$(WIN_CC) $(WIN_LIB_CFLAGS) $(WIN_ZARR_HELPER_C) -o $@ -lshell32
+
+$(WIN_API_TESTS:%=$(WIN_BUILD)/tests/%.exe): $(WIN_BUILD)/tests/%.exe: tests/%.c $(wildcard tests/*.h) $(WIN_PLATFORM_C) \
+		$(wildcard csrc/*/*.h) $(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/libz.dll.a
+	@mkdir -p $(@D)
+	$(WIN_CC) $(WIN_LIB_CFLAGS) -Itests $< $(WIN_PLATFORM_C) -o $@ -L$(WIN_BUILD) -lvoxlight $(WIN_BUILD)/libz.dll.a -lshell32
+# beside the test programs, where Windows looks first
+$(WIN_BUILD)/tests/voxlight.dll: $(WIN_BUILD)/voxlight.dll
+	cp $< $@
+
+# The CLI, beside voxlight.dll as on Linux (the same files: see $(BUILD)/voxlight).
+$(WIN_BUILD)/voxlight.exe: $(CLI_C) $(WIN_PLATFORM_C) $(wildcard csrc/*/*.h) $(WIN_BUILD)/voxlight.dll
+	$(WIN_CC) $(WIN_LIB_CFLAGS) $(CLI_C) $(WIN_PLATFORM_C) -o $@ -L$(WIN_BUILD) -lvoxlight -lshell32
 
 # beside voxlight.dll, where Windows looks for it first
 $(WIN_BUILD)/render_scene.exe: tests/render_scene.c $(WIN_BUILD)/voxlight.dll
@@ -223,7 +277,7 @@ $(WIN_BUILD)/render_scene.exe: tests/render_scene.c $(WIN_BUILD)/voxlight.dll
 # voxlight.dll: the library's C for Windows (the *_win32.c files in place of
 # the POSIX ones, WGL in place of OSMesa and EGL); it exports what the
 # public headers mark VXL_API (a .def made from them: the headers carry no
-# Windows-only markup), and links only Windows' own gdi32 and user32.
+# Windows-only markup), and links only Windows' own gdi32, user32 and shell32.
 WIN_LIB_C := $(filter-out $(CLI_C) $(HELPER_C) %_posix.c %/backend_osmesa.c %/backend_egl.c,$(wildcard csrc/*/*.c))
 WIN_LIB_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) -O2 -g0 -Icsrc/include $(CSRC_INC) -I$(BUILD)/gen \
 	-idirafter /usr/include -idirafter /usr/include/$(shell $(CC) -print-multiarch)
@@ -233,27 +287,42 @@ $(WIN_BUILD)/voxlight.def: $(wildcard csrc/include/*.h)
 	  sed -nE 's/^VXL_API[^(]*[ *](vxl_[a-z0-9_]+)\(.*/    \1/p' csrc/include/*.h | sort -u; } > $@
 $(WIN_BUILD)/voxlight.dll: $(WIN_LIB_C) $(wildcard csrc/*/*.h) $(BUILD)/gen/shaders_embedded.c $(WIN_BUILD)/voxlight.def
 	$(WIN_CC) $(WIN_LIB_CFLAGS) -shared $(WIN_LIB_C) $(BUILD)/gen/shaders_embedded.c $(WIN_BUILD)/voxlight.def \
-		-o $@ -Wl,--out-implib,$(WIN_BUILD)/libvoxlight.dll.a -lgdi32 -luser32
+		-o $@ -Wl,--out-implib,$(WIN_BUILD)/libvoxlight.dll.a -lgdi32 -luser32 -lshell32
 .PHONY: windows
 
 $(WIN_BUILD)/tests/test_platform.exe: tests/test_platform.c tests/harness.h $(WIN_PLATFORM_C) $(wildcard csrc/platform/*.h)
 	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_CFLAGS) $< $(WIN_PLATFORM_C) -o $@
+	$(WIN_CC) $(WIN_CFLAGS) $< $(WIN_PLATFORM_C) -o $@ -lshell32
 
 $(WIN_BUILD)/tests/child_program.exe: tests/child_program.c
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_CFLAGS) $< -o $@
 
+$(WIN_BUILD)/tests/test_gz_reader.exe: tests/test_gz_reader.c tests/harness.h tests/utf8_temp.h $(WIN_PLATFORM_C) \
+		csrc/io/gz_reader.c csrc/io/zlib_api.c csrc/core/error.c csrc/core/crc32.c $(wildcard csrc/*/*.h)
+	@mkdir -p $(@D)
+	$(WIN_CC) $(WIN_LIB_CFLAGS) -Itests $< $(filter %.c,$(filter-out $<,$^)) -o $@ -lshell32
+
 $(WIN_BUILD)/tests/test_crc32.exe: tests/test_crc32.c tests/harness.h csrc/core/crc32.c csrc/core/crc32_tables.h
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_CFLAGS) $< csrc/core/crc32.c -o $@
+
+# test_gz_reader reads gzip and plain files through the library's internal
+# reader (the same file is built for Windows above).
+GZ_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gz_reader zlib_api error crc32 $(PLATFORM))
+$(BUILD)/tests/test_gz_reader: tests/test_gz_reader.c tests/harness.h tests/utf8_temp.h $(GZ_TEST_OBJ) | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(GZ_TEST_OBJ) -o $@ -ldl -lpthread
 
 # test_crc32 checks the library's internal CRC-32 against zlib's values.
 $(BUILD)/tests/test_crc32: tests/test_crc32.c tests/harness.h $(BUILD)/obj/crc32.o | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(BUILD)/obj/crc32.o -o $@
 
-$(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h tests/fuzz/*.h) $(BUILD)/libvoxlight.so | $(BUILD)/tests
-	$(CC) $(CFLAGS) -Itests $< -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
+# The tests use the public API, and the platform room for what differs
+# between OSes (test_util.h), so the same files build for Windows below.
+$(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h tests/fuzz/*.h) $(BUILD)/libvoxlight.so \
+		$(PLATFORM:%=$(BUILD)/obj/%.o) | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(PLATFORM:%=$(BUILD)/obj/%.o) -o $@ -L$(BUILD) -lvoxlight -lz -lm -ldl -lpthread \
+		-Wl,-rpath,'$$ORIGIN/..'
 
 $(BUILD)/obj $(BUILD)/gen $(BUILD)/tests:
 	mkdir -p $@
@@ -274,7 +343,7 @@ FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_u
 # the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
-	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c crc32.c $(PLATFORM:%=%.c))
+	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c $(PLATFORM:%=%.c))
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))

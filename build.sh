@@ -25,11 +25,13 @@ ROOT=$(pwd)
 # library (and every test) renders through Mesa's surfaceless EGL; without
 # Wine only the Windows tests cannot run (their suite says so). "clang-rt"
 # stands for the sanitizer/libFuzzer runtime of clang's major version.
+# libz-mingw-w64: zlib1.dll, shipped beside voxlight.dll (Windows has no
+# system zlib).
 NEEDS=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
        libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev libzstd-dev libblosc-dev mricron-data blender
        xvfb xauth python3 python3-numpy python3-pytest zip unzip clang clang-rt llvm
        python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv" "?python3.13-venv"
-       "?wine64|wine")
+       "?wine64|wine" libz-mingw-w64)
 
 # (output captured, not piped into grep -q: under pipefail an early grep exit
 # would fail the pipeline)
@@ -129,7 +131,8 @@ build() {
     # Windows x64, cross-compiled by the same zig (its MinGW-w64 runtime):
     # the platform room's Windows files and their tests, run under Wine
     if [ "$lib_cc" != cc ]; then
-        make -s -j"$(nproc)" BUILD=build windows WIN_CC="$ROOT/build/zig/bin/python -m ziglang cc -target x86_64-windows-gnu"
+        make -s -j"$(nproc)" BUILD=build windows WIN_CC="$ROOT/build/zig/bin/python -m ziglang cc -target x86_64-windows-gnu" \
+            WIN_DLLTOOL="$ROOT/build/zig/bin/python -m ziglang dlltool"
     fi
     if [ -x tools/package_addon.sh ]; then tools/package_addon.sh build; fi
 }
@@ -309,9 +312,26 @@ wine_binary() {
     return 1
 }
 
+# Runs "$@" with DISPLAY on an Xvfb of its own, which ends with it (a
+# shell function too, which xvfb-run cannot run).
+with_xvfb() {
+    local fifo pid display rc
+    fifo=$(mktemp -u)
+    mkfifo "$fifo"
+    Xvfb -displayfd 3 -screen 0 640x480x24 -nolisten tcp 3>"$fifo" 2>/dev/null &
+    pid=$!
+    read -r display <"$fifo"
+    rm -f "$fifo"
+    DISPLAY=":$display" "$@" && rc=0 || rc=$?
+    kill "$pid" 2>/dev/null
+    wait "$pid" 2>/dev/null || true
+    return $rc
+}
+
 # The Windows test programs of build/windows-x64/tests under Wine, in a
-# Wine prefix of their own under build/ (made on the first run; console
-# programs need no display).
+# Wine prefix of their own under build/ (made on the first run), on one
+# Xvfb: Wine's OpenGL, which the render tests' WGL contexts use, is GLX on
+# Mesa's llvmpipe.
 run_wine_tests() {
     local dir=$1 wine
     if ! wine=$(wine_binary); then
@@ -324,7 +344,7 @@ run_wine_tests() {
         echo "0 passed, 1 failed"
         return 1
     fi
-    WINEPREFIX="$ROOT/build/wine" WINEDEBUG=-all run_c_tests "$dir" timeout 600 "$wine"
+    WINEPREFIX="$ROOT/build/wine" WINEDEBUG=-all with_xvfb run_c_tests "$dir" timeout 600 "$wine"
 }
 
 cmd=${1:-build}

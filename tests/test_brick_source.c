@@ -19,6 +19,7 @@
 
 #include "fuzz/writers.h"
 #include "harness.h"
+#include "os.h"
 #include "loader_test_util.h"
 #include "nifti_writer.h"
 #include "stream_compare.h"
@@ -188,7 +189,7 @@ TEST(raw_source_equals_the_whole_load_for_every_type_and_byte_order)
         for (int format = 0; format < 4; format++)
             for (int big = 0; big < 2; big++) {
                 /* the big-endian half reads every coarse level by averaging level-0 reads */
-                if (big) setenv("VOXLIGHT_SOURCE_KEEP_BYTES", "0", 1);
+                if (big) vxl_os_set_env("VOXLIGHT_SOURCE_KEEP_BYTES", "0");
                 snprintf(what, sizeof what, "%s %s %s", names[format], k_types[k].nrrd, big ? "big" : "little");
                 REQUIRE(write_case(tmp(p, sizeof p, names[format]), format, &k_types[k], big, raw) == 0);
                 vxl_volume *w = NULL, *s = NULL;
@@ -200,7 +201,7 @@ TEST(raw_source_equals_the_whole_load_for_every_type_and_byte_order)
                 }
                 vxl_volume_destroy(w);
                 vxl_volume_destroy(s);
-                unsetenv("VOXLIGHT_SOURCE_KEEP_BYTES");
+                vxl_os_set_env("VOXLIGHT_SOURCE_KEEP_BYTES", NULL);
             }
         free(raw);
     }

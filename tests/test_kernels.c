@@ -27,6 +27,7 @@
 #include <string.h>
 
 #include "harness.h"
+#include "files.h"
 #include "test_util.h"
 #include "voxlight_dev.h"
 
@@ -222,7 +223,7 @@ static void check_minmax_kernels_agree(vxl_test_ctx *T_, const int B)
     static double norm[GX * GY * GZ];
     char edge[8];
     snprintf(edge, sizeof edge, "%d", B);
-    setenv("VOXLIGHT_BRICK_SIZE", edge, 1);
+    vxl_os_set_env("VOXLIGHT_BRICK_SIZE", edge);
     for (int t = 0; t < 3; t++) {
         vxl_renderer *rs[2] = {make_stored(VXL_STORAGE_DENSE), make_stored(VXL_STORAGE_BRICKED)};
         vxl_volume *v = make_typed(dtypes[t], norm);
@@ -268,7 +269,7 @@ static void check_minmax_kernels_agree(vxl_test_ctx *T_, const int B)
         vxl_renderer_destroy(rs[0]);
         vxl_renderer_destroy(rs[1]);
     }
-    unsetenv("VOXLIGHT_BRICK_SIZE");
+    vxl_os_set_env("VOXLIGHT_BRICK_SIZE", NULL);
 }
 
 TEST(brick_minmax_cpu_equals_glsl_bit_for_bit)
@@ -283,7 +284,7 @@ TEST(brick_minmax_cpu_equals_glsl_bit_for_bit)
  * skipping only leaves out samples that add nothing. */
 TEST(dense_storage_skips_with_finer_bricks)
 {
-    unsetenv("VOXLIGHT_BRICK_SIZE");
+    vxl_os_set_env("VOXLIGHT_BRICK_SIZE", NULL);
     static double norm[GX * GY * GZ];
     vxl_renderer *rs[2] = {make_stored(VXL_STORAGE_DENSE), make_stored(VXL_STORAGE_BRICKED)};
     vxl_volume *v = make_typed(VXL_DTYPE_U8, norm);
@@ -305,18 +306,24 @@ TEST(dense_storage_skips_with_finer_bricks)
     vxl_renderer_destroy(rs[1]);
 }
 
-/* The source tree's shaders/, from this binary's place (BUILD/tests/):
- * found from any working directory; 0 when not found. */
+/* The source tree's shaders/, found by walking up from this program's
+ * folder (BUILD/tests/, or BUILD/windows-x64/tests/): found from any working
+ * directory; 0 when not found. */
 static int source_shader_dir(char *out, size_t n)
 {
-    char exe[PATH_MAX];
-    if (!realpath("/proc/self/exe", exe)) return 0;
-    for (int up = 0; up < 3; up++) {
-        char *slash = strrchr(exe, '/');
+    char found[4096], exe[4096];
+    if (vxl_dynlib_path_of((const void *)&source_shader_dir, found, sizeof found) ||
+        !vxl_real_path(found, exe, sizeof exe))
+        return 0;
+    for (int up = 0; up < 5; up++) {
+        char *slash = strrchr(exe, '/'), *back = strrchr(exe, '\\');
+        if (back > slash) slash = back;
         if (!slash) return 0;
         *slash = '\0';
+        if (snprintf(out, n, "%s/shaders/lib", exe) < (int)n && vxl_is_dir(out))
+            return snprintf(out, n, "%s/shaders", exe) < (int)n;
     }
-    return snprintf(out, n, "%s/shaders", exe) < (int)n;
+    return 0;
 }
 
 /* VOXLIGHT_SHADER_DIR / shader_dir names the shaders/ folder and resolves

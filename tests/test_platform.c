@@ -16,6 +16,7 @@
 #include "dynlib.h"
 #include "files.h"
 #include "harness.h"
+#include "utf8_temp.h"
 #include "os.h"
 #include "process.h"
 #include "threads.h"
@@ -122,19 +123,10 @@ TEST(the_clock_never_goes_back)
     }
 }
 
-/* The folder the checks write into: the system's temporary folder. */
-static void temp_folder(char *out, size_t n)
-{
-    const char *env[] = {"TMPDIR", "TEMP", "TMP"};
-    const char *base = NULL;
-    for (int i = 0; i < 3 && !base; i++) base = getenv(env[i]);
-    snprintf(out, n, "%s/voxlight-platform-José-ü", base && *base ? base : ".");
-}
-
 TEST(files_with_utf8_names_are_written_renamed_listed_and_read)
 {
     char dir[4096], tmp[4200], final[4200];
-    temp_folder(dir, sizeof dir);
+    utf8_temp_folder("platform", dir, sizeof dir);
     REQUIRE(vxl_mkdir(dir) == 0);
     CHECK(vxl_mkdir(dir) == 0); /* already there */
     CHECK(vxl_is_dir(dir) && !vxl_is_file(dir));

@@ -270,21 +270,14 @@ TEST(extreme_steps_are_bounded)
     }
 }
 
-/* R's backend against EGL: OSMesa and EGL are two ways to llvmpipe and must
- * agree. Without OSMesa, R is itself on EGL, and the comparison is of two
- * EGL contexts on the one process-wide display (which egl_close shares). */
-TEST(egl_on_mesa_matches_osmesa)
+/* R against a second context on `backend`, rendering the same ball. */
+static void second_context_matches(vxl_test_ctx *T_, uint32_t backend)
 {
-    if (getenv("VOXLIGHT_TEST_NO_EGL")) {
-        fprintf(stderr, "    VOXLIGHT_TEST_NO_EGL set: EGL comparison not run\n");
-        CHECK(0 && "EGL test disabled by environment");
-        return;
-    }
-    vxl_renderer *e = make_renderer(VXL_BACKEND_EGL);
+    vxl_renderer *e = make_renderer(backend);
     REQUIRE(e);
     vxl_renderer_info info = {.struct_size = sizeof info};
-    CHECK(vxl_renderer_get_info(e, &info) == VXL_OK && info.backend == VXL_BACKEND_EGL);
-    fprintf(stderr, "    egl: %s, %s, %s\n", info.backend_name, info.gl_renderer, info.gl_version);
+    CHECK(vxl_renderer_get_info(e, &info) == VXL_OK && info.backend == backend);
+    fprintf(stderr, "    second context: %s, %s, %s\n", info.backend_name, info.gl_renderer, info.gl_version);
     double c = 15.5, prm[4] = {c, c, c, 11};
     vxl_volume *v = make_volume_f32(32, 32, 32, field_ball, prm);
     REQUIRE(v);
@@ -294,14 +287,26 @@ TEST(egl_on_mesa_matches_osmesa)
     vxl_render_params p = ball_params();
     CHECK(vxl_render(R, &p, a, NULL) == VXL_OK && vxl_render(e, &p, b, NULL) == VXL_OK);
     double rmse = image_rmse(a, b, NPIX * 4);
-    CHECKF(rmse < 2e-3, "egl vs %s rmse %.5f", osmesa_installed() ? "osmesa" : "a second egl context", rmse);
+    CHECKF(rmse < 2e-3, "%s against R's context: rmse %.5f", info.backend_name, rmse);
     vxl_renderer_destroy(e);
 }
 
-/* the same check where there is no OSMesa, named for what it compares */
-TEST(two_egl_contexts_match)
+/* OSMesa and EGL are two ways to llvmpipe and must agree. */
+TEST(egl_on_mesa_matches_osmesa)
 {
-    egl_on_mesa_matches_osmesa(T_);
+    if (getenv("VOXLIGHT_TEST_NO_EGL")) {
+        fprintf(stderr, "    VOXLIGHT_TEST_NO_EGL set: EGL comparison not run\n");
+        CHECK(0 && "EGL test disabled by environment");
+        return;
+    }
+    second_context_matches(T_, VXL_BACKEND_EGL);
+}
+
+/* Without OSMesa (R on EGL), or on Windows (WGL): two contexts of the one
+ * backend, which share a process-wide display or llvmpipe screen. */
+TEST(two_contexts_of_one_backend_match)
+{
+    second_context_matches(T_, software_backend());
 }
 
 int main(int argc, char **argv)
@@ -322,7 +327,7 @@ int main(int argc, char **argv)
     RUN(camera_inside_and_axis_parallel_views_are_sane);
     RUN(extreme_steps_are_bounded);
     if (osmesa_installed()) RUN(egl_on_mesa_matches_osmesa);
-    else RUN(two_egl_contexts_match);
+    else RUN(two_contexts_of_one_backend_match);
     vxl_renderer_destroy(R);
     return TEST_SUMMARY();
 }

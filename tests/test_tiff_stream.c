@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "os.h"
 #include "loader_test_util.h"
 #include "stream_compare.h"
 #include "voxlight_dev.h"
@@ -238,7 +239,7 @@ TEST(streamed_tiff_equals_the_whole_read)
         REQUIRE(write_tiff(tmp(p, sizeof p, c % 2 ? "case.tiff" : "case.tif"), &sp, px) == 0);
         vxl_volume *w = NULL, *s = NULL;
         /* every other case reads each coarse level by averaging level-0 reads (the large-file path) */
-        if (c % 2) setenv("VOXLIGHT_SOURCE_KEEP_BYTES", "0", 1);
+        if (c % 2) vxl_os_set_env("VOXLIGHT_SOURCE_KEEP_BYTES", "0");
         CHECKF(load(p, VXL_STREAMING_OFF, 0, &w) == VXL_OK, "%s: %s", k_cases[c].name, vxl_last_error());
         CHECKF(load(p, VXL_STREAMING_ON, 0, &s) == VXL_OK, "%s: %s", k_cases[c].name, vxl_last_error());
         if (w && s) {
@@ -263,7 +264,7 @@ TEST(streamed_tiff_equals_the_whole_read)
         }
         vxl_volume_destroy(w);
         vxl_volume_destroy(s);
-        unsetenv("VOXLIGHT_SOURCE_KEEP_BYTES");
+        vxl_os_set_env("VOXLIGHT_SOURCE_KEEP_BYTES", NULL);
         free(px);
     }
 }

@@ -3,13 +3,14 @@
 #ifndef VXL_TEST_UTIL_H
 #define VXL_TEST_UTIL_H
 
-#include <dlfcn.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "dynlib.h"
+#include "os.h"
 #include "scenes.h"
 #include "voxlight.h"
 
@@ -75,7 +76,7 @@ static inline int osmesa_installed(void)
     static int known, have;
     if (!known) {
         known = 1;
-        have = dlopen("libOSMesa.so.8", RTLD_NOW | RTLD_LOCAL) != NULL;
+        have = vxl_dynlib_open("libOSMesa.so.8", NULL, 0) != NULL;
     }
     return have;
 }
@@ -83,10 +84,13 @@ static inline int osmesa_installed(void)
 /* The software backend the tests render on: OSMesa where it is installed,
  * else Mesa's surfaceless EGL, which is what `auto` and every user get on a
  * release without OSMesa (Mesa 25.1 removed it). The fallback is announced on
- * stdout, which ./build.sh test shows, so a log says which backend ran. */
+ * stdout, which ./build.sh test shows, so a log says which backend ran. On
+ * Windows (under Wine: its OpenGL is Mesa's llvmpipe through GLX) it is WGL,
+ * the only backend there. */
 static inline uint32_t software_backend(void)
 {
     static int announced;
+    if (!strcmp(vxl_os_name(), "windows")) return VXL_BACKEND_WGL;
     if (osmesa_installed()) return VXL_BACKEND_OSMESA;
     if (!announced) {
         announced = 1;

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "os.h"
 #include "loader_test_util.h"
 #include "volume.h"
 #include "voxlight.h"
@@ -328,7 +329,7 @@ TEST(chunks_decompressing_past_their_size_are_errors_naming_the_file)
 
 TEST(a_missing_codec_library_is_named_only_when_its_chunks_are_met)
 {
-    setenv("VOXLIGHT_ZARR_LIBZSTD", "/nonexistent/libzstd-missing.so.1", 1);
+    vxl_os_set_env("VOXLIGHT_ZARR_LIBZSTD", "/nonexistent/libzstd-missing.so.1");
     vxl_volume *v = load(store_path("v2_zstd_u16"), VXL_STREAMING_ON, 0, 0);
     CHECK(v == NULL);
     const char *msg = vxl_last_error();
@@ -338,13 +339,13 @@ TEST(a_missing_codec_library_is_named_only_when_its_chunks_are_met)
     v = load(store_path("v2_gzip_u16"), VXL_STREAMING_ON, 0, 0); /* gzip needs no library */
     CHECKF(v && v->source, "%s", vxl_last_error());
     vxl_volume_destroy(v);
-    unsetenv("VOXLIGHT_ZARR_LIBZSTD");
-    setenv("VOXLIGHT_ZARR_LIBBLOSC", "/nonexistent/libblosc-missing.so.1", 1);
+    vxl_os_set_env("VOXLIGHT_ZARR_LIBZSTD", NULL);
+    vxl_os_set_env("VOXLIGHT_ZARR_LIBBLOSC", "/nonexistent/libblosc-missing.so.1");
     v = load(store_path("v2_blosc_i8"), VXL_STREAMING_ON, 0, 0);
     CHECKF(!v && strstr(vxl_last_error(), "libblosc-missing.so.1") && strstr(vxl_last_error(), "blosc-compressed"),
            "%s", vxl_last_error());
     vxl_volume_destroy(v);
-    unsetenv("VOXLIGHT_ZARR_LIBBLOSC");
+    vxl_os_set_env("VOXLIGHT_ZARR_LIBBLOSC", NULL);
 }
 
 static int g_calls;

@@ -8,7 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <time.h>
+
+#include "clock.h"
+#include "os.h"
 
 #include "cli_cut.h"   /* --clip-plane, --crop, --no-caps (issue 19) */
 #include "cli_modes.h" /* --mode, --iso-value, --matcap, --ortho, --view (issue 19) */
@@ -533,17 +535,16 @@ static int cmd_render(int argc, char **argv)
     rgba = malloc((size_t)w * h * 4 * sizeof *rgba);
     depth = malloc((size_t)w * h * sizeof *depth);
     if (!rgba || !depth) { die("out of memory for a %ux%u image", w, h); goto done; }
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    const double t0 = vxl_monotonic_s();
     if (vxl_render(r, &a.p, rgba, depth)) { die("%s", vxl_renderer_error(r)); goto done; }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
+    const double t1 = vxl_monotonic_s();
     if (vxl_write_image(a.output, rgba, depth, w, h)) { die("%s", vxl_last_error()); goto done; }
     vxl_renderer_info ri = {.struct_size = sizeof ri};
     vxl_renderer_get_info(r, &ri);
     fprintf(stderr, "voxlight: wrote %s (%ux%u, %s, %s)\n", a.output, w, h, ri.backend_name, ri.gl_renderer);
     vxl_render_stats st = {.struct_size = sizeof st};
     vxl_renderer_get_stats(r, &st);
-    double secs = (double)(t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9;
+    double secs = t1 - t0;
     if (st.page_brick)
         fprintf(stderr, "voxlight: storage %s, %.1f MiB resident, %u of %u bricks of %u^3 in the pool, %u constant; frame %.3f s\n",
                 vxl_storage_name(st.storage), st.resident_bytes / 1048576.0, st.pages_resident, st.pages_total,
@@ -580,6 +581,7 @@ static int cmd_labels(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    if (vxl_os_utf8_args(&argc, &argv)) return die("the command line cannot be read as UTF-8");
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
         print_usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? 1 : 0;

@@ -6,7 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
+
+#include "files.h"
 
 void vxl_cli_labels_init(vxl_cli_labels *l)
 {
@@ -57,7 +58,7 @@ static int find_lut(const char *image, char *out, size_t out_size)
         const char *slash = strrchr(stem, '/');
         for (size_t s = 0; s < sizeof suffixes / sizeof *suffixes; s++) {
             if ((size_t)snprintf(out, out_size, "%s%s", stem, suffixes[s]) >= out_size) continue;
-            if (strcmp(out, image) && access(out, R_OK) == 0) return 1;
+            if (strcmp(out, image) && vxl_is_file(out)) return 1;
         }
         char *dot = strrchr(stem, '.');
         if (!dot || (slash && dot < slash) || dot == stem) break;

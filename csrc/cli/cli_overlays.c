@@ -5,7 +5,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
+
+#include "files.h"
 
 void vxl_cli_overlays_init(vxl_cli_overlays *o)
 {
@@ -32,7 +33,10 @@ static int parse_spec(const char *val, vxl_cli_overlays *o, char *err, size_t er
 {
     vxl_overlay_style *s = &o->style[o->count];
     char *path = o->path[o->count];
-    const char *colon = access(val, F_OK) == 0 ? NULL : strchr(val, ':');
+    vxl_path_info info;
+    /* a drive letter's colon ("C:\\scans\\ct.nii:hot") is the path's */
+    const int drive = ((val[0] | 32) >= 'a' && (val[0] | 32) <= 'z') && val[1] == ':' && (val[2] == '\\' || val[2] == '/');
+    const char *colon = vxl_path_stat(val, &info) == 0 ? NULL : strchr(val + (drive ? 2 : 0), ':');
     size_t len = colon ? (size_t)(colon - val) : strlen(val);
     if (!len || len >= sizeof o->path[0])
         return snprintf(err, err_size, "bad --overlay '%s': use FILE[:PRESET][:LO:HI]", val), 1;

@@ -5,7 +5,8 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
-#include <unistd.h>
+
+#include "os.h"
 
 #define CLI_DEFAULT_BUDGET (2ull << 30) /* voxlight.h: a budget of 0 means 2 GiB */
 
@@ -14,7 +15,10 @@
  * process with one open at a time, so a static flag is all it needs (the
  * library itself keeps no such state). */
 static volatile sig_atomic_t interrupted;
-static struct sigaction previous_sigint;
+/* C's signal(), which POSIX and Windows consoles both deliver Ctrl-C to
+ * (glibc's restarts interrupted reads, so the library's reads go on and it
+ * stops at its next progress call). */
+static void (*previous_sigint)(int);
 
 static void on_sigint(int sig)
 {
@@ -98,7 +102,7 @@ static int print_progress(void *user, double fraction, const char *stage)
 void vxl_cli_stream_begin(vxl_cli_stream *s, const char *input, uint64_t total_budget, vxl_load_options *lo)
 {
     s->input = input;
-    s->tty = isatty(STDERR_FILENO);
+    s->tty = vxl_os_is_terminal(stderr);
     s->line_open = 0;
     s->last_step = -1;
     s->stage[0] = '\0';
@@ -114,17 +118,12 @@ void vxl_cli_stream_begin(vxl_cli_stream *s, const char *input, uint64_t total_b
     lo->progress = print_progress;
     lo->progress_user = s;
     interrupted = 0;
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_sigint;
-    sa.sa_flags = SA_RESTART; /* the library's reads go on; it stops at its next progress call */
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &previous_sigint);
+    previous_sigint = signal(SIGINT, on_sigint);
 }
 
 int vxl_cli_stream_end(vxl_cli_stream *s, int load_rc)
 {
-    sigaction(SIGINT, &previous_sigint, NULL);
+    signal(SIGINT, previous_sigint == SIG_ERR ? SIG_DFL : previous_sigint);
     if (s->line_open) {
         fputc('\n', stderr);
         s->line_open = 0;

@@ -1,8 +1,9 @@
 /* matcap_png.c - the CLI's PNG reader for --matcap (matcap_png.h). The
  * library reads colour images only through its OpenImageIO helper, which
  * reduces them to grey volumes, and the CLI links no image library: a
- * MatCap is one small RGB picture, decoded here with zlib (which the library
- * already links). Image rows are stored top first; vxl_matcap wants row 0 =
+ * MatCap is one small RGB picture, decoded here with the system's zlib,
+ * opened at run time as the library opens it (os.h names it per OS), so
+ * the tool needs no zlib to start. Image rows are stored top first; vxl_matcap wants row 0 =
  * bottom. The texels are the stored values over 255 (65535), as they are:
  * the CLI writes its PNGs the same way (image_write.c, no transfer curve),
  * so a MatCap shades a white surface to the picture's own colours. */
@@ -12,7 +13,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
 #include <zlib.h>
+
+#include "dynlib.h"
+#include "files.h"
+#include "os.h"
 
 #define MAX_SIDE 4096 /* vxl_matcap's limit */
 
@@ -54,9 +60,10 @@ static int unfilter(unsigned char *raw, uint32_t h, size_t stride, int bpp)
 int vxl_cli_read_matcap_png(const char *path, float **rgba, uint32_t *w, uint32_t *h, char *err, size_t err_size)
 {
     *rgba = NULL;
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = vxl_fopen(path, "rb");
     if (!fp) return fail(err, err_size, "cannot open the MatCap '%s'", path);
     unsigned char *file = NULL, *idat = NULL, *raw = NULL;
+    vxl_dynlib *zlib = NULL;
     long size = fseek(fp, 0, SEEK_END) == 0 ? ftell(fp) : -1;
     int rc = 1;
     if (size < 8 || size > (1L << 30) || fseek(fp, 0, SEEK_SET) != 0 || !(file = malloc((size_t)size)) ||
@@ -108,7 +115,16 @@ int vxl_cli_read_matcap_png(const char *path, float **rgba, uint32_t *w, uint32_
     int bpp = channels * (int)depth / 8;
     size_t stride = (size_t)*w * (size_t)bpp;
     uLongf raw_size = (uLongf)((stride + 1) * *h);
-    if (!(raw = malloc(raw_size)) || uncompress(raw, &raw_size, idat, (uLong)n_idat) != Z_OK ||
+    char why[256] = "";
+    zlib = vxl_dynlib_open(vxl_os_zlib_name(), why, sizeof why);
+    __typeof__(&uncompress) inflate_all = NULL;
+    vxl_dynlib_fn fn = zlib ? vxl_dynlib_symbol(zlib, "uncompress") : NULL;
+    if (fn) memcpy(&inflate_all, &fn, sizeof fn);
+    if (!inflate_all) {
+        fail(err, err_size, "the MatCap '%s' cannot be decoded without zlib: %s", path, zlib ? "it lacks uncompress" : why);
+        goto done;
+    }
+    if (!(raw = malloc(raw_size)) || inflate_all(raw, &raw_size, idat, (uLong)n_idat) != Z_OK ||
         raw_size != (stride + 1) * *h || unfilter(raw, *h, stride, bpp)) {
         fail(err, err_size, "the MatCap '%s' has corrupt image data", path);
         goto done;
@@ -133,6 +149,7 @@ done:
     free(file);
     free(idat);
     free(raw);
+    vxl_dynlib_close(zlib);
     if (rc) {
         free(*rgba);
         *rgba = NULL;

@@ -5,5 +5,7 @@
 int vxl_context_open_backend(vxl_context *c, uint32_t b, vxl_err *e)
 {
     if (b == VXL_BACKEND_AUTO || b == VXL_BACKEND_WGL) return vxl_wgl_open(c, e);
-    return vxl_fail(e, VXL_ERR_BACKEND, "backend %u is not one of Windows' (VOXLIGHT_BACKEND must be auto or wgl)", b);
+    /* as on Linux: a backend this system does not have is a bad argument */
+    return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "backend %u is not one of Windows' (VOXLIGHT_BACKEND must be auto or wgl)",
+                    b);
 }

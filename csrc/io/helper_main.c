@@ -4,22 +4,20 @@
 #include "helper_main.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
+#include "helper_self.h"
+#include "os.h"
 #include "reader_stream.h"
 
 static int write_all(int fd, const void *buf, size_t n)
 {
     const char *p = buf;
     while (n) {
-        ssize_t w = write(fd, p, n > (1u << 30) ? (1u << 30) : n);
+        int64_t w = vxl_self_write(fd, p, n > (1u << 30) ? (1u << 30) : n);
         if (w < 0 && errno == EINTR) continue;
         if (w <= 0) return -1;
         p += w;
@@ -80,32 +78,10 @@ static void cap_address_space(uint64_t budget)
 {
 #ifndef VXL_HELPER_SANITIZED
     const uint64_t headroom = 2ull << 30;
-    uint64_t cap = budget > (UINT64_MAX - headroom) / 3 ? UINT64_MAX : 3 * budget + headroom;
-    struct rlimit lim;
-    if (getrlimit(RLIMIT_AS, &lim) == 0 && (lim.rlim_max == RLIM_INFINITY || cap < lim.rlim_max)) {
-        lim.rlim_cur = (rlim_t)cap;
-        setrlimit(RLIMIT_AS, &lim); /* best effort: a failure leaves the process as it was */
-    }
+    vxl_self_cap_memory(budget > (UINT64_MAX - headroom) / 3 ? UINT64_MAX : 3 * budget + headroom);
 #else
     (void)budget;
 #endif
-}
-
-/* Descriptors the host process left open without O_CLOEXEC (Blender's,
- * another add-on's) are inherited by the helper; held here they could keep
- * a pipe of the host's open for the helper's whole run. The helper is
- * given only 0, 1 and 2, so it closes the rest first thing: the library
- * starts it with plain posix_spawn, which on glibc 2.28 (the oldest the
- * library supports) has no way to close them itself. Linux's close_range
- * where the kernel has it, else every descriptor up to the limit. */
-static void close_inherited(void)
-{
-#ifdef SYS_close_range
-    if (syscall(SYS_close_range, 3u, ~0u, 0u) == 0) return;
-#endif
-    long max = sysconf(_SC_OPEN_MAX);
-    if (max < 0 || max > 65536) max = 65536;
-    for (int fd = 3; fd < max; fd++) close(fd);
 }
 
 static void volume_header(const vxl_volume *v, vxl_reader_header *h)
@@ -132,6 +108,12 @@ static void volume_header(const vxl_volume *v, vxl_reader_header *h)
 
 int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_command *cmds, int n_cmds)
 {
+    /* the file's path as the library passed it (UTF-8), not as Windows'
+     * ANSI code page spells it */
+    if (vxl_os_utf8_args(&argc, &argv)) {
+        fprintf(stderr, "%s: the command line cannot be read as UTF-8\n", helper);
+        return 2;
+    }
     const vxl_helper_command *cmd = NULL;
     for (int i = 0; argc == VXL_HELPER_ARGC && i < n_cmds; i++)
         if (!strcmp(argv[1], cmds[i].name)) cmd = &cmds[i];
@@ -143,11 +125,14 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
         fputs(")\n", stderr);
         return 2;
     }
-    close_inherited();
+    /* Descriptors the host process left open (Blender's, another
+     * add-on's), held here, could keep a pipe of the host's open for the
+     * helper's whole run. */
+    vxl_self_close_inherited();
     /* The stream keeps stdout's pipe to itself: whatever the libraries
      * print goes to stderr instead of into the voxels. */
-    int out = fcntl(1, F_DUPFD_CLOEXEC, 3);
-    if (out < 0 || dup2(2, 1) < 0) {
+    int out = vxl_self_take_stdout();
+    if (out < 0) {
         perror(helper);
         return 3;
     }

@@ -2,8 +2,8 @@
  *
  * Our own reader instead of libnifti: we need one 3D volume at a time, want
  * every header field treated as hostile input, and want failures reported
- * through vxl_fail rather than printed. zlib's gz* functions read plain and
- * gzip files alike, so one code path serves both.
+ * through vxl_fail rather than printed. gz_reader.h reads plain and gzip
+ * files alike, so one code path serves both.
  *
  * Flow: find the header file -> read and parse the header into a
  * version-neutral struct -> validate it -> read the chosen volume's raw bytes (frame option, 4D)
@@ -15,7 +15,7 @@
 #include "loader_util.h"
 #include "loaders.h"
 #include "stream_load.h"
-#include "zlib_api.h"
+#include "gz_reader.h"
 
 #include <errno.h>
 #include <math.h>
@@ -33,8 +33,6 @@
 /* Extensions (e.g. CIFTI XML) can be megabytes, never anywhere near this;
  * a larger vox_offset is a corrupt header, not a real file. */
 #define MAX_VOX_OFFSET (1ull << 30)
-/* gzread takes an unsigned and returns an int: stay well inside INT_MAX. */
-#define READ_CHUNK (1u << 30)
 #define GZ_BUFFER (256u * 1024u)
 
 /* A 3x4 affine, row-major as NIfTI writes srow_x/y/z. A struct so it can be
@@ -201,31 +199,17 @@ static char *image_path_for(const char *hdr_path)
 
 static vxl_gz *open_gz(const char *path, vxl_err *e)
 {
-    return vxl_gz_open(path, GZ_BUFFER, e); /* larger than zlib's 8 KiB default: fewer syscalls */
+    return vxl_gz_open(path, GZ_BUFFER, e); /* large: fewer reads of the file */
 }
 
 /* Reads up to n bytes; *got says how many arrived. Returns VXL_OK at EOF too
  * (the caller judges a short count), or an error for a broken stream. */
-static int read_bytes(vxl_gz *f, void *buf, uint64_t n, uint64_t *got, const char *path, vxl_err *e)
+static int read_bytes(vxl_gz *f, void *buf, uint64_t n, uint64_t *got, vxl_err *e)
 {
-    unsigned char *p = buf;
-    *got = 0;
-    while (*got < n) {
-        uint64_t left = n - *got;
-        unsigned want = left > READ_CHUNK ? READ_CHUNK : (unsigned)left;
-        int r = vxl_gz_read(f, p + *got, want);
-        if (r < 0) {
-            int zerr = Z_OK;
-            const char *msg = vxl_gz_error(f, &zerr);
-            if (zerr == Z_ERRNO)
-                return vxl_fail(e, VXL_ERR_IO, "read error in '%s': %s", path, strerror(errno));
-            return vxl_fail(e, VXL_ERR_FORMAT, "corrupt compressed data in '%s': %s", path,
-                            msg ? msg : "unknown zlib error");
-        }
-        if (r == 0) break;
-        *got += (uint64_t)r;
-    }
-    return VXL_OK;
+    size_t have = 0;
+    int rc = vxl_gz_read(f, buf, (size_t)n, &have, e);
+    *got = have;
+    return rc;
 }
 
 /* ---------------------------------------------------------------- header */
@@ -324,7 +308,7 @@ static int read_header(vxl_gz *f, const char *path, nii_header *h, vxl_err *e)
 {
     unsigned char b[NII2_HDR_SIZE];
     uint64_t got;
-    int rc = read_bytes(f, b, NII1_HDR_SIZE, &got, path, e);
+    int rc = read_bytes(f, b, NII1_HDR_SIZE, &got, e);
     if (rc) return rc;
     if (got < 4 || !detect_version(b, &h->version, &h->swapped)) {
         if (got < 4)
@@ -339,7 +323,7 @@ static int read_header(vxl_gz *f, const char *path, nii_header *h, vxl_err *e)
     size_t want = h->version == 1 ? NII1_HDR_SIZE : NII2_HDR_SIZE;
     if (got == NII1_HDR_SIZE && want > got) {
         uint64_t more;
-        rc = read_bytes(f, b + got, want - got, &more, path, e);
+        rc = read_bytes(f, b + got, want - got, &more, e);
         if (rc) return rc;
         got += more;
     }
@@ -549,18 +533,16 @@ static int read_voxels(vxl_gz *f, const char *path, uint64_t offset, uint64_t nb
     *out = NULL;
     int rc = precheck_size(f, path, offset, nbytes, e);
     if (rc) return rc;
-    /* Forward seek only (we are at or before offset); on gzip streams zlib
-     * decompresses and discards, and a seek past the end shows up as a short
-     * read below. */
-    if (vxl_gz_seek(f, (z_off_t)offset, SEEK_SET) < 0)
-        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot seek to vox_offset %llu", path,
-                        (unsigned long long)offset);
+    /* on gzip streams the reader inflates and discards up to offset; a seek
+     * past the end shows up as a short read below */
+    rc = vxl_gz_seek(f, offset, e);
+    if (rc) return rc;
     void *buf = malloc((size_t)nbytes);
     if (!buf)
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for %llu bytes of voxel data", path,
                         (unsigned long long)nbytes);
     uint64_t got;
-    rc = read_bytes(f, buf, nbytes, &got, path, e);
+    rc = read_bytes(f, buf, nbytes, &got, e);
     if (!rc && got < nbytes)
         rc = vxl_fail(e, VXL_ERR_FORMAT,
                       "'%s': truncated file: expected %llu bytes of voxel data, got %llu", path,

@@ -26,6 +26,7 @@
 #include "clock.h"
 #include "dynlib.h"
 #include "files.h"
+#include "os.h"
 #include "process.h"
 #include "loader_util.h"
 
@@ -40,19 +41,25 @@ static int helper_path(const vxl_reader *r, const char *path, char *out, size_t 
         if (snprintf(out, n, "%s", env) >= (int)n)
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "%s is too long", r->env);
     } else {
+        if (r->linux_only && !strcmp(vxl_os_name(), "windows"))
+            return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s are not read on Windows yet: their reader needs %s, "
+                            "which has no Windows build here (Windows reads NIfTI, NRRD, MetaImage and OME-Zarr, and "
+                            "uncompressed TIFF with streaming on)", path, r->formats, r->library);
         char self[4096];
         if (vxl_dynlib_path_of((const void *)&vxl_reader_run, self, sizeof self))
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot locate libvoxlight to find %s", path,
                             r->helper);
-        const char *slash = strrchr(self, '/');
+        /* the helper sits beside the library (either separator: Windows' paths take both) */
+        const char *slash = strrchr(self, '/'), *back = strrchr(self, '\\');
+        if (back > slash) slash = back;
         int dir_len = slash ? (int)(slash - self) : 1;
-        if (snprintf(out, n, "%.*s/%s", dir_len, slash ? self : ".", r->helper) >= (int)n)
+        if (snprintf(out, n, "%.*s/%s%s", dir_len, slash ? self : ".", r->helper, vxl_program_suffix()) >= (int)n)
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': the path of %s is too long", path, r->helper);
     }
     vxl_path_info st;
     if (vxl_path_stat(out, &st) != 0)
         return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': %s are read by the helper program %s, which is missing "
-                        "(it belongs next to libvoxlight.so: reinstall the add-on)", path, r->formats, out);
+                        "(it belongs next to the library: reinstall the add-on)", path, r->formats, out);
     if (!vxl_is_program(out))
         return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': the helper program %s that reads %s is not executable "
                         "(chmod +x it)", path, out, r->formats);

@@ -18,6 +18,7 @@ typedef struct vxl_reader {
     const char *library;  /* "OpenImageIO" */
     const char *soname;   /* the library's file, "libOpenImageIO.so.2.4" */
     const char *package;  /* its Debian package; "" when the build could not tell */
+    int linux_only;       /* its library has no Windows build: Windows refuses the formats */
 } vxl_reader;
 
 /* Runs `helper command path options` and collects its reply of kind

@@ -15,17 +15,17 @@
 
 static const vxl_reader stack_reader = {
     VXL_HELPER_OIIO, VXL_HELPER_OIIO_ENV, "the TIFF/PNG stack reader", "TIFF/PNG stacks", "OpenImageIO",
-    VXL_OIIO_SONAME, VXL_OIIO_PACKAGE};
+    VXL_OIIO_SONAME, VXL_OIIO_PACKAGE, 1};
 static const vxl_reader vdb_reader = {
     VXL_HELPER_OIIO, VXL_HELPER_OIIO_ENV, "the OpenVDB reader", "OpenVDB files", "OpenImageIO",
-    VXL_OIIO_SONAME, VXL_OIIO_PACKAGE};
+    VXL_OIIO_SONAME, VXL_OIIO_PACKAGE, 1};
 static const vxl_reader dicom_reader = {
     VXL_HELPER_DICOM, VXL_HELPER_DICOM_ENV, "the DICOM reader", "DICOM series", "dcmtk",
-    VXL_DCMTK_SONAME, VXL_DCMTK_PACKAGE};
+    VXL_DCMTK_SONAME, VXL_DCMTK_PACKAGE, 1};
 
 static const vxl_reader zarr_reader = {
     VXL_HELPER_ZARR, VXL_HELPER_ZARR_ENV, "the OME-Zarr reader", "OME-Zarr stores", "libblosc and libzstd",
-    VXL_BLOSC_SONAME " and " VXL_ZSTD_SONAME, VXL_BLOSC_PACKAGE " " VXL_ZSTD_PACKAGE};
+    VXL_BLOSC_SONAME " and " VXL_ZSTD_SONAME, VXL_BLOSC_PACKAGE " " VXL_ZSTD_PACKAGE, 0};
 
 #define MAX_ENTRIES 100000u /* files counted for the time limit */
 

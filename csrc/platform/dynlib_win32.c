@@ -1,5 +1,8 @@
 /* dynlib_win32.c - dynlib.h on Windows: LoadLibraryExW with the library's
- * own folder searched for its dependencies, names in UTF-8. */
+ * own folder searched for its dependencies, names in UTF-8. A bare name is
+ * looked for first beside the module this code is linked into (voxlight.dll
+ * ships zlib1.dll there): Windows' own search starts in the folder of the
+ * program, which inside Blender is Blender's. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,19 +11,41 @@
 #include "dynlib.h"
 #include "utf16_win32.h"
 
+/* LoadLibraryExW of a UTF-8 name or path. */
+static HMODULE load(const char *name, DWORD flags)
+{
+    wchar_t *w = malloc(VXL_WPATH * sizeof *w);
+    HMODULE h = NULL;
+    if (w && vxl_utf8_to_utf16(name, w, VXL_WPATH)) h = LoadLibraryExW(w, NULL, flags);
+    free(w);
+    return h;
+}
+
+/* name in the folder of the module holding this code, into out; 0 or -1. */
+static int beside_this_module(const char *name, char *out, size_t size)
+{
+    if (vxl_dynlib_path_of((const void *)&beside_this_module, out, size)) return -1;
+    char *slash = strrchr(out, '\\');
+    char *fwd = strrchr(out, '/');
+    if (fwd > slash) slash = fwd;
+    if (!slash || (size_t)(slash + 1 - out) + strlen(name) + 1 > size) return -1;
+    memcpy(slash + 1, name, strlen(name) + 1);
+    return 0;
+}
+
 vxl_dynlib *vxl_dynlib_open(const char *name, char *why, size_t why_size)
 {
-    static const int n = VXL_WPATH;
-    wchar_t *w = malloc(n * sizeof *w);
+    /* a path: its own folder first for what it needs */
+    const DWORD path_flags = LOAD_LIBRARY_SEARCH_DLL_LOAD_DIR | LOAD_LIBRARY_SEARCH_DEFAULT_DIRS;
     HMODULE h = NULL;
-    if (w && vxl_utf8_to_utf16(name, w, n)) {
-        /* a path: its own folder first for what it needs; a bare name: the system's search */
-        const DWORD flags = strchr(name, '\\') || strchr(name, '/')
-                                ? LOAD_LIBRARY_SEARCH_DLL_LOAD_DIR | LOAD_LIBRARY_SEARCH_DEFAULT_DIRS
-                                : 0;
-        h = LoadLibraryExW(w, NULL, flags);
+    if (strchr(name, '\\') || strchr(name, '/')) {
+        h = load(name, path_flags);
+    } else {
+        char *beside = malloc(VXL_WPATH * 3);
+        if (beside && beside_this_module(name, beside, VXL_WPATH * 3) == 0) h = load(beside, path_flags);
+        free(beside);
+        if (!h) h = load(name, 0); /* the system's search */
     }
-    free(w);
     if (!h && why_size) snprintf(why, why_size, "%s cannot be loaded (Windows error %lu)", name, GetLastError());
     return (vxl_dynlib *)h;
 }

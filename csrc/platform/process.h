@@ -44,6 +44,9 @@ void vxl_child_finish(vxl_child *c, vxl_child_end *end);
 /* Whether path is a program this process may start. */
 int vxl_is_program(const char *path);
 
+/* What ends a program's file name on this OS: "" or ".exe". */
+const char *vxl_program_suffix(void);
+
 /* The short name ("SEGV") of a signal a child may end by, or NULL. */
 const char *vxl_signal_name(int sig);
 

@@ -177,3 +177,5 @@ const char *vxl_signal_name(int sig)
     default: return NULL;
     }
 }
+
+const char *vxl_program_suffix(void) { return ""; }

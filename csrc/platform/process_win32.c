@@ -211,3 +211,5 @@ const char *vxl_signal_name(int sig)
     (void)sig;
     return NULL;
 }
+
+const char *vxl_program_suffix(void) { return ".exe"; }

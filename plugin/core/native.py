@@ -16,7 +16,7 @@ Conventions kept from the header:
 The binding is split by job; this module gathers their names, so the rest
 of the add-on and the tests say `native.X`:
   native_abi           constants, structs, errors, pointer and matrix conversions
-  native_private_copy  private copies of the library and its reader helpers
+  native_private_copy  private copies of the library, the DLLs it needs and its reader helpers
   native_library       finding, loading and checking the library (Library)
   native_volume        Volume, list_dicom_series
   native_tiles         tile_params, params_digest
@@ -39,8 +39,8 @@ from .native_abi import (ABI_VERSION, BACKENDS, CLASSIFY_MODES, ENUM_FALLBACKS, 
 from .native_library import (LIBRARY_NAME, Library, candidate_paths, filter_names,  # noqa: F401
                              library_status, load_library)
 from .native_private_copy import (CACHE_DIR, HELPER_PREFIX, OLD_VDB_HELPER_NAME,  # noqa: F401
-                                  VDB_HELPER_NAME, cache_roots, clean_stale_copies, helper_names,
-                                  private_copy, restore_execute_bit)
+                                  VDB_HELPER_NAME, cache_roots, clean_stale_copies, companion_names,
+                                  helper_names, private_copy, restore_execute_bit)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct  # noqa: F401
 from .native_overlays import overlay_array  # noqa: F401
 from .native_renderer import Renderer, make_params  # noqa: F401

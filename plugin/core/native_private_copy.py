@@ -1,6 +1,7 @@
-"""Private copies of libvoxlight and its reader helpers, so the library is
-never mapped from the add-on's own folder (see below), and the execute bit
-Blender's zip install drops from the helpers.
+"""Private copies of libvoxlight, the libraries it loads from its own folder
+and its reader helpers, so the library is never mapped from the add-on's
+own folder (see below), and the execute bit Blender's zip install drops from
+the helpers.
 
 Part of the ctypes binding; plugin/core/native.py re-exports it."""
 
@@ -28,9 +29,11 @@ OLD_VDB_HELPER_NAME = "voxlight-vdb-read"  # its name in older builds
 # are; if libvoxlight.so were mapped from there, the running Blender would
 # crash at its next call into it. So the library is loaded from a copy in a
 # cache folder named by the content's hash, together with the reader helpers
-# it starts from its own folder (found with dladdr, csrc/io/reader_spawn.c). An
-# updated add-on has another hash, hence a new folder and a fresh dlopen
-# (dlopen of the old path would hand back the old, already loaded library).
+# it starts from its own folder (found with dladdr, csrc/io/reader_spawn.c)
+# and, on Windows, the DLLs it loads from there (zlib1.dll; the rules'
+# is_companion), all of them part of the hash. An updated add-on has
+# another hash, hence a new folder and a fresh dlopen (dlopen of the old
+# path would hand back the old, already loaded library).
 # Each process holds the folder it uses (platform_rules: a shared flock, or
 # on Windows the lock file kept open); a folder nobody holds is stale and
 # removed by the next load.
@@ -48,6 +51,21 @@ def helper_names(folder, rules=None):
         return []
     return sorted(n for n in names
                   if (rules.is_helper(n, HELPER_PREFIX) or n == OLD_VDB_HELPER_NAME)
+                  and os.path.isfile(os.path.join(folder, n)))
+
+
+def companion_names(folder, rules=None, library=None):
+    """The files besides the helpers that the library in folder needs next
+    to it (rules.is_companion: on Windows the other DLLs), library's own
+    name excepted."""
+    rules = rules or platform_rules.current()
+    library = rules.path.normcase(library or rules.library)
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    return sorted(n for n in names
+                  if rules.is_companion(n) and rules.path.normcase(n) != library
                   and os.path.isfile(os.path.join(folder, n)))
 
 
@@ -109,10 +127,12 @@ def _make_copy(root, key, files, rules):
     os.makedirs(root, exist_ok=True)
     stage = tempfile.mkdtemp(prefix=".stage-", dir=root)
     try:
-        for i, f in enumerate(files):
-            dest = os.path.join(stage, os.path.basename(f))
+        for f in files:
+            name = os.path.basename(f)
+            dest = os.path.join(stage, name)
             shutil.copyfile(f, dest)
-            os.chmod(dest, 0o644 if i == 0 else 0o755)  # files[0] is the library
+            helper = rules.is_helper(name, HELPER_PREFIX) or name == OLD_VDB_HELPER_NAME
+            os.chmod(dest, 0o755 if helper else 0o644)
         open(os.path.join(stage, _LOCK_NAME), "w").close()
         try:
             os.rename(stage, folder)
@@ -174,12 +194,14 @@ def clean_stale_copies(root, rules=None):
 
 
 def private_copy(path, rules=None):
-    """The path of a private copy of the library at path, with the helpers
-    that sit next to it, or None when no cache folder is writable (the
-    library is then loaded in place)."""
+    """The path of a private copy of the library at path, with the files it
+    needs (companion_names) and the helpers that sit next to it, or None
+    when no cache folder is writable (the library is then loaded in
+    place)."""
     rules = rules or platform_rules.current()
     src = os.path.dirname(os.path.abspath(path))
-    files = [os.path.abspath(path)] + [os.path.join(src, n) for n in helper_names(src, rules)]
+    names = companion_names(src, rules, os.path.basename(path)) + helper_names(src, rules)
+    files = [os.path.abspath(path)] + [os.path.join(src, n) for n in names]
     try:
         key = _content_key(files)
     except OSError:

@@ -1,19 +1,20 @@
-"""The add-on's only OS-specific code: how the library and its reader
-helpers are named, where private copies of them go, and how a process
-marks a copy as in use so that no other Blender removes it (the copies
-themselves: native_private_copy.py). One rule set per OS, chosen by
-os.name; both are exercised on Linux by tests/python/test_platform_rules.py.
+"""The add-on's only OS-specific code: how the library, the files that
+travel with it and its reader helpers are named, where private copies of
+them go, and how a process marks a copy as in use so that no other Blender
+removes it (the copies themselves: native_private_copy.py). One rule set
+per OS, chosen by os.name; both are exercised on Linux by
+tests/python/test_platform_rules.py.
 
 POSIX: libvoxlight.so and voxlight-read-*, copies under $XDG_CACHE_HOME,
 in use while a shared flock is held on the copy's lock file (a cleaner
 takes the lock exclusively, without waiting, to know it is free).
 
-Windows: voxlight.dll and voxlight-read-*.exe, copies under %LOCALAPPDATA%;
-a loaded DLL, and any file a process holds open, cannot be deleted or
-overwritten there, so a process holds the lock file open and a cleaner
-knows a copy is free when it can delete that file. Paths have drive
-letters and backslashes (ntpath), and may hold any Unicode (the library
-takes UTF-8)."""
+Windows: voxlight.dll, the DLLs shipped beside it (zlib1.dll) and
+voxlight-read-*.exe, copies under %LOCALAPPDATA%; a loaded DLL, and any
+file a process holds open, cannot be deleted or overwritten there, so a
+process holds the lock file open and a cleaner knows a copy is free when it
+can delete that file. Paths have drive letters and backslashes (ntpath),
+and may hold any Unicode (the library takes UTF-8)."""
 
 import ntpath
 import os
@@ -31,6 +32,12 @@ class PosixRules:
         """A helper program of this platform: no extension (a .exe is
         Windows')."""
         return name.startswith(prefix) and "." not in name[len(prefix):]
+
+    def is_companion(self, name):
+        """A file the library needs beside it in its private copy, besides
+        the helpers: none, as libvoxlight.so opens only the system's
+        libraries (libz.so.1 by its soname)."""
+        return False
 
     def cache_base(self, environ):
         """The user's cache folder."""
@@ -96,6 +103,13 @@ class WindowsRules:
 
     def is_helper(self, name, prefix):
         return name.startswith(prefix) and name.lower().endswith(".exe")
+
+    def is_companion(self, name):
+        """Every other DLL shipped beside voxlight.dll (zlib1.dll):
+        voxlight.dll loads them from its own folder, which is the private
+        copy's once loaded from there. Windows' names ignore case."""
+        lower = name.lower()
+        return lower.endswith(".dll") and lower != self.library
 
     def cache_base(self, environ):
         return environ.get("LOCALAPPDATA") or self.path.join(

@@ -131,7 +131,7 @@ def test_a_missing_helper_breaks_only_its_format(inputs, tmp_path):
     r = run("info", inputs["stack"], env=env)
     assert r.returncode != 0
     assert re.search(r"TIFF/PNG stacks are read by the helper program .*nowhere/voxlight-read-oiio, which is "
-                     r"missing \(it belongs next to libvoxlight\.so", r.stderr), r.stderr
+                     r"missing \(it belongs next to the library", r.stderr), r.stderr
     loads("nrrd", inputs, env)
     loads("dicom", inputs, env)
 

@@ -3,23 +3,15 @@ same scene as libvoxlight.so on Linux, through its WGL backend, under
 Debian's Wine with Xvfb (Wine's OpenGL reaches Mesa's llvmpipe): the two
 images must agree to float rounding. tests/render_scene.c is the program,
 built for both."""
-import os
-import shutil
 import subprocess
 from pathlib import Path
 
 import numpy as np
 
+from wine_run import run_windows
+
 ROOT = Path(__file__).resolve().parents[2]
 LINUX = ROOT / "build" / "tests" / "render_scene"
-WINDOWS = ROOT / "build" / "windows-x64" / "render_scene.exe"
-
-
-def wine():
-    for c in ("/usr/lib/wine/wine64", shutil.which("wine64"), shutil.which("wine")):
-        if c and os.access(c, os.X_OK):
-            return c
-    raise AssertionError("no Wine (./build.sh installs wine64)")
 
 
 def load(path):
@@ -32,15 +24,9 @@ def load(path):
 
 
 def test_windows_render_equals_linux_render(tmp_path):
-    assert WINDOWS.exists(), "build/windows-x64 has no render_scene.exe (make windows)"
     lin = subprocess.run([str(LINUX), str(tmp_path / "linux.bin")], capture_output=True, text=True, timeout=300)
     assert lin.returncode == 0, lin.stderr
-    env = dict(os.environ, WINEPREFIX=str(ROOT / "build" / "wine"), WINEDEBUG="-all")
-    env.pop("VOXLIGHT_BACKEND", None)
-    # Wine maps the Linux root to Z:
-    out = "Z:" + str(tmp_path / "windows.bin").replace("/", "\\")
-    win = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 640x480x24", wine(), str(WINDOWS), out],
-                         capture_output=True, text=True, env=env, timeout=600)
+    win = run_windows("render_scene.exe", tmp_path / "windows.bin", display=True)
     assert win.returncode == 0, win.stdout + win.stderr
     assert "backend wgl" in win.stdout, win.stdout
     a, da = load(tmp_path / "linux.bin")

@@ -102,13 +102,51 @@ def _scenario(tmp_path, monkeypatch, rules, hold_elsewhere):
     return ours, others, stale, keep
 
 
-def _copy(addon, cache, rules):
+def _copy(addon, cache, rules, companions=()):
     path = npc.private_copy(str(addon / rules.library), rules)
     assert path and path.startswith(str(cache)), path
     assert os.path.basename(path) == rules.library
     assert sorted(os.listdir(os.path.dirname(path))) == sorted(
-        [rules.library, "voxlight-read-oiio" + rules.helper_suffix, npc._LOCK_NAME])
+        [rules.library, "voxlight-read-oiio" + rules.helper_suffix, npc._LOCK_NAME, *companions])
     return path
+
+
+def test_windows_copy_holds_the_dlls_voxlight_dll_loads_from_its_folder(tmp_path, monkeypatch):
+    """voxlight.dll loads zlib1.dll from its own folder, which is the
+    private copy's: the copy must hold it, and a new zlib1.dll must make a
+    new copy (a fresh folder) rather than reuse the old one."""
+    files = WindowsFiles()
+    rules = platform_rules.WindowsRules(remove=files.remove, open_file=files.open)
+    addon = _addon(tmp_path, rules)
+    (addon / "zlib1.dll").write_bytes(b"zlib 1.3")
+    # Build outputs that are not run-time files never travel.
+    (addon / "libvoxlight.dll.a").write_bytes(b"import library")
+    (addon / "voxlight.def").write_bytes(b"EXPORTS")
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("VOXLIGHT_CACHE_DIR", str(cache))
+    assert npc.companion_names(str(addon), rules) == ["zlib1.dll"]
+    first = _copy(addon, cache, rules, companions=["zlib1.dll"])
+    copied = os.path.join(os.path.dirname(first), "zlib1.dll")
+    assert open(copied, "rb").read() == b"zlib 1.3"
+
+    (addon / "zlib1.dll").write_bytes(b"zlib 1.3.1")
+    second = _copy(addon, cache, rules, companions=["zlib1.dll"])
+    assert os.path.dirname(second) != os.path.dirname(first), "zlib1.dll is not in the content hash"
+    assert open(os.path.join(os.path.dirname(second), "zlib1.dll"), "rb").read() == b"zlib 1.3.1"
+    assert open(copied, "rb").read() == b"zlib 1.3", "the copy in use was written over"
+
+
+def test_posix_copy_takes_no_dll(tmp_path, monkeypatch):
+    """libvoxlight.so needs only the system's libraries: a DLL beside it
+    (another platform's file) is neither copied nor hashed."""
+    rules = platform_rules.PosixRules()
+    addon = _addon(tmp_path, rules)
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("VOXLIGHT_CACHE_DIR", str(cache))
+    before = _copy(addon, cache, rules)
+    (addon / "zlib1.dll").write_bytes(b"zlib 1.3")
+    assert npc.companion_names(str(addon), rules) == []
+    assert _copy(addon, cache, rules) == before
 
 
 def test_windows_rules_keep_held_copies_and_remove_stale_ones(tmp_path, monkeypatch):

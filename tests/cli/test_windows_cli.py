@@ -1,0 +1,152 @@
+"""The CLI cross-compiled for Windows (build/windows-x64/voxlight.exe, with
+voxlight.dll, zlib1.dll and voxlight-read-zarr.exe beside it) under Wine:
+each format written in Voxlight's own C reads and renders as the Linux CLI
+does, from a folder whose name is not ASCII (UTF-8 arguments through the
+wide-character command line and file calls); the formats whose readers need
+a C++ library with no Windows build are refused by name, never a crash.
+The Linux CLI on the same files is the reference: `info` must print the
+same report and `render` the same PNG."""
+import os
+import subprocess
+import sys
+import zlib
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from test_cli_formats import write_mha, write_nrrd, write_tiff
+from wine_run import run_windows
+
+ROOT = Path(__file__).resolve().parents[2]
+CLI = ROOT / "build" / "voxlight"
+sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "tests" / "python"))
+from nifti_write import write_nifti  # noqa: E402
+from zarr_write import pyramid, write_store  # noqa: E402
+
+
+def run_linux(*args):
+    env = dict(os.environ)
+    env.pop("VOXLIGHT_BACKEND", None)
+    return subprocess.run([str(CLI), *map(str, args)], capture_output=True, text=True, env=env, timeout=300)
+
+
+def png_pixels(path):
+    """(h, w, channels) uint8/uint16 of a PNG the CLI wrote (no filters
+    beyond what zlib and the row filter bytes hold: rows are read as written)."""
+    b = Path(path).read_bytes()
+    assert b[:8] == b"\x89PNG\r\n\x1a\n"
+    i, idat = 8, b""
+    while i < len(b):
+        n, kind = struct.unpack(">I4s", b[i:i + 8])
+        if kind == b"IHDR":
+            w, h, bits, colour = struct.unpack(">IIBB", b[i + 8:i + 18])
+        elif kind == b"IDAT":
+            idat += b[i + 8:i + 8 + n]
+        i += 12 + n
+    return w, h, bits, colour, zlib.decompress(idat)
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    """One file per format the Windows build reads, in a folder named José."""
+    d = tmp_path_factory.mktemp("win") / "Scans José ü"
+    d.mkdir()
+    z, y, x = np.indices((24, 24, 24))
+    r = np.sqrt((z - 11.5) ** 2 + (y - 11.5) ** 2 + (x - 11.5) ** 2)
+    ball = (1000 * np.clip(8.5 - r, 0, 1)).astype(np.int16)  # a ball of radius 8, one voxel soft
+    files = {}
+    files["nifti"] = d / "ball.nii.gz"
+    write_nifti(files["nifti"], ball.transpose(2, 1, 0), np.diag([0.8, 0.8, 1.2, 1.0]))
+    files["nrrd"] = d / "ball.nrrd"
+    write_nrrd(files["nrrd"], ball, gz=True)
+    files["metaimage"] = d / "ball.mha"
+    write_mha(files["metaimage"], ball, compressed=True)
+    files["zarr"] = write_store(d / "ball.zarr", pyramid(ball.astype(np.uint16), 2, "zyx"), "zyx", version=2,
+                                codec="gzip", chunks=[8, 8, 8])
+    files["tiff"] = d / "ball.tif"
+    write_tiff(files["tiff"], list(ball.astype(np.float32)))
+    return files
+
+
+def without_paths(text, *paths):
+    """The report's lines that do not name the input (which each OS spells its own way)."""
+    return [l for l in text.splitlines() if not any(str(p.name) in l for p in paths)]
+
+
+@pytest.mark.parametrize("fmt,extra", [("nifti", []), ("nrrd", []), ("metaimage", []), ("zarr", []),
+                                       ("zarr", ["--streaming", "on"]), ("tiff", ["--streaming", "on"])])
+def test_info_matches_linux(inputs, fmt, extra):
+    src = inputs[fmt]
+    lin = run_linux("info", src, *extra)
+    assert lin.returncode == 0, lin.stderr
+    win = run_windows("voxlight.exe", "info", src, *extra)
+    assert win.returncode == 0, win.stdout + win.stderr
+    assert without_paths(win.stdout, src) == without_paths(lin.stdout, src)
+
+
+@pytest.mark.parametrize("fmt,extra", [("nifti", []), ("zarr", []), ("tiff", ["--streaming", "on"])])
+def test_render_matches_linux(inputs, tmp_path, fmt, extra):
+    src = inputs[fmt]
+    out_l, out_w = tmp_path / "linux.png", src.parent / ("windows-%s.png" % fmt)
+    lin = run_linux("render", src, "-o", out_l, "--size", "64x64", *extra)
+    assert lin.returncode == 0, lin.stderr
+    win = run_windows("voxlight.exe", "render", src, "-o", out_w, "--size", "64x64", *extra, display=True)
+    assert win.returncode == 0, win.stdout + win.stderr
+    assert ", wgl, " in win.stderr, win.stderr  # rendered through WGL
+    w_l, h_l, bits_l, c_l, px_l = png_pixels(out_l)
+    w_w, h_w, bits_w, c_w, px_w = png_pixels(out_w)
+    assert (w_w, h_w, bits_w, c_w) == (w_l, h_l, bits_l, c_l)
+    a = np.frombuffer(px_l, np.uint8).astype(int)
+    b = np.frombuffer(px_w, np.uint8).astype(int)
+    assert (a != 0).mean() > 0.1  # the ball is in the picture
+    assert np.abs(a - b).max() <= 1, "PNG bytes differ by up to %d" % np.abs(a - b).max()
+
+
+def test_a_matcap_png_is_decoded_on_windows(inputs, tmp_path):
+    """--matcap's PNG is inflated by the zlib1.dll beside voxlight.exe."""
+    from test_cli_modes import write_png
+    cap = tmp_path / "cap.png"
+    yy, xx = np.mgrid[0:32, 0:32]
+    write_png(cap, np.stack([xx * 8, yy * 8, np.full_like(xx, 128)], -1).astype(np.uint8))
+    out_l, out_w = tmp_path / "l.png", tmp_path / "w.png"
+    args = ["--size", "48x48", "--mode", "iso", "--iso-value", "0.3", "--matcap", cap]
+    lin = run_linux("render", inputs["nifti"], "-o", out_l, *args)
+    assert lin.returncode == 0, lin.stderr
+    win = run_windows("voxlight.exe", "render", inputs["nifti"], "-o", out_w, *args, display=True)
+    assert win.returncode == 0, win.stdout + win.stderr
+    a = np.frombuffer(png_pixels(out_l)[4], np.uint8).astype(int)
+    b = np.frombuffer(png_pixels(out_w)[4], np.uint8).astype(int)
+    assert np.abs(a - b).max() <= 1
+
+
+def one_error_line(win):
+    assert win.returncode == 1, win.stdout + win.stderr
+    lines = [l for l in win.stderr.splitlines() if l.startswith("voxlight: error:")]
+    assert len(lines) == 1, win.stderr
+    return lines[0]
+
+
+def test_formats_without_a_windows_reader_are_refused_by_name(inputs, tmp_path):
+    """TIFF read whole (streaming off) and DICOM need OpenImageIO and dcmtk;
+    zstd and blosc chunks need Debian's libzstd and libblosc."""
+    dcm = tmp_path / "slice.dcm"
+    dcm.write_bytes(b"\0" * 128 + b"DICM" + b"\0" * 64)
+    for src, formats, library in ((inputs["tiff"], "TIFF/PNG stacks", "OpenImageIO"),
+                                  (dcm, "DICOM series", "dcmtk")):
+        line = one_error_line(run_windows("voxlight.exe", "info", src, "--streaming", "off"))
+        assert "%s are not read on Windows yet" % formats in line and library in line, line
+    ball = np.zeros((8, 8, 8), np.uint16)
+    ball[2:6, 2:6, 2:6] = 1000
+    for codec in ("zstd", "blosc"):
+        store = write_store(tmp_path / ("%s.zarr" % codec), [ball], "zyx", version=2, codec=codec, chunks=[4, 4, 4])
+        line = one_error_line(run_windows("voxlight.exe", "info", store))
+        assert "%s-compressed chunks are not read on Windows yet" % codec in line, line
+
+
+def test_a_missing_file_is_one_error_line(tmp_path):
+    win = run_windows("voxlight.exe", "info", tmp_path / "nowhere José.nii.gz")
+    assert win.returncode == 1
+    assert "nowhere José.nii.gz" in win.stderr and "voxlight: error:" in win.stderr, win.stderr

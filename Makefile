@@ -136,7 +136,8 @@ $(BUILD)/voxlight-read-zarr: $(BUILD)/obj/helper_zarr.o $(patsubst %.c,$(BUILD)/
 		$(BUILD)/obj/zarr_detect.o $(HELPER_CORE) $(LIB_CC_STAMP)
 	$(LIB_CC) $(OPT) -o $@ $(filter-out $(LIB_CC_STAMP),$^) -ldl -lpthread -lm
 
-$(BUILD)/voxlight-read-dicom: $(BUILD)/obj/helper_dicom.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(DICOM_CXX))) $(HELPER_CORE)
+$(BUILD)/voxlight-read-dicom: $(BUILD)/obj/helper_dicom.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(DICOM_CXX))) \
+		$(BUILD)/obj/dicom_rle.o $(HELPER_CORE)
 	$(CXX) $(OPT) -o $@ $^ $(DCMTK_LIBS) -lz -lm
 
 $(BUILD)/voxlight-bench: bench/bench.c $(BUILD)/libvoxlight.so
@@ -244,7 +245,7 @@ WIN_API_TESTS := test_accuracy test_api test_budget test_classification test_cut
 	test_labels test_modes test_overlays test_paging test_reference_light test_render test_scene_shadows test_shadows \
 	test_skipping test_slice_plane test_slices test_streaming test_stripes
 windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/child_program.exe $(WIN_BUILD)/tests/test_crc32.exe \
-	$(WIN_BUILD)/tests/test_gz_reader.exe $(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/voxlight.exe $(WIN_BUILD)/render_scene.exe \
+	$(WIN_BUILD)/tests/test_gz_reader.exe $(WIN_BUILD)/tests/test_dicom_rle.exe $(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/voxlight.exe $(WIN_BUILD)/render_scene.exe \
 	$(WIN_ZLIB_DLLS) $(WIN_API_TESTS:%=$(WIN_BUILD)/tests/%.exe) $(WIN_BUILD)/tests/voxlight.dll \
 	$(WIN_BUILD)/voxlight-read-zarr.exe
 
@@ -303,6 +304,10 @@ $(WIN_BUILD)/tests/test_gz_reader.exe: tests/test_gz_reader.c tests/harness.h te
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_LIB_CFLAGS) -Itests $< $(filter %.c,$(filter-out $<,$^)) -o $@ -lshell32
 
+$(WIN_BUILD)/tests/test_dicom_rle.exe: tests/test_dicom_rle.c tests/harness.h csrc/io/dicom_rle.c csrc/io/dicom_rle.h
+	@mkdir -p $(@D)
+	$(WIN_CC) $(WIN_CFLAGS) -Icsrc/io $< csrc/io/dicom_rle.c -o $@
+
 $(WIN_BUILD)/tests/test_crc32.exe: tests/test_crc32.c tests/harness.h csrc/core/crc32.c csrc/core/crc32_tables.h
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_CFLAGS) $< csrc/core/crc32.c -o $@
@@ -312,6 +317,11 @@ $(WIN_BUILD)/tests/test_crc32.exe: tests/test_crc32.c tests/harness.h csrc/core/
 GZ_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gz_reader zlib_api error crc32 $(PLATFORM))
 $(BUILD)/tests/test_gz_reader: tests/test_gz_reader.c tests/harness.h tests/utf8_temp.h $(GZ_TEST_OBJ) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(GZ_TEST_OBJ) -o $@ -ldl -lpthread
+
+# test_dicom_rle checks the DICOM RLE decoder on frames made byte by byte
+# (the same file is built for Windows above).
+$(BUILD)/tests/test_dicom_rle: tests/test_dicom_rle.c tests/harness.h $(BUILD)/obj/dicom_rle.o | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(BUILD)/obj/dicom_rle.o -o $@
 
 # test_crc32 checks the library's internal CRC-32 against zlib's values.
 $(BUILD)/tests/test_crc32: tests/test_crc32.c tests/harness.h $(BUILD)/obj/crc32.o | $(BUILD)/tests
@@ -343,7 +353,7 @@ FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_u
 # the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
-	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c $(PLATFORM:%=%.c))
+	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c dicom_rle.c $(PLATFORM:%=%.c))
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))

@@ -27,11 +27,13 @@ ROOT=$(pwd)
 # stands for the sanitizer/libFuzzer runtime of clang's major version.
 # libz-mingw-w64: zlib1.dll, shipped beside voxlight.dll (Windows has no
 # system zlib).
+# dcmtk: its command-line tools (dcmcrle) write the compressed DICOM the
+# tests read, an encoder independent of our decoders.
 NEEDS=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
        libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev libzstd-dev libblosc-dev mricron-data blender
        xvfb xauth python3 python3-numpy python3-pytest zip unzip clang clang-rt llvm
        python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv" "?python3.13-venv"
-       "?wine64|wine" libz-mingw-w64)
+       "?wine64|wine" libz-mingw-w64 dcmtk)
 
 # (output captured, not piped into grep -q: under pipefail an early grep exit
 # would fail the pipeline)
@@ -391,7 +393,7 @@ case "$cmd" in
         [ "$TOTAL_FAIL" -eq 0 ] ;;
     fuzz)
         # ./build.sh fuzz [SECONDS [TARGET...]]: each loader's libFuzzer target
-        # (nifti nrrd metaimage tiff png dicom vdb label_table zarr brick_cache tiff_layout) for SECONDS (default 300);
+        # (nifti nrrd metaimage tiff png dicom vdb label_table zarr brick_cache tiff_layout dicom_rle) for SECONDS (default 300);
         # crashes are kept in tests/crashers/<target>/. SECONDS "replay":
         # replay tests/crashers/ only
         install_deps; build

@@ -1,5 +1,5 @@
 /* loader_test_util.h - helpers the loader tests share: removing their temp
- * tree, and reading a loaded volume's data values back from its texels
+ * tree, reading and writing whole files, and reading a loaded volume's data values back from its texels
  * (layout from volume.h), so byte-order, offset or ordering mistakes show up
  * as wrong values. */
 #ifndef VXL_LOADER_TEST_UTIL_H
@@ -14,7 +14,7 @@
 
 #include "volume.h"
 
-static void remove_tree(const char *path)
+__attribute__((unused)) static void remove_tree(const char *path)
 {
     DIR *d = opendir(path);
     if (d) {
@@ -30,6 +30,38 @@ static void remove_tree(const char *path)
     } else {
         unlink(path);
     }
+}
+
+/* A whole file, malloc'd (*size bytes), or NULL. */
+static inline unsigned char *read_all(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    unsigned char *buf = NULL;
+    size_t cap = 0, n = 0;
+    for (;;) {
+        if (n == cap) {
+            cap = cap ? cap * 2 : 4096;
+            unsigned char *nb = realloc(buf, cap);
+            if (!nb) break;
+            buf = nb;
+        }
+        size_t r = fread(buf + n, 1, cap - n, f);
+        n += r;
+        if (r == 0) break;
+    }
+    fclose(f);
+    *size = n;
+    return buf;
+}
+
+/* path holding exactly buf[0..n); 0 or -1. */
+static inline int write_all(const char *path, const void *buf, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return -1;
+    int ok = fwrite(buf, 1, n, f) == n;
+    return (fclose(f) == 0 && ok) ? 0 : -1;
 }
 
 /* Data value of voxel i, reconstructed from the stored texel. */

@@ -1,7 +1,8 @@
 /* test_dicom.c - DICOM series through the public API (vxl_volume_load,
  * vxl_dicom_list_series): geometry from positions with shuffled files and an
  * oblique orientation, rescale to Hounsfield units, several series, 4D
- * series (time points at every position), and the refusals (missing slice, mixed sizes, compressed, multi-frame, truncated,
+ * series (time points at every position), RLE Lossless against dcmtk's encoder, and the refusals (missing slice,
+ * mixed sizes, compressed, multi-frame, truncated,
  * garbage, over budget). Files come from tests/fuzz/dicom_writer.h, written
  * from the standard independently of dcmtk. Voxel values are read back
  * through the texels (volume.h), so ordering mistakes show as wrong values. */
@@ -465,6 +466,54 @@ TEST(dispatch_finds_dicom_folders_files_and_dicomdir)
     CHECK(vxl_volume_load(sub, &opt, &v) == VXL_ERR_INVALID_ARGUMENT && contains(vxl_last_error(), "has 1"));
 }
 
+/* The same series in RLE Lossless, as dcmtk's own encoder (dcmcrle, from
+ * Debian's dcmtk) writes it, reads voxel for voxel as the uncompressed files
+ * (our decoder, io/dicom_rle.c, against an independent encoder); a frame
+ * whose header is damaged is one clear error. */
+TEST(rle_lossless_series_reads_as_the_uncompressed_one)
+{
+    char raw[256], rle[256], cmd[1200];
+    folder(raw, sizeof raw, "rle_source");
+    folder(rle, sizeof rle, "rle");
+    const double o[3] = {0, 0, 0}, step[3] = {0, 0, 2};
+    /* values over 255 and past 32767: both bytes of each pixel vary */
+    REQUIRE(write_stack(raw, "1.2.3.95", k_axial, o, step, NS, NULL, 33000, NULL) == 0);
+    for (int k = 0; k < NS; k++) {
+        snprintf(cmd, sizeof cmd, "dcmcrle %s/IM%04d.dcm %s/IM%04d.dcm", raw, k, rle, k);
+        REQUIRE(system(cmd) == 0);
+    }
+    vxl_volume *a = load_series(raw, NULL);
+    vxl_volume *b = load_series(rle, NULL);
+    REQUIRE(a);
+    CHECKF(b != NULL, "%s", vxl_last_error());
+    if (b) {
+        CHECK(!memcmp(a->dims, b->dims, sizeof a->dims) && a->texture_bits == b->texture_bits);
+        CHECK(a->value_min == b->value_min && a->value_max == b->value_max);
+        const size_t bytes = (size_t)a->dims[0] * a->dims[1] * a->dims[2] * (a->texture_bits / 8);
+        CHECK(a->texels && b->texels && !memcmp(a->texels, b->texels, bytes));
+    }
+    vxl_volume_destroy(a);
+    vxl_volume_destroy(b);
+
+    /* the first frame's header claims 3 segments for 2-byte pixels */
+    char p[512];
+    snprintf(p, sizeof p, "%s/IM0000.dcm", rle);
+    size_t n = 0;
+    unsigned char *f = read_all(p, &n);
+    REQUIRE(f);
+    static const unsigned char header[8] = {2, 0, 0, 0, 64, 0, 0, 0}; /* 2 segments, the first at 64 */
+    unsigned char *at = NULL;
+    for (size_t i = 0; i + 8 <= n && !at; i++)
+        if (!memcmp(f + i, header, 8)) at = f + i;
+    REQUIRE(at);
+    at[0] = 3;
+    REQUIRE(write_all(p, f, n) == 0);
+    free(f);
+    CHECK(load_series(rle, NULL) == NULL);
+    CHECKF(contains(vxl_last_error(), "IM0000.dcm") && contains(vxl_last_error(), "3 segments"), "%s",
+           vxl_last_error());
+}
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/vxl_dicom_XXXXXX");
@@ -482,6 +531,7 @@ int main(void)
     RUN(mixed_sizes_compressed_and_multiframe_are_clear_errors);
     RUN(truncated_garbage_and_oversized_files_are_refused);
     RUN(dispatch_finds_dicom_folders_files_and_dicomdir);
+    RUN(rle_lossless_series_reads_as_the_uncompressed_one);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

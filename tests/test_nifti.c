@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "loader_test_util.h"
 #include "nifti_writer.h"
 #include "volume.h"
 #include "voxlight.h"
@@ -42,36 +43,6 @@ static void remove_tmp_dir(void)
     }
     closedir(d);
     rmdir(g_dir);
-}
-
-static unsigned char *read_all(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    unsigned char *buf = NULL;
-    size_t cap = 0, n = 0;
-    for (;;) {
-        if (n == cap) {
-            cap = cap ? cap * 2 : 4096;
-            unsigned char *nb = realloc(buf, cap);
-            if (!nb) break;
-            buf = nb;
-        }
-        size_t r = fread(buf + n, 1, cap - n, f);
-        n += r;
-        if (r == 0) break;
-    }
-    fclose(f);
-    *size = n;
-    return buf;
-}
-
-static int write_all(const char *path, const void *buf, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    if (!f) return -1;
-    int ok = fwrite(buf, 1, n, f) == n;
-    return (fclose(f) == 0 && ok) ? 0 : -1;
 }
 
 /* ------------------------------------------------------------- datatypes */

@@ -31,10 +31,12 @@
 // reader_stream.h): libvoxlight.so links no C++. Whether a path is DICOM
 // at all is decided in the library, in C (dicom_detect.c).
 //
-// Not decoded: compressed (encapsulated) transfer syntaxes, multi-frame
-// images, colour, BitsAllocated other than 8/16. Each is a clear error naming
-// the file.
+// Transfer syntaxes: the uncompressed ones (dcmtk), and RLE Lossless
+// (our own C, dicom_rle.c). Not decoded: the other compressed (encapsulated)
+// transfer syntaxes, multi-frame images, colour, BitsAllocated other than
+// 8/16. Each is a clear error naming the file.
 #include <dcmtk/config/osconfig.h>
+#include <dcmtk/dcmdata/dcpxitem.h>
 #include <dcmtk/dcmdata/dctk.h>
 #include <dcmtk/oflog/oflog.h>
 
@@ -54,6 +56,7 @@
 #include <vector>
 
 extern "C" {
+#include "dicom_rle.h"
 #include "helper_main.h"
 #include "loader_util.h"
 }
@@ -69,6 +72,7 @@ struct Slice {
     unsigned rows = 0, cols = 0, bits_alloc = 0, bits_stored = 0, pixel_rep = 0, samples = 1;
     long frames = 1;
     bool has_ipp = false, has_iop = false, encapsulated = false;
+    bool rle = false; // RLE Lossless: decoded by dicom_rle.c
     double ipp[3] = {0, 0, 0}, iop[6] = {1, 0, 0, 0, 1, 0}, ps[2] = {1, 1};
     double slope = 1, inter = 0, thickness = 0;
     std::string xfer;
@@ -228,6 +232,7 @@ Parse read_slice(const std::string &path, Slice &s, std::string &why)
     }
     DcmXfer x(ds->getOriginalXfer());
     s.xfer = x.getXferName();
+    s.rle = x.getXfer() == EXS_RLELossless;
 #if PACKAGE_VERSION_NUMBER >= 369 // dcmtk 3.6.9 (Debian 13) deprecates isEncapsulated()
     s.encapsulated = x.usesEncapsulatedFormat();
 #else
@@ -251,7 +256,7 @@ std::string check_pixels(const std::vector<Slice> &sl)
     const Slice &f = sl[0];
     for (const Slice &s : sl) {
         const char *p = s.path.c_str();
-        if (s.encapsulated)
+        if (s.encapsulated && !s.rle)
             return format("'%s': compressed transfer syntax '%s' is not supported (decompress first, e.g. "
                           "dcmdjpeg or gdcmconv --raw)", p, s.xfer.c_str());
         if (s.frames != 1)
@@ -498,6 +503,46 @@ template <typename T> void unpack(const T *src, size_t n, unsigned bits, bool is
     }
 }
 
+// A slice's n stored values at src (bits_alloc each, native byte order) into
+// dst, masked to bits_stored and sign-extended where signed.
+void unpack_slice(const Slice &s, const void *src, size_t n, void *dst)
+{
+    const bool sgn = s.pixel_rep == 1;
+    if (s.bits_alloc == 8) {
+        if (sgn) unpack(static_cast<const int8_t *>(src), n, s.bits_stored, true, static_cast<int8_t *>(dst));
+        else unpack(static_cast<const uint8_t *>(src), n, s.bits_stored, false, static_cast<uint8_t *>(dst));
+    } else {
+        if (sgn) unpack(static_cast<const int16_t *>(src), n, s.bits_stored, true, static_cast<int16_t *>(dst));
+        else unpack(static_cast<const uint16_t *>(src), n, s.bits_stored, false, static_cast<uint16_t *>(dst));
+    }
+}
+
+// An RLE Lossless slice's one frame: its fragments (the items after the
+// basic offset table) joined, then decoded by dicom_rle.c into out
+// (rows*cols values of bits_alloc, native byte order).
+int decode_rle(const Slice &s, DcmElement *el, std::vector<uint8_t> &out, vxl_err *e)
+{
+    const char *p = s.path.c_str();
+    DcmPixelSequence *seq = nullptr;
+    if (el->ident() != EVR_PixelData ||
+        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(EXS_RLELossless, nullptr, seq).bad() || !seq)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': RLE PixelData holds no fragments", p);
+    std::vector<uint8_t> frame;
+    for (unsigned long i = 1; i < seq->card(); i++) {
+        DcmPixelItem *item = nullptr;
+        Uint8 *b = nullptr;
+        if (seq->getItem(item, i).bad() || !item || (item->getLength() && (item->getUint8Array(b).bad() || !b)))
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read RLE fragment %lu", p, i);
+        frame.insert(frame.end(), b, b + item->getLength());
+    }
+    out.resize(size_t(s.rows) * s.cols * (s.bits_alloc / 8));
+    char why[256];
+    if (vxl_dicom_rle_decode(frame.data(), frame.size(), s.rows, s.cols, s.bits_alloc / 8, out.data(), why,
+                             sizeof why))
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %s", p, why);
+    return VXL_OK;
+}
+
 // Reads one slice's pixels into dst (rows*cols values of bits_alloc).
 int read_pixels(const Slice &s, void *dst, vxl_err *e)
 {
@@ -509,23 +554,28 @@ int read_pixels(const Slice &s, void *dst, vxl_err *e)
     if (ff.getDataset()->findAndGetElement(DCM_PixelData, el).bad() || !el)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': no PixelData", p);
     const size_t n = size_t(s.rows) * s.cols, bytes = n * (s.bits_alloc / 8);
+    if (s.rle) {
+        std::vector<uint8_t> raw;
+        int rc = decode_rle(s, el, raw, e);
+        if (rc) return rc;
+        unpack_slice(s, raw.data(), n, dst);
+        return VXL_OK;
+    }
     if (el->getLength() < bytes)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': truncated PixelData: %zu bytes for %ux%u pixels of %u bits, got %lu",
                         p, bytes, s.cols, s.rows, s.bits_alloc, (unsigned long)el->getLength());
-    bool sgn = s.pixel_rep == 1;
+    const void *a = nullptr;
     if (s.bits_alloc == 8) {
-        Uint8 *a = nullptr;
-        c = el->getUint8Array(a);
-        if (c.bad() || !a) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read PixelData: %s", p, c.text());
-        if (sgn) unpack(reinterpret_cast<const int8_t *>(a), n, s.bits_stored, true, static_cast<int8_t *>(dst));
-        else unpack(reinterpret_cast<const uint8_t *>(a), n, s.bits_stored, false, static_cast<uint8_t *>(dst));
+        Uint8 *b = nullptr;
+        c = el->getUint8Array(b);
+        a = b;
     } else {
-        Uint16 *a = nullptr;
-        c = el->getUint16Array(a);
-        if (c.bad() || !a) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read PixelData: %s", p, c.text());
-        if (sgn) unpack(reinterpret_cast<const int16_t *>(a), n, s.bits_stored, true, static_cast<int16_t *>(dst));
-        else unpack(reinterpret_cast<const uint16_t *>(a), n, s.bits_stored, false, static_cast<uint16_t *>(dst));
+        Uint16 *b = nullptr;
+        c = el->getUint16Array(b);
+        a = b;
     }
+    if (c.bad() || !a) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read PixelData: %s", p, c.text());
+    unpack_slice(s, a, n, dst);
     return VXL_OK;
 }
 

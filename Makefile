@@ -42,6 +42,8 @@ DCMTK_LIBS := -ldcmdata -loflog -lofstd
 # voxlight-read-dicom (DICOM). csrc/*/helper_*.c are the helpers' own files.
 OIIO_CXX := csrc/io/image_stack.cpp csrc/io/vdb.cpp
 DICOM_CXX := csrc/io/dicom.cpp
+# the DICOM codecs in our own C (the helper links them; so do their tests)
+DICOM_CODECS := dicom_rle dicom_jpeg_lossless
 HELPER_C := $(wildcard csrc/*/helper_*.c)
 # csrc/cli/*.c: the command-line tool's own files, linked into it alone.
 CLI_C := $(wildcard csrc/cli/*.c)
@@ -137,7 +139,7 @@ $(BUILD)/voxlight-read-zarr: $(BUILD)/obj/helper_zarr.o $(patsubst %.c,$(BUILD)/
 	$(LIB_CC) $(OPT) -o $@ $(filter-out $(LIB_CC_STAMP),$^) -ldl -lpthread -lm
 
 $(BUILD)/voxlight-read-dicom: $(BUILD)/obj/helper_dicom.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(DICOM_CXX))) \
-		$(BUILD)/obj/dicom_rle.o $(HELPER_CORE)
+		$(DICOM_CODECS:%=$(BUILD)/obj/%.o) $(HELPER_CORE)
 	$(CXX) $(OPT) -o $@ $^ $(DCMTK_LIBS) -lz -lm
 
 $(BUILD)/voxlight-bench: bench/bench.c $(BUILD)/libvoxlight.so
@@ -245,7 +247,7 @@ WIN_API_TESTS := test_accuracy test_api test_budget test_classification test_cut
 	test_labels test_modes test_overlays test_paging test_reference_light test_render test_scene_shadows test_shadows \
 	test_skipping test_slice_plane test_slices test_streaming test_stripes
 windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/child_program.exe $(WIN_BUILD)/tests/test_crc32.exe \
-	$(WIN_BUILD)/tests/test_gz_reader.exe $(WIN_BUILD)/tests/test_dicom_rle.exe $(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/voxlight.exe $(WIN_BUILD)/render_scene.exe \
+	$(WIN_BUILD)/tests/test_gz_reader.exe $(WIN_BUILD)/tests/test_dicom_codecs.exe $(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/voxlight.exe $(WIN_BUILD)/render_scene.exe \
 	$(WIN_ZLIB_DLLS) $(WIN_API_TESTS:%=$(WIN_BUILD)/tests/%.exe) $(WIN_BUILD)/tests/voxlight.dll \
 	$(WIN_BUILD)/voxlight-read-zarr.exe
 
@@ -304,9 +306,10 @@ $(WIN_BUILD)/tests/test_gz_reader.exe: tests/test_gz_reader.c tests/harness.h te
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_LIB_CFLAGS) -Itests $< $(filter %.c,$(filter-out $<,$^)) -o $@ -lshell32
 
-$(WIN_BUILD)/tests/test_dicom_rle.exe: tests/test_dicom_rle.c tests/harness.h csrc/io/dicom_rle.c csrc/io/dicom_rle.h
+$(WIN_BUILD)/tests/test_dicom_codecs.exe: tests/test_dicom_codecs.c tests/harness.h $(DICOM_CODECS:%=csrc/io/%.c) \
+		csrc/core/error.c $(WIN_PLATFORM_C) $(wildcard csrc/*/*.h)
 	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_CFLAGS) -Icsrc/io $< csrc/io/dicom_rle.c -o $@
+	$(WIN_CC) $(WIN_LIB_CFLAGS) -Itests $< $(DICOM_CODECS:%=csrc/io/%.c) csrc/core/error.c $(WIN_PLATFORM_C) -o $@ -lshell32
 
 $(WIN_BUILD)/tests/test_crc32.exe: tests/test_crc32.c tests/harness.h csrc/core/crc32.c csrc/core/crc32_tables.h
 	@mkdir -p $(@D)
@@ -318,10 +321,12 @@ GZ_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,gz_reader zlib_api error crc32 $(PL
 $(BUILD)/tests/test_gz_reader: tests/test_gz_reader.c tests/harness.h tests/utf8_temp.h $(GZ_TEST_OBJ) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(GZ_TEST_OBJ) -o $@ -ldl -lpthread
 
-# test_dicom_rle checks the DICOM RLE decoder on frames made byte by byte
-# (the same file is built for Windows above).
-$(BUILD)/tests/test_dicom_rle: tests/test_dicom_rle.c tests/harness.h $(BUILD)/obj/dicom_rle.o | $(BUILD)/tests
-	$(CC) $(CFLAGS) -Itests $< $(BUILD)/obj/dicom_rle.o -o $@
+# test_dicom_codecs checks the DICOM decoders written in our C on frames
+# made byte by byte or kept from dcmtk's encoder (the same file is built for
+# Windows above).
+DICOM_CODECS_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,$(DICOM_CODECS) error $(PLATFORM))
+$(BUILD)/tests/test_dicom_codecs: tests/test_dicom_codecs.c tests/harness.h $(DICOM_CODECS_TEST_OBJ) | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(DICOM_CODECS_TEST_OBJ) -o $@ -ldl -lpthread
 
 # test_crc32 checks the library's internal CRC-32 against zlib's values.
 $(BUILD)/tests/test_crc32: tests/test_crc32.c tests/harness.h $(BUILD)/obj/crc32.o | $(BUILD)/tests
@@ -353,7 +358,8 @@ FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_u
 # the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
-	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c dicom_rle.c $(PLATFORM:%=%.c))
+	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c dicom_rle.c \
+	dicom_jpeg_lossless.c $(PLATFORM:%=%.c))
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))

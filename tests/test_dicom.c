@@ -1,7 +1,7 @@
 /* test_dicom.c - DICOM series through the public API (vxl_volume_load,
  * vxl_dicom_list_series): geometry from positions with shuffled files and an
  * oblique orientation, rescale to Hounsfield units, several series, 4D
- * series (time points at every position), RLE Lossless against dcmtk's encoder, and the refusals (missing slice,
+ * series (time points at every position), RLE and JPEG Lossless against dcmtk's encoders, and the refusals (missing slice,
  * mixed sizes, compressed, multi-frame, truncated,
  * garbage, over budget). Files come from tests/fuzz/dicom_writer.h, written
  * from the standard independently of dcmtk. Voxel values are read back
@@ -466,38 +466,107 @@ TEST(dispatch_finds_dicom_folders_files_and_dicomdir)
     CHECK(vxl_volume_load(sub, &opt, &v) == VXL_ERR_INVALID_ARGUMENT && contains(vxl_last_error(), "has 1"));
 }
 
-/* The same series in RLE Lossless, as dcmtk's own encoder (dcmcrle, from
- * Debian's dcmtk) writes it, reads voxel for voxel as the uncompressed files
- * (our decoder, io/dicom_rle.c, against an independent encoder); a frame
- * whose header is damaged is one clear error. */
-TEST(rle_lossless_series_reads_as_the_uncompressed_one)
+/* A 64 x 48 x 5 series of 16-bit (or signed 8-bit) values over the whole
+ * range, smooth and noisy in turns, so every predictor and code length is
+ * used; file IMkkkk.dcm per slice. */
+#define CW 64
+#define CH 48
+static int write_busy_series(const char *dir, const char *uid, int eight_bit)
 {
-    char raw[256], rle[256], cmd[1200];
-    folder(raw, sizeof raw, "rle_source");
-    folder(rle, sizeof rle, "rle");
-    const double o[3] = {0, 0, 0}, step[3] = {0, 0, 2};
-    /* values over 255 and past 32767: both bytes of each pixel vary */
-    REQUIRE(write_stack(raw, "1.2.3.95", k_axial, o, step, NS, NULL, 33000, NULL) == 0);
+    static uint16_t px[CW * CH];
+    uint32_t x = 12345;
     for (int k = 0; k < NS; k++) {
-        snprintf(cmd, sizeof cmd, "dcmcrle %s/IM%04d.dcm %s/IM%04d.dcm", raw, k, rle, k);
-        REQUIRE(system(cmd) == 0);
+        for (int j = 0; j < CH; j++)
+            for (int i = 0; i < CW; i++) {
+                x = x * 1103515245u + 12345u;
+                const unsigned smooth = (unsigned)(i * 900 + j * 400 + k * 5000);
+                const unsigned v = (j / 8 + k) % 2 ? smooth : (x >> 8);
+                px[i + CW * j] = (uint16_t)(eight_bit ? (v >> 8) & 0xFF : v);
+            }
+        dcmw_slice d = dcmw_axial(uid, CW, CH, 2.0 * k, px, CW * CH * (eight_bit ? 1u : 2u));
+        if (eight_bit) {
+            static uint8_t px8[CW * CH];
+            for (int n = 0; n < CW * CH; n++) px8[n] = (uint8_t)px[n];
+            d.pixels = px8;
+            d.bits_alloc = 8;
+            d.pixel_rep = 1;
+        }
+        d.instance = k;
+        char p[512];
+        snprintf(p, sizeof p, "%s/IM%04d.dcm", dir, k);
+        if (dcmw_write(p, &d)) return -1;
     }
-    vxl_volume *a = load_series(raw, NULL);
-    vxl_volume *b = load_series(rle, NULL);
-    REQUIRE(a);
-    CHECKF(b != NULL, "%s", vxl_last_error());
-    if (b) {
-        CHECK(!memcmp(a->dims, b->dims, sizeof a->dims) && a->texture_bits == b->texture_bits);
-        CHECK(a->value_min == b->value_min && a->value_max == b->value_max);
-        const size_t bytes = (size_t)a->dims[0] * a->dims[1] * a->dims[2] * (a->texture_bits / 8);
-        CHECK(a->texels && b->texels && !memcmp(a->texels, b->texels, bytes));
-    }
-    vxl_volume_destroy(a);
-    vxl_volume_destroy(b);
+    return 0;
+}
 
-    /* the first frame's header claims 3 segments for 2-byte pixels */
-    char p[512];
-    snprintf(p, sizeof p, "%s/IM0000.dcm", rle);
+/* Every file of src compressed by `tool` (a dcmtk command: its encoders are
+ * independent of our decoders) into a fresh folder g_dir/name. */
+static int compress_series(const char *src, const char *name, const char *tool, char *out, size_t n)
+{
+    folder(out, n, name);
+    char cmd[1400];
+    for (int k = 0; k < NS; k++) {
+        snprintf(cmd, sizeof cmd, "%s %s/IM%04d.dcm %s/IM%04d.dcm", tool, src, k, out, k);
+        if (system(cmd) != 0) return -1;
+    }
+    return 0;
+}
+
+/* a and b hold the same voxels (same size, range and texels). */
+static int same_volume(const vxl_volume *a, const vxl_volume *b)
+{
+    const size_t bytes = (size_t)a->dims[0] * a->dims[1] * a->dims[2] * (a->texture_bits / 8);
+    return !memcmp(a->dims, b->dims, sizeof a->dims) && a->texture_bits == b->texture_bits &&
+           a->value_min == b->value_min && a->value_max == b->value_max && a->texels && b->texels &&
+           !memcmp(a->texels, b->texels, bytes);
+}
+
+/* The same series in RLE Lossless and in JPEG Lossless (SV1, every other
+ * predictor, a frame split over several fragments), as dcmtk's own
+ * encoders write them, reads voxel for voxel as the uncompressed files:
+ * our decoders (io/dicom_rle.c, io/dicom_jpeg_lossless.c) against
+ * independent encoders, for 16-bit unsigned and 8-bit signed pixels. */
+TEST(lossless_compressed_series_read_as_the_uncompressed_one)
+{
+    static const char *const variants[][2] = {
+        {"rle", "dcmcrle"},
+        {"jpeg_sv1", "dcmcjpeg"},
+        {"jpeg_sv1_fragments", "dcmcjpeg +fs 1"},
+        {"jpeg_sv2", "dcmcjpeg +el +sv 2"},
+        {"jpeg_sv3", "dcmcjpeg +el +sv 3"},
+        {"jpeg_sv4", "dcmcjpeg +el +sv 4"},
+        {"jpeg_sv5", "dcmcjpeg +el +sv 5"},
+        {"jpeg_sv6", "dcmcjpeg +el +sv 6"},
+        {"jpeg_sv7", "dcmcjpeg +el +sv 7"},
+    };
+    for (int eight = 0; eight < 2; eight++) {
+        char src[256], dir[256], name[64];
+        snprintf(name, sizeof name, "busy%d", eight);
+        folder(src, sizeof src, name);
+        REQUIRE(write_busy_series(src, eight ? "1.2.3.96" : "1.2.3.95", eight) == 0);
+        vxl_volume *a = load_series(src, NULL);
+        REQUIRE(a);
+        for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
+            snprintf(name, sizeof name, "%s_%d", variants[v][0], eight);
+            REQUIRE(compress_series(src, name, variants[v][1], dir, sizeof dir) == 0);
+            vxl_volume *b = load_series(dir, NULL);
+            CHECKF(b && same_volume(a, b), "%s, %s pixels: %s", variants[v][1], eight ? "8-bit" : "16-bit",
+                   b ? "voxels differ" : vxl_last_error());
+            vxl_volume_destroy(b);
+        }
+        vxl_volume_destroy(a);
+    }
+}
+
+/* A damaged frame is one clear line naming the file: an RLE header claiming
+ * 3 segments for 2-byte pixels; a JPEG frame cut inside its scan. */
+TEST(damaged_compressed_frames_are_clear_errors)
+{
+    char src[256], dir[256], p[512];
+    folder(src, sizeof src, "damage_source");
+    REQUIRE(write_busy_series(src, "1.2.3.97", 0) == 0);
+    REQUIRE(compress_series(src, "damaged_rle", "dcmcrle", dir, sizeof dir) == 0);
+    snprintf(p, sizeof p, "%s/IM0000.dcm", dir);
     size_t n = 0;
     unsigned char *f = read_all(p, &n);
     REQUIRE(f);
@@ -509,9 +578,27 @@ TEST(rle_lossless_series_reads_as_the_uncompressed_one)
     at[0] = 3;
     REQUIRE(write_all(p, f, n) == 0);
     free(f);
-    CHECK(load_series(rle, NULL) == NULL);
+    CHECK(load_series(dir, NULL) == NULL);
     CHECKF(contains(vxl_last_error(), "IM0000.dcm") && contains(vxl_last_error(), "3 segments"), "%s",
            vxl_last_error());
+
+    /* the scan's second half zeroed: the codes then run into nonsense or past the data */
+    REQUIRE(compress_series(src, "damaged_jpeg", "dcmcjpeg", dir, sizeof dir) == 0);
+    snprintf(p, sizeof p, "%s/IM0002.dcm", dir);
+    f = read_all(p, &n);
+    REQUIRE(f);
+    static const unsigned char sos[2] = {0xFF, 0xDA};
+    unsigned char *scan = NULL;
+    for (size_t i = 0; i + 2 <= n && !scan; i++)
+        if (!memcmp(f + i, sos, 2)) scan = f + i;
+    REQUIRE(scan);
+    const size_t from = (size_t)(scan - f) + 16, to = n - 8;
+    REQUIRE(to > from);
+    for (size_t i = from + (to - from) / 2; i < to; i++) f[i] = 0xFF; /* fill bytes, then no EOI: cut short */
+    REQUIRE(write_all(p, f, n) == 0);
+    free(f);
+    CHECK(load_series(dir, NULL) == NULL);
+    CHECKF(contains(vxl_last_error(), "IM0002.dcm") && contains(vxl_last_error(), "JPEG"), "%s", vxl_last_error());
 }
 
 int main(void)
@@ -531,7 +618,8 @@ int main(void)
     RUN(mixed_sizes_compressed_and_multiframe_are_clear_errors);
     RUN(truncated_garbage_and_oversized_files_are_refused);
     RUN(dispatch_finds_dicom_folders_files_and_dicomdir);
-    RUN(rle_lossless_series_reads_as_the_uncompressed_one);
+    RUN(lossless_compressed_series_read_as_the_uncompressed_one);
+    RUN(damaged_compressed_frames_are_clear_errors);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

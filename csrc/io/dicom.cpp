@@ -31,8 +31,9 @@
 // reader_stream.h): libvoxlight.so links no C++. Whether a path is DICOM
 // at all is decided in the library, in C (dicom_detect.c).
 //
-// Transfer syntaxes: the uncompressed ones (dcmtk), and RLE Lossless
-// (our own C, dicom_rle.c). Not decoded: the other compressed (encapsulated)
+// Transfer syntaxes: the uncompressed ones (dcmtk), RLE Lossless and JPEG
+// Lossless (our own C, dicom_rle.c, dicom_jpeg_lossless.c). Not decoded:
+// the other compressed (encapsulated)
 // transfer syntaxes, multi-frame images, colour, BitsAllocated other than
 // 8/16. Each is a clear error naming the file.
 #include <dcmtk/config/osconfig.h>
@@ -56,6 +57,7 @@
 #include <vector>
 
 extern "C" {
+#include "dicom_jpeg_lossless.h"
 #include "dicom_rle.h"
 #include "helper_main.h"
 #include "loader_util.h"
@@ -72,7 +74,9 @@ struct Slice {
     unsigned rows = 0, cols = 0, bits_alloc = 0, bits_stored = 0, pixel_rep = 0, samples = 1;
     long frames = 1;
     bool has_ipp = false, has_iop = false, encapsulated = false;
-    bool rle = false; // RLE Lossless: decoded by dicom_rle.c
+    // Compressed pixels our own C decodes (the rest are refused by name)
+    enum class Codec { none, rle, jpeg_lossless } codec = Codec::none;
+    E_TransferSyntax xs = EXS_Unknown;
     double ipp[3] = {0, 0, 0}, iop[6] = {1, 0, 0, 0, 1, 0}, ps[2] = {1, 1};
     double slope = 1, inter = 0, thickness = 0;
     std::string xfer;
@@ -232,7 +236,9 @@ Parse read_slice(const std::string &path, Slice &s, std::string &why)
     }
     DcmXfer x(ds->getOriginalXfer());
     s.xfer = x.getXferName();
-    s.rle = x.getXfer() == EXS_RLELossless;
+    s.xs = x.getXfer();
+    if (s.xs == EXS_RLELossless) s.codec = Slice::Codec::rle;
+    if (s.xs == EXS_JPEGProcess14 || s.xs == EXS_JPEGProcess14SV1) s.codec = Slice::Codec::jpeg_lossless;
 #if PACKAGE_VERSION_NUMBER >= 369 // dcmtk 3.6.9 (Debian 13) deprecates isEncapsulated()
     s.encapsulated = x.usesEncapsulatedFormat();
 #else
@@ -256,7 +262,7 @@ std::string check_pixels(const std::vector<Slice> &sl)
     const Slice &f = sl[0];
     for (const Slice &s : sl) {
         const char *p = s.path.c_str();
-        if (s.encapsulated && !s.rle)
+        if (s.encapsulated && s.codec == Slice::Codec::none)
             return format("'%s': compressed transfer syntax '%s' is not supported (decompress first, e.g. "
                           "dcmdjpeg or gdcmconv --raw)", p, s.xfer.c_str());
         if (s.frames != 1)
@@ -517,30 +523,31 @@ void unpack_slice(const Slice &s, const void *src, size_t n, void *dst)
     }
 }
 
-// An RLE Lossless slice's one frame: its fragments (the items after the
-// basic offset table) joined, then decoded by dicom_rle.c into out
-// (rows*cols values of bits_alloc, native byte order).
-int decode_rle(const Slice &s, DcmElement *el, std::vector<uint8_t> &out, vxl_err *e)
+// A compressed slice's one frame: its fragments (the items after the basic
+// offset table) joined, then decoded by our own C (dicom_rle.c,
+// dicom_jpeg_lossless.c) into out (rows*cols values of bits_alloc, native
+// byte order).
+int decode_frame(const Slice &s, DcmElement *el, std::vector<uint8_t> &out, vxl_err *e)
 {
     const char *p = s.path.c_str();
     DcmPixelSequence *seq = nullptr;
     if (el->ident() != EVR_PixelData ||
-        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(EXS_RLELossless, nullptr, seq).bad() || !seq)
-        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': RLE PixelData holds no fragments", p);
+        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(s.xs, nullptr, seq).bad() || !seq)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': compressed PixelData holds no fragments", p);
     std::vector<uint8_t> frame;
     for (unsigned long i = 1; i < seq->card(); i++) {
         DcmPixelItem *item = nullptr;
         Uint8 *b = nullptr;
         if (seq->getItem(item, i).bad() || !item || (item->getLength() && (item->getUint8Array(b).bad() || !b)))
-            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read RLE fragment %lu", p, i);
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read compressed fragment %lu", p, i);
         frame.insert(frame.end(), b, b + item->getLength());
     }
     out.resize(size_t(s.rows) * s.cols * (s.bits_alloc / 8));
-    char why[256];
-    if (vxl_dicom_rle_decode(frame.data(), frame.size(), s.rows, s.cols, s.bits_alloc / 8, out.data(), why,
-                             sizeof why))
-        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %s", p, why);
-    return VXL_OK;
+    vxl_err codec = {};
+    const int rc = s.codec == Slice::Codec::rle
+        ? vxl_dicom_rle_decode(frame.data(), frame.size(), s.rows, s.cols, s.bits_alloc / 8, out.data(), &codec)
+        : vxl_jpeg_lossless_decode(frame.data(), frame.size(), s.rows, s.cols, s.bits_alloc / 8, out.data(), &codec);
+    return rc ? vxl_fail(e, rc, "'%s': %s", p, codec.msg) : VXL_OK;
 }
 
 // Reads one slice's pixels into dst (rows*cols values of bits_alloc).
@@ -554,9 +561,9 @@ int read_pixels(const Slice &s, void *dst, vxl_err *e)
     if (ff.getDataset()->findAndGetElement(DCM_PixelData, el).bad() || !el)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': no PixelData", p);
     const size_t n = size_t(s.rows) * s.cols, bytes = n * (s.bits_alloc / 8);
-    if (s.rle) {
+    if (s.codec != Slice::Codec::none) {
         std::vector<uint8_t> raw;
-        int rc = decode_rle(s, el, raw, e);
+        int rc = decode_frame(s, el, raw, e);
         if (rc) return rc;
         unpack_slice(s, raw.data(), n, dst);
         return VXL_OK;

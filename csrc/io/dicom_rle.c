@@ -1,7 +1,6 @@
 /* dicom_rle.c - dicom_rle.h. */
 #include "dicom_rle.h"
 
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,15 +8,6 @@
 #define HEADER_BYTES 64
 
 static uint32_t le32(const uint8_t *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
-
-__attribute__((format(printf, 3, 4))) static int fail(char *why, size_t why_size, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    if (why_size) vsnprintf(why, why_size, fmt, ap);
-    va_end(ap);
-    return -1;
-}
 
 /* PackBits from seg[0..n) into out[0..want): 0 when exactly want bytes came
  * (an encoder may pad a segment to even length: what follows is ignored),
@@ -45,29 +35,31 @@ static int unpack_bits(const uint8_t *seg, size_t n, uint8_t *out, size_t want)
 }
 
 int vxl_dicom_rle_decode(const uint8_t *frame, size_t n, uint32_t rows, uint32_t cols, uint32_t bytes_per_pixel,
-                         void *dst, char *why, size_t why_size)
+                         void *dst, vxl_err *e)
 {
     if (bytes_per_pixel != 1 && bytes_per_pixel != 2)
-        return fail(why, why_size, "RLE of %u-byte pixels is not supported", bytes_per_pixel);
+        return vxl_fail(e, VXL_ERR_FORMAT, "RLE of %u-byte pixels is not supported", bytes_per_pixel);
     if (n < HEADER_BYTES)
-        return fail(why, why_size, "RLE frame of %zu bytes is shorter than its %d-byte header", n, HEADER_BYTES);
+        return vxl_fail(e, VXL_ERR_FORMAT, "RLE frame of %zu bytes is shorter than its %d-byte header", n,
+                        HEADER_BYTES);
     const uint32_t segments = le32(frame);
     if (segments != bytes_per_pixel)
-        return fail(why, why_size, "RLE frame has %u segments, expected %u (one per byte of a grey pixel)", segments,
-                    bytes_per_pixel);
+        return vxl_fail(e, VXL_ERR_FORMAT, "RLE frame has %u segments, expected %u (one per byte of a grey pixel)",
+                        segments, bytes_per_pixel);
     const size_t pixels = (size_t)rows * cols;
     uint8_t *plane = malloc(pixels ? pixels : 1);
-    if (!plane) return fail(why, why_size, "out of memory for a %ux%u RLE frame", cols, rows);
-    int rc = 0;
+    if (!plane) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for a %ux%u RLE frame", cols, rows);
+    int rc = VXL_OK;
     for (uint32_t s = 0; s < segments && !rc; s++) {
         const uint32_t start = le32(frame + 4 + 4 * s);
         const uint32_t end = s + 1 < segments ? le32(frame + 8 + 4 * s) : (uint32_t)(n > UINT32_MAX ? UINT32_MAX : n);
         if (start < HEADER_BYTES || start > end || end > n) {
-            rc = fail(why, why_size, "RLE segment %u has offset %u outside its frame", s, start);
+            rc = vxl_fail(e, VXL_ERR_FORMAT, "RLE segment %u has offset %u outside its frame", s, start);
             break;
         }
         if (unpack_bits(frame + start, end - start, plane, pixels)) {
-            rc = fail(why, why_size, "RLE segment %u does not decode to %zu bytes (corrupt or cut short)", s, pixels);
+            rc = vxl_fail(e, VXL_ERR_FORMAT, "RLE segment %u does not decode to %zu bytes (corrupt or cut short)", s,
+                          pixels);
             break;
         }
         /* segment 0 holds the most significant byte */

@@ -9,11 +9,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "error.h"
+#include "voxlight.h"
+
 /* Decodes one frame of rows x cols single-sample pixels of bytes_per_pixel
  * (1 or 2) from the frame's fragments joined (frame[0..n)) into dst, native
- * byte order. 0, or -1 with the reason in why (the frame is corrupt or cut
- * short: every offset and run is checked against n and the frame's size). */
+ * byte order. VXL_OK, or a vxl_fail with the reason (VXL_ERR_FORMAT: the
+ * frame is corrupt or cut short; every offset and run is checked against n
+ * and the frame's size). */
 int vxl_dicom_rle_decode(const uint8_t *frame, size_t n, uint32_t rows, uint32_t cols, uint32_t bytes_per_pixel,
-                         void *dst, char *why, size_t why_size);
+                         void *dst, vxl_err *e);
 
 #endif

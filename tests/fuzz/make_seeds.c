@@ -1,7 +1,8 @@
 /* make_seeds.c - writes the seed corpus for the fuzz targets: small valid
  * files of every format and the main variants (types, byte orders,
  * compression, geometry, pages, channels).
- *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png,dicom,label_table,dicom_rle}/seed_*
+ *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png,dicom,label_table,dicom_codecs}/seed_*
+ * (dicom_codecs' JPEG seeds come from tests/fuzz/jpeg_seeds.py: dcmtk encodes them)
  * Built and run by `make fuzz-seeds` (./build.sh test / fuzz). */
 #include <stdint.h>
 #include <stdio.h>
@@ -152,14 +153,14 @@ int main(int argc, char **argv)
     ok(lt_write_seed(path("label_table", "seed_lut"), LT_MODE_LUT, pal, sizeof pal, NULL, 0), "label lut");
     ok(lt_write_seed(path("label_table", "seed_pair"), LT_MODE_PAIR, pal, sizeof pal, lt_names, sizeof lt_names - 1),
        "label pair");
-    /* DICOM RLE frames (dicom_rle_input.h's 4-byte prefix, the 64-byte
+    /* DICOM RLE frames (dicom_codec_input.h's 4-byte prefix, the 64-byte
      * header, PackBits segments): 8-bit
      * 2 x 4 with every kind of run, and 16-bit 1 x 3 in two segments */
     static const uint8_t rle8[] = {1, 3, 0, 0, 1, 0, 0, 0, 64, 0, 0, 0, [68] = 2, 1, 2, 3, 0x80, 0xfd, 9, 0, 7, 0};
     static const uint8_t rle16[] = {0, 2, 1, 0, 2, 0, 0, 0, 64, 0, 0, 0, 68, 0, 0, 0, [68] = 0xff, 0x12, 0, 0x80,
                                     2, 0x34, 0xff, 0};
-    ok(tw_write(path("dicom_rle", "seed_8bit"), rle8, sizeof rle8, NULL, 0), "dicom rle 8-bit");
-    ok(tw_write(path("dicom_rle", "seed_16bit"), rle16, sizeof rle16, NULL, 0), "dicom rle 16-bit");
+    ok(tw_write(path("dicom_codecs", "seed_rle_8bit"), rle8, sizeof rle8, NULL, 0), "dicom rle 8-bit");
+    ok(tw_write(path("dicom_codecs", "seed_rle_16bit"), rle16, sizeof rle16, NULL, 0), "dicom rle 16-bit");
 
     return failures ? 1 : 0;
 }

@@ -26,6 +26,9 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
  * TIFF/PNG: a multi-page TIFF, a numbered series (slice_0001.tif ...) or a
  * folder of images (image_stack.cpp in voxlight-read-oiio). */
 int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* 0 where vxl_image_stack_load cannot run (its library has no build for
+ * this OS): a TIFF that can stream then streams whatever its size. */
+int vxl_image_stack_reader_runs_here(void);
 /* OpenVDB scalar grid (vdb.cpp in voxlight-read-oiio). */
 int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 /* DICOM: a folder, a DICOMDIR or one file of a series (dicom.cpp in

@@ -34,6 +34,8 @@
 #define MAX_SERIES 100000u       /* dicom.cpp scans at most this many files */
 #define LOADER_SAYS "error while loading shared libraries: "
 
+int vxl_reader_runs_here(const vxl_reader *r) { return !(r->linux_only && !strcmp(vxl_os_name(), "windows")); }
+
 static int helper_path(const vxl_reader *r, const char *path, char *out, size_t n, vxl_err *e)
 {
     const char *env = getenv(r->env);
@@ -41,10 +43,10 @@ static int helper_path(const vxl_reader *r, const char *path, char *out, size_t 
         if (snprintf(out, n, "%s", env) >= (int)n)
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "%s is too long", r->env);
     } else {
-        if (r->linux_only && !strcmp(vxl_os_name(), "windows"))
+        if (!vxl_reader_runs_here(r))
             return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s are not read on Windows yet: their reader needs %s, "
-                            "which has no Windows build here (Windows reads NIfTI, NRRD, MetaImage and OME-Zarr, and "
-                            "uncompressed TIFF with streaming on)", path, r->formats, r->library);
+                            "which has no Windows build here (Windows reads NIfTI, NRRD, MetaImage, OME-Zarr and "
+                            "uncompressed multi-page TIFF, streamed)", path, r->formats, r->library);
         char self[4096];
         if (vxl_dynlib_path_of((const void *)&vxl_reader_run, self, sizeof self))
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot locate libvoxlight to find %s", path,

@@ -31,4 +31,8 @@ typedef struct vxl_reader {
 int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, const vxl_load_options *opt,
                    uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, vxl_err *e);
 
+/* 0 where r's library has no build for this OS (Windows and a linux_only
+ * reader): vxl_reader_run then refuses its formats by name. */
+int vxl_reader_runs_here(const vxl_reader *r);
+
 #endif

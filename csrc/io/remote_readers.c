@@ -110,6 +110,8 @@ static int load_remote(const vxl_reader *r, const char *command, int reads_sibli
     return volume_from(&h, body, out, e);
 }
 
+int vxl_image_stack_reader_runs_here(void) { return vxl_reader_runs_here(&stack_reader); }
+
 int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     return load_remote(&stack_reader, VXL_CMD_STACK, 1, 0, path, opt, out, e);

@@ -11,10 +11,11 @@
 #include "stream_load.h"
 #include "tiff_layout.h"
 
-/* A single TIFF file (issue 21): its pages are read by offset when its
- * directories allow it (tiff_layout.h) and the plan streams (ON, or AUTO
- * over half the budget); otherwise the OpenImageIO helper reads it whole,
- * as before, and over the budget the error says why it could not stream. */
+/* A single TIFF file: its pages are read by offset when its directories
+ * allow it (tiff_layout.h) and the plan streams (ON, or AUTO over half the
+ * budget, or AUTO where the OpenImageIO helper cannot run: Windows);
+ * otherwise the helper reads it whole, as before, and over the budget the
+ * error says why it could not stream. */
 static int vxl_tiff_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     const uint32_t mode = vxl_load_streaming(opt);
@@ -32,6 +33,7 @@ static int vxl_tiff_load(const char *path, const vxl_load_options *opt, vxl_volu
         int stream = 0;
         uint64_t nbytes = 0;
         rc = vxl_stream_plan(path, t.dims, t.dtype, opt, NULL, &stream, &nbytes, e);
+        if (!rc && !stream && !vxl_image_stack_reader_runs_here()) stream = 1; /* its only reader here */
         if (rc || stream) {
             vxl_raw_layout l;
             if (!rc) rc = vxl_tiff_raw_layout(path, &t, opt, &l, e);

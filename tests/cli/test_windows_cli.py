@@ -105,6 +105,17 @@ def test_render_matches_linux(inputs, tmp_path, fmt, extra):
     assert np.abs(a - b).max() <= 1, "PNG bytes differ by up to %d" % np.abs(a - b).max()
 
 
+def test_an_uncompressed_tiff_streams_on_windows_without_asking(inputs):
+    """Windows has no OpenImageIO helper: a TIFF our C can read by offset is
+    streamed under the default (auto), as Linux streams it when asked."""
+    src = inputs["tiff"]
+    lin = run_linux("info", src, "--streaming", "on")
+    assert lin.returncode == 0, lin.stderr
+    win = run_windows("voxlight.exe", "info", src)
+    assert win.returncode == 0, win.stdout + win.stderr
+    assert without_paths(win.stdout, src) == without_paths(lin.stdout, src)
+
+
 def test_a_matcap_png_is_decoded_on_windows(inputs, tmp_path):
     """--matcap's PNG is inflated by the zlib1.dll beside voxlight.exe."""
     from test_cli_modes import write_png

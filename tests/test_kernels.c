@@ -316,10 +316,9 @@ static int source_shader_dir(char *out, size_t n)
         !vxl_real_path(found, exe, sizeof exe))
         return 0;
     for (int up = 0; up < 5; up++) {
-        char *slash = strrchr(exe, '/'), *back = strrchr(exe, '\\');
-        if (back > slash) slash = back;
+        const char *slash = vxl_path_last_separator(exe);
         if (!slash) return 0;
-        *slash = '\0';
+        exe[slash - exe] = '\0';
         if (snprintf(out, n, "%s/shaders/lib", exe) < (int)n && vxl_is_dir(out))
             return snprintf(out, n, "%s/shaders", exe) < (int)n;
     }

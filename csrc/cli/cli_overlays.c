@@ -35,7 +35,8 @@ static int parse_spec(const char *val, vxl_cli_overlays *o, char *err, size_t er
     char *path = o->path[o->count];
     vxl_path_info info;
     /* a drive letter's colon ("C:\\scans\\ct.nii:hot") is the path's */
-    const int drive = ((val[0] | 32) >= 'a' && (val[0] | 32) <= 'z') && val[1] == ':' && (val[2] == '\\' || val[2] == '/');
+    const int drive =
+        ((val[0] | 32) >= 'a' && (val[0] | 32) <= 'z') && val[1] == ':' && (val[2] == '\\' || val[2] == '/');
     const char *colon = vxl_path_stat(val, &info) == 0 ? NULL : strchr(val + (drive ? 2 : 0), ':');
     size_t len = colon ? (size_t)(colon - val) : strlen(val);
     if (!len || len >= sizeof o->path[0])

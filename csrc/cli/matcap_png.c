@@ -3,8 +3,8 @@
  * reduces them to grey volumes, and the CLI links no image library: a
  * MatCap is one small RGB picture, decoded here with the system's zlib,
  * opened at run time as the library opens it (os.h names it per OS), so
- * the tool needs no zlib to start. Image rows are stored top first; vxl_matcap wants row 0 =
- * bottom. The texels are the stored values over 255 (65535), as they are:
+ * the tool needs no zlib to start. Image rows are stored top first;
+ * vxl_matcap wants row 0 = bottom. The texels are the stored values over 255 (65535), as they are:
  * the CLI writes its PNGs the same way (image_write.c, no transfer curve),
  * so a MatCap shades a white surface to the picture's own colours. */
 #include "matcap_png.h"

@@ -33,9 +33,9 @@
 //
 // Transfer syntaxes: the uncompressed ones (dcmtk), RLE Lossless and JPEG
 // Lossless (our own C, dicom_rle.c, dicom_jpeg_lossless.c). Not decoded:
-// the other compressed (encapsulated)
-// transfer syntaxes, multi-frame images, colour, BitsAllocated other than
-// 8/16. Each is a clear error naming the file.
+// the other compressed (encapsulated) transfer syntaxes, multi-frame
+// images, colour, BitsAllocated other than 8/16. Each is a clear error
+// naming the file.
 #include <dcmtk/config/osconfig.h>
 #include <dcmtk/dcmdata/dcpxitem.h>
 #include <dcmtk/dcmdata/dctk.h>

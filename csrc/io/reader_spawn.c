@@ -34,7 +34,7 @@
 #define MAX_SERIES 100000u       /* dicom.cpp scans at most this many files */
 #define LOADER_SAYS "error while loading shared libraries: "
 
-int vxl_reader_runs_here(const vxl_reader *r) { return !(r->linux_only && !strcmp(vxl_os_name(), "windows")); }
+int vxl_reader_runs_here(const vxl_reader *r) { return !r->linux_only || vxl_os_has_debian_libraries(); }
 
 static int helper_path(const vxl_reader *r, const char *path, char *out, size_t n, vxl_err *e)
 {
@@ -51,9 +51,8 @@ static int helper_path(const vxl_reader *r, const char *path, char *out, size_t 
         if (vxl_dynlib_path_of((const void *)&vxl_reader_run, self, sizeof self))
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot locate libvoxlight to find %s", path,
                             r->helper);
-        /* the helper sits beside the library (either separator: Windows' paths take both) */
-        const char *slash = strrchr(self, '/'), *back = strrchr(self, '\\');
-        if (back > slash) slash = back;
+        /* the helper sits beside the library */
+        const char *slash = vxl_path_last_separator(self);
         int dir_len = slash ? (int)(slash - self) : 1;
         if (snprintf(out, n, "%.*s/%s%s", dir_len, slash ? self : ".", r->helper, vxl_program_suffix()) >= (int)n)
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': the path of %s is too long", path, r->helper);

@@ -89,7 +89,7 @@ static int open_library(vxl_zarr_codecs *c, const codec_library *lib, vxl_dynlib
     *handle = h;
     vxl_mutex_unlock(&c->lock);
     /* Debian's packages have no Windows build: there the codec is refused by name */
-    if (!h && !strcmp(vxl_os_name(), "windows"))
+    if (!h && !vxl_os_has_debian_libraries())
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %s-compressed chunks are not read on Windows yet (stores with gzip, "
                         "zlib or no compression are)", chunk, lib->codec);
     if (!h)

@@ -9,6 +9,7 @@
 #include <windows.h>
 
 #include "dynlib.h"
+#include "files.h"
 #include "utf16_win32.h"
 
 /* LoadLibraryExW of a UTF-8 name or path. */
@@ -25,11 +26,11 @@ static HMODULE load(const char *name, DWORD flags)
 static int beside_this_module(const char *name, char *out, size_t size)
 {
     if (vxl_dynlib_path_of((const void *)&beside_this_module, out, size)) return -1;
-    char *slash = strrchr(out, '\\');
-    char *fwd = strrchr(out, '/');
-    if (fwd > slash) slash = fwd;
-    if (!slash || (size_t)(slash + 1 - out) + strlen(name) + 1 > size) return -1;
-    memcpy(slash + 1, name, strlen(name) + 1);
+    const char *slash = vxl_path_last_separator(out);
+    if (!slash) return -1;
+    const size_t dir = (size_t)(slash + 1 - out);
+    if (dir + strlen(name) + 1 > size) return -1;
+    memcpy(out + dir, name, strlen(name) + 1);
     return 0;
 }
 

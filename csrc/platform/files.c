@@ -1,6 +1,14 @@
 /* files.c - what files.h does the same on every OS. */
 #include "files.h"
 
+#include <string.h>
+
+const char *vxl_path_last_separator(const char *path)
+{
+    const char *slash = strrchr(path, '/'), *back = strrchr(path, '\\');
+    return back > slash ? back : slash;
+}
+
 int vxl_is_file(const char *path)
 {
     vxl_path_info i;

@@ -57,6 +57,10 @@ int vxl_dir_writable(const char *folder);
 /* The absolute, resolved form of path into out; NULL when it cannot. */
 char *vxl_real_path(const char *path, char *out, size_t size);
 
+/* The last folder separator of path, '/' or '\\' (Windows takes both), or
+ * NULL when it has none. */
+const char *vxl_path_last_separator(const char *path);
+
 /* A folder's entries, "." and ".." left out. */
 typedef struct vxl_dir vxl_dir;
 vxl_dir *vxl_dir_open(const char *path);

@@ -14,6 +14,11 @@ const char *vxl_os_name(void);
  * beside voxlight.dll. */
 const char *vxl_os_zlib_name(void);
 
+/* 1 where the libraries of Debian's packages that some readers link or open
+ * (OpenImageIO, dcmtk, libblosc, libzstd) can be present: POSIX systems; 0
+ * on Windows, where no build of them is shipped. */
+int vxl_os_has_debian_libraries(void);
+
 /* A program's arguments as UTF-8, as every path the library takes is: on
  * Windows main's are in the ANSI code page (José's folder would not open),
  * so they are replaced by the command line's wide characters, converted

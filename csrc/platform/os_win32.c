@@ -8,6 +8,7 @@
 #include "utf16_win32.h"
 
 const char *vxl_os_name(void) { return "windows"; }
+int vxl_os_has_debian_libraries(void) { return 0; }
 const char *vxl_os_zlib_name(void) { return "zlib1.dll"; }
 
 int vxl_os_utf8_args(int *argc, char ***argv)

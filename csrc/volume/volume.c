@@ -4,6 +4,7 @@
 #include "volume.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -388,4 +389,18 @@ void vxl_volume_destroy(vxl_volume *v)
     vxl_brick_source_free(v->source);
     free(v->texels);
     free(v);
+}
+
+void vxl_volume_note(vxl_volume *v, const char *fmt, ...)
+{
+    if (!v || !fmt) return;
+    char line[VXL_VOLUME_NOTES_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    const size_t cap = sizeof v->notes, used = strlen(v->notes);
+    if (used + 4 >= cap) return; /* full: already ends in "..." */
+    int n = snprintf(v->notes + used, cap - used, "%s%s", used ? "; " : "", line);
+    if (n < 0 || (size_t)n >= cap - used) memcpy(v->notes + cap - 4, "...", 4);
 }

@@ -12,6 +12,7 @@
 
 #define VXL_DEFAULT_BUDGET (2ull << 30) /* 2 GiB */
 #define VXL_DEFAULT_MAX_DIM 65536u
+#define VXL_VOLUME_NOTES_MAX 512 /* vxl_volume.notes, NUL included */
 
 struct vxl_volume {
     uint32_t dims[3];
@@ -34,7 +35,19 @@ struct vxl_volume {
      * Code that needs every voxel either reads through source a box at a
      * time or refuses a streamed volume with a clear error. */
     vxl_brick_source *source;
+    /* What the reader decided for the user to know: a sentence per decision
+     * ("4 slices interpolated where a slice is missing"), joined by "; ". ""
+     * when nothing was. Reported by `info`, the add-on and the statistics. */
+    char notes[VXL_VOLUME_NOTES_MAX];
 };
+
+/* Appends one note (printf format) to v->notes, "; "-separated; cut with
+ * "..." when the notes are full, so the first decisions always survive. */
+void vxl_volume_note(vxl_volume *v, const char *fmt, ...)
+#if defined(__GNUC__) || defined(__clang__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 
 /* Checks dims against max_dim and the budget before anything is allocated.
  * bytes_per_voxel is what the texture will cost. */

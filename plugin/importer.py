@@ -53,6 +53,7 @@ def fill_volume_properties(obj, path, info, v2l, unit_scale):
     if "histogram" in info:
         p.histogram = [int(min(c, 2**31 - 1)) for c in info["histogram"]]
     p.frame_count = info.get("frame_count", 1)
+    p.reader_notes = info.get("notes", "")
 
 
 class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
@@ -181,10 +182,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             self.report({"ERROR"}, "Voxlight: cannot import %s: %s" % (name, e))
             return {"CANCELLED"}
         runtime.adopt(entry)
-        info = entry.info
-        streamed = ", streamed from disk (%d levels)" % info["level_count"] if info.get("streamed") else ""
-        self.report({"INFO"}, "Voxlight: imported %s (%d x %d x %d, %s%s) %s"
-                    % (name, *info["dims"], info["dtype"], streamed, self._why))
+        self.report({"INFO"}, import_job.import_report(name, entry.info, self._why))
         return {"FINISHED"}
 
     def _label_plan(self, context, path, info):

@@ -10,7 +10,7 @@ the editor's default width."""
 import bpy
 
 from . import tf
-from .core import histogram_image, runtime
+from .core import histogram_image, import_job, runtime
 from .operators import OnActiveVolume
 from .properties import FIXED_TAP_FILTERS
 
@@ -66,6 +66,8 @@ class VOXLIGHT_PT_volume(_VolumePanel, bpy.types.Panel):
                                                    _KIND_TEXT.get(tf.kind_of(p), "")))
         if p.series:
             col.label(text="DICOM series %s" % p.series)
+        for line in import_job.note_lines(p.reader_notes):  # what the reader assumed at import
+            col.label(text=line, icon="INFO")
         if p.frame_count > 1:  # 4D: which volume frame the scene frame shows
             col = _split(layout.column(align=True), decorate=True)
             col.label(text="%d volume frames" % p.frame_count)

@@ -168,6 +168,11 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                                                   "view shows the face", 1)])
     frame_count: IntProperty(name="Volume Frames", default=1, min=1, options=set(),
                              description="Volumes in the file (4D: fMRI, cardiac phases)")
+    # Set at import from vxl_volume_info.notes, so the panel keeps showing
+    # what the reader assumed after the import's report has scrolled away.
+    reader_notes: StringProperty(name="Reader Notes", default="", options=set(),
+                                 description="What the reader decided rather than read at import "
+                                             "(e.g. a voxel size assumed), a sentence per decision")
     frame_mode: EnumProperty(name="Frame", default="TIMELINE", update=tag_redraw,
                              description="Which volume of a 4D series is shown",
                              items=[("TIMELINE", "Follow Timeline",

@@ -462,6 +462,60 @@ TEST(old_output_structs_are_written_up_to_their_size)
     vxl_renderer_destroy(r);
 }
 
+/* A reader's notes (vxl_volume_add_note stands in for one) reach
+ * vxl_volume_info.notes: "; "-joined, one line, the first kept and "..."
+ * when full, and only for a caller whose struct covers all of notes. */
+TEST(notes_reach_the_volume_info)
+{
+    double prm[4] = {0.1, 0, 0, 0};
+    vxl_volume *v = make_volume_f32(4, 4, 4, field_ramp, prm);
+    REQUIRE(v);
+    vxl_volume_info in = {.struct_size = sizeof in};
+    CHECK(vxl_volume_get_info(v, &in) == VXL_OK && in.notes[0] == '\0');
+    CHECK(vxl_volume_add_note(v, "PixelSpacing missing: 1 mm assumed") == VXL_OK);
+    CHECK(vxl_volume_add_note(v, "2 slices interpolated\nwhere slices are missing") == VXL_OK);
+    CHECK(vxl_volume_get_info(v, &in) == VXL_OK);
+    CHECKF(!strcmp(in.notes, "PixelSpacing missing: 1 mm assumed; 2 slices interpolated where slices are missing"),
+           "%s", in.notes);
+    CHECK(vxl_volume_add_note(NULL, "x") == VXL_ERR_INVALID_ARGUMENT);
+    CHECK(vxl_volume_add_note(v, NULL) == VXL_ERR_INVALID_ARGUMENT);
+
+    /* an older caller's struct, and one that ends inside notes: notes untouched */
+    const uint32_t notes_at = (uint32_t)offsetof(vxl_volume_info, notes);
+    const uint32_t sizes[2] = {notes_at, notes_at + 10};
+    for (int i = 0; i < 2; i++) {
+        vxl_volume_info old;
+        memset(&old, 0xEE, sizeof old);
+        old.struct_size = sizes[i];
+        CHECK(vxl_volume_get_info(v, &old) == VXL_OK && old.dims[0] == 4 && old.bytes_read == 0);
+        CHECK(old.struct_size == notes_at && (unsigned char)old.notes[0] == 0xEE &&
+              (unsigned char)old.notes[VXL_NOTES_MAX - 1] == 0xEE);
+    }
+
+    /* too many notes: the first survive, the last are cut to "..." */
+    char long_note[101];
+    memset(long_note, 'n', 100);
+    long_note[100] = '\0';
+    for (int i = 0; i < 8; i++) CHECK(vxl_volume_add_note(v, long_note) == VXL_OK);
+    CHECK(vxl_volume_get_info(v, &in) == VXL_OK);
+    size_t len = strnlen(in.notes, sizeof in.notes);
+    CHECKF(len == VXL_NOTES_MAX - 1 && !strcmp(in.notes + len - 3, "...") &&
+           !strncmp(in.notes, "PixelSpacing missing", 20), "%zu: %s", len, in.notes);
+    vxl_volume_destroy(v);
+
+    /* notes filled exactly: the next note is lost, and the notes say so */
+    v = make_volume_f32(4, 4, 4, field_ramp, prm);
+    REQUIRE(v);
+    char full[VXL_NOTES_MAX - 1];
+    memset(full, 'f', sizeof full - 1);
+    full[sizeof full - 1] = '\0';
+    CHECK(vxl_volume_add_note(v, full) == VXL_OK && vxl_volume_get_info(v, &in) == VXL_OK && !strcmp(in.notes, full));
+    CHECK(vxl_volume_add_note(v, "lost") == VXL_OK && vxl_volume_get_info(v, &in) == VXL_OK);
+    len = strlen(in.notes);
+    CHECKF(len == sizeof full - 1 && !strcmp(in.notes + len - 3, "...") && in.notes[0] == 'f', "%s", in.notes);
+    vxl_volume_destroy(v);
+}
+
 int main(void)
 {
     RUN(abi_and_names);
@@ -480,5 +534,6 @@ int main(void)
     RUN(old_renderer_options_get_the_defaults);
     RUN(old_load_options_get_the_defaults);
     RUN(old_output_structs_are_written_up_to_their_size);
+    RUN(notes_reach_the_volume_info);
     return TEST_SUMMARY();
 }

@@ -356,6 +356,8 @@ static int cmd_info(int argc, char **argv)
     else printf("format:      %s\n", strrchr(input, '.') ? strrchr(input, '.') + 1 : "image stack");
     printf("dimensions:  %u x %u x %u\n", in.dims[0], in.dims[1], in.dims[2]);
     if (in.frame_count > 1) printf("frames:      %u (this is frame %u; --frame N)\n", in.frame_count, in.frame);
+    /* what the reader decided rather than read, so no guess goes unseen */
+    if (in.notes[0]) printf("notes:       %s\n", in.notes);
     printf("spacing:     %g x %g x %g mm\n", in.spacing[0], in.spacing[1], in.spacing[2]);
     const char *dtype = vxl_dtype_name(in.dtype);
     printf("data type:   %s (stored as %u-bit %s)\n", dtype ? dtype : "?", in.texture_bits,

@@ -220,6 +220,8 @@ typedef struct vxl_volume_desc {
     double scl_inter;
 } vxl_volume_desc;
 
+#define VXL_NOTES_MAX 512 /* vxl_volume_info.notes, its NUL included */
+
 typedef struct vxl_volume_info {
     uint32_t struct_size;
     uint32_t dtype;             /* VXL_DTYPE_* of the source data */
@@ -243,6 +245,12 @@ typedef struct vxl_volume_info {
     uint64_t resident_bytes;    /* CPU bytes the volume holds now (whole: its voxels; streamed: its
                                    index, coarse level and brick cache) */
     uint64_t bytes_read;        /* bytes read from the file (or cache) so far, by all users */
+    /* Appended: what the reader decided for the user to know, so an import
+     * never guesses silently ("PixelSpacing missing: 1 mm assumed"): UTF-8,
+     * one line, a sentence per decision joined by "; ", cut with "..." when
+     * full; "" when it decided nothing. Written only when struct_size covers
+     * all of it. */
+    char notes[VXL_NOTES_MAX];
 } vxl_volume_info;
 
 VXL_API int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **out);

@@ -54,6 +54,13 @@ VXL_API int vxl_volume_read_level(const vxl_volume *vol, uint32_t level, const u
 VXL_API int vxl_volume_brick_index(const vxl_volume *vol, uint32_t *brick, uint32_t dims[3], float *out,
                                    size_t max_floats);
 
+/* ---------------------------------------------------------------- notes */
+
+/* Appends one note to the volume's notes as a reader would (vxl_volume_info
+ * .notes: "; "-separated, cut with "..." when full), so tests can check
+ * what reaches the user without a reader that decides something. */
+VXL_API int vxl_volume_add_note(vxl_volume *vol, const char *note);
+
 /* ------------------------------------------------------- label uploads */
 
 /* Issue 20: how many label volumes and label tables the renderer has

@@ -104,6 +104,8 @@ static void volume_header(const vxl_volume *v, vxl_reader_header *h)
     h->inf_count = v->inf_count;
     h->storage_bytes = v->storage_bytes;
     h->nbytes = v->storage_bytes;
+    /* a reader's notes are terminated; a full array is cut, not sent open */
+    snprintf(h->notes, sizeof h->notes, "%s", v->notes);
 }
 
 int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_command *cmds, int n_cmds)

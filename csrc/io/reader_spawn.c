@@ -113,6 +113,17 @@ static int all_finite(const double *v, int n)
     return 1;
 }
 
+/* The notes reach a terminal and Blender's UI: terminated inside the array
+ * and free of control characters (UTF-8's bytes above 0x7f pass). */
+static int notes_ok(const char *notes, size_t cap)
+{
+    const char *end = memchr(notes, 0, cap);
+    if (!end) return 0;
+    for (const char *c = notes; c < end; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f) return 0;
+    return 1;
+}
+
 /* A volume header: every field the rebuilt vxl_volume will hold. */
 static int check_volume_header(const vxl_reader *r, const char *path, const vxl_reader_header *h,
                                const vxl_load_options *opt, vxl_err *e)
@@ -135,6 +146,9 @@ static int check_volume_header(const vxl_reader *r, const char *path, const vxl_
         h->frame >= h->frame_count || h->affine_source > 2 || h->nifti_version > 2 ||
         h->nan_count + h->inf_count < h->nan_count || h->nan_count + h->inf_count > nbytes)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent an inconsistent volume header", path, r->name);
+    if (!notes_ok(h->notes, sizeof h->notes))
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent notes that are not one terminated line of "
+                        "text", path, r->name);
     return VXL_OK;
 }
 

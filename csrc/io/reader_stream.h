@@ -15,6 +15,8 @@
 
 #include <stdint.h>
 
+#include "volume.h" /* VXL_VOLUME_NOTES_MAX */
+
 /* The helpers' file names; they sit next to libvoxlight.so. The variable
  * named like the file (upper case, '-' as '_') overrides where one is
  * (tests, unusual installs). */
@@ -38,7 +40,9 @@
  * FRAME SERIES (SERIES may be ""): the load options, defaults resolved. */
 #define VXL_HELPER_ARGC 10
 
-#define VXL_READER_MAGIC "VXLRD01"
+/* 02: the header carries the volume's notes; a helper left over from an
+ * older build is refused as sending no valid header, not misread. */
+#define VXL_READER_MAGIC "VXLRD02"
 #define VXL_READER_MSG_MAX 1024 /* longest error message a helper may send */
 
 #define VXL_REPLY_VOLUME 1u /* body: the volume's texels */
@@ -63,9 +67,13 @@ typedef struct vxl_reader_header {
     double affine[16];      /* column-major voxel -> world */
     uint64_t nan_count, inf_count, storage_bytes;
     uint64_t nbytes;        /* body bytes that follow */
+    /* vxl_volume.notes (VXL_REPLY_VOLUME): NUL-terminated inside the array,
+     * one line of text; all zero otherwise. The receiver refuses anything
+     * else. A fixed array keeps the stream one header and one body. */
+    char notes[VXL_VOLUME_NOTES_MAX];
 } vxl_reader_header;
 
 /* tests/python/test_vdb_isolation.py packs this layout by hand. */
-_Static_assert(sizeof(vxl_reader_header) == 288, "vxl_reader_header layout changed: update the tests' format");
+_Static_assert(sizeof(vxl_reader_header) == 800, "vxl_reader_header layout changed: update the tests' format");
 
 #endif

@@ -90,6 +90,7 @@ static int volume_from(const vxl_reader_header *h, void *texels, vxl_volume **ou
     memcpy(v->affine, h->affine, sizeof v->affine);
     v->frame_count = h->frame_count;
     v->frame = h->frame;
+    memcpy(v->notes, h->notes, sizeof v->notes); /* terminated: checked on receipt */
     *out = v;
     return VXL_OK;
 }

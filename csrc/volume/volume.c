@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "voxlight_dev.h" /* vxl_volume_add_note */
+
 uint32_t vxl_dtype_size(uint32_t dtype)
 {
     switch (dtype) {
@@ -276,6 +278,8 @@ int vxl_volume_create(const vxl_volume_desc *d, const vxl_load_options *opt, vxl
                             d->scl_slope, d->scl_inter, opt, out, NULL);
 }
 
+_Static_assert(VXL_NOTES_MAX == VXL_VOLUME_NOTES_MAX, "vxl_volume_info.notes holds vxl_volume.notes whole");
+
 int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
 {
     if (!v || !out) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "volume or info is NULL");
@@ -283,6 +287,9 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
      * built against an older, shorter struct is not overrun. */
     const size_t v1 = offsetof(vxl_volume_info, frame_count), s = out->struct_size;
     size_t have = s >= v1 && s < sizeof *out ? s : sizeof *out;
+    /* a struct that ends inside notes would get an unterminated piece */
+    const size_t notes_at = offsetof(vxl_volume_info, notes);
+    if (have > notes_at && have < sizeof *out) have = notes_at;
     vxl_volume_info info, *o = &info;
     memset(o, 0, sizeof *o);
     o->struct_size = (uint32_t)have;
@@ -309,6 +316,7 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
         o->level_count = 1;
         o->resident_bytes = v->storage_bytes;
     }
+    memcpy(o->notes, v->notes, sizeof o->notes);
     memcpy(out, o, have);
     return VXL_OK;
 }
@@ -399,8 +407,22 @@ void vxl_volume_note(vxl_volume *v, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
+    /* one line of text: the notes reach a terminal and Blender's UI, and the
+     * helpers' receiver refuses control characters */
+    for (char *c = line; *c; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = ' ';
     const size_t cap = sizeof v->notes, used = strlen(v->notes);
-    if (used + 4 >= cap) return; /* full: already ends in "..." */
+    if (used + 4 >= cap) { /* full: this note is lost, so the notes end in "..." (may already) */
+        memcpy(v->notes + used - 3, "...", 4);
+        return;
+    }
     int n = snprintf(v->notes + used, cap - used, "%s%s", used ? "; " : "", line);
     if (n < 0 || (size_t)n >= cap - used) memcpy(v->notes + cap - 4, "...", 4);
+}
+
+int vxl_volume_add_note(vxl_volume *v, const char *note)
+{
+    if (!v || !note) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "volume or note is NULL");
+    vxl_volume_note(v, "%s", note);
+    return VXL_OK;
 }

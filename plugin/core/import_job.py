@@ -123,3 +123,19 @@ class ImportJob:
 
     def wait(self, timeout=None):
         return self._done.wait(timeout)
+
+
+def note_lines(notes):
+    """The reader's notes (vxl_volume_info.notes: a sentence per decision,
+    joined by "; ") one per line, for a panel whose labels do not wrap."""
+    return [n.strip() for n in (notes or "").split("; ") if n.strip()]
+
+
+def import_report(name, info, why):
+    """The import's INFO report: what was imported, what it became and why
+    (why), and what the reader decided rather than read (info["notes"]), so
+    no guess the reader made goes unseen."""
+    streamed = ", streamed from disk (%d levels)" % info["level_count"] if info.get("streamed") else ""
+    text = "Voxlight: imported %s (%d x %d x %d, %s%s) %s" % (name, *info["dims"], info["dtype"], streamed, why)
+    notes = info.get("notes", "")
+    return text + (" - reader notes: %s" % notes if notes else "")

@@ -33,6 +33,7 @@ BLENDS = ("over", "add", "max")  # VXL_BLEND_*
 STREAMING_MODES = ("auto", "off", "on")  # VXL_STREAMING_*
 MAX_OVERLAYS = 3  # VXL_MAX_OVERLAYS
 MAX_LABEL_ID = 65535  # VXL_MAX_LABEL_ID
+NOTES_MAX = 512  # VXL_NOTES_MAX: vxl_volume_info.notes, its NUL included
 # The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
 ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "storage": STORAGES,
                   "classify": CLASSIFY_MODES, "gradient_opacity": GRADIENT_OPACITY_MODES,
@@ -123,7 +124,8 @@ class VolumeInfo(ctypes.Structure):
                 ("streamed", ctypes.c_uint32),        # appended (issue 21)
                 ("level_count", ctypes.c_uint32),
                 ("resident_bytes", ctypes.c_uint64),
-                ("bytes_read", ctypes.c_uint64)]
+                ("bytes_read", ctypes.c_uint64),
+                ("notes", ctypes.c_char * NOTES_MAX)]  # appended: what the reader decided
 
 
 class PhantomDesc(ctypes.Structure):

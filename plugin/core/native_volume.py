@@ -170,6 +170,8 @@ class Volume(LibraryObject):
             "level_count": max(1, info.level_count),
             "resident_bytes": info.resident_bytes,
             "bytes_read": info.bytes_read,
+            # what the reader decided rather than read ("PixelSpacing missing: 1 mm assumed"); "" if nothing
+            "notes": info.notes.decode("utf-8", "replace"),
         }
 
     def histogram(self, bins=32, lo=None, hi=None):

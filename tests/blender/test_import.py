@@ -15,6 +15,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "cli"))
 import _util as u  # noqa: E402
 from _util import test  # noqa: E402
+from helper_reply import notes_helper  # noqa: E402
 from test_cli_formats import blob, write_mha, write_nrrd, write_png, write_tiff  # noqa: E402
 from vdb_write import write_vdb  # noqa: E402
 
@@ -106,6 +107,26 @@ def vdb_import_is_in_scene_units():
     u.add_camera((1.35, -3.0, 3.15), target=(1.35, 2.25, 3.15))
     img = vx.render_volume(ob, resolution=(48, 48))
     assert img[..., 3].max() > 0.2 and img[0, 0, 3] < 0.01
+
+
+@test
+def reader_notes_reach_the_object():
+    """What a reader decided rather than read (vxl_volume_info.notes) is kept
+    on the object for the Voxlight panel; a stand-in helper sends them."""
+    u.reset_scene()
+    path = os.path.join(u.TMP, "noted.png")
+    write_png(path, blob((1, 3, 4), np.uint16)[0])
+    notes = "PixelSpacing missing: 1 mm assumed; 2 slices interpolated where slices are missing"
+    os.environ["VOXLIGHT_READ_OIIO"] = notes_helper(u.TMP, notes)
+    try:
+        ob = u.import_volume(path)
+    finally:
+        del os.environ["VOXLIGHT_READ_OIIO"]
+    assert tuple(ob.voxlight.dims) == (4, 3, 2) and ob.voxlight.reader_notes == notes, ob.voxlight.reader_notes
+    assert vx.core.import_job.note_lines(ob.voxlight.reader_notes)[1].startswith("2 slices")
+    path = os.path.join(u.TMP, "plain.nrrd")
+    write_nrrd(path, blob((4, 5, 6), np.int16))
+    assert u.import_volume(path).voxlight.reader_notes == ""
 
 
 @test

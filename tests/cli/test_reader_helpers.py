@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from helper_reply import notes_helper
 from test_cli_dicom4d import write_series
 from test_cli_formats import blob, write_nrrd, write_png
 
@@ -143,6 +144,18 @@ def test_a_crashing_helper_is_an_error(inputs, tmp_path):
     assert "the DICOM reader crashed (signal 6: SIGABRT)" in r.stderr, r.stderr
     loads("stack", inputs, env)
     loads("nrrd", inputs, env)
+
+
+def test_info_prints_what_the_reader_decided(inputs, tmp_path):
+    """vxl_volume.notes cross the helper's pipe and `info` prints them on a
+    notes: line; a volume whose reader decided nothing has none."""
+    notes = "PixelSpacing missing: 1 mm assumed; 2 slices interpolated where slices are missing"
+    r = run("info", inputs["stack"], env={"VOXLIGHT_READ_OIIO": notes_helper(tmp_path, notes)})
+    assert r.returncode == 0, r.stderr
+    assert re.search(r"^notes:\s+%s$" % re.escape(notes), r.stdout, re.M), r.stdout
+    assert "dimensions:  4 x 3 x 2" in r.stdout
+    r = run("info", inputs["nrrd"])
+    assert r.returncode == 0 and "notes:" not in r.stdout, r.stdout
 
 
 def test_a_tiff_whose_strips_claim_gigabytes_is_called_corrupt():

@@ -114,3 +114,37 @@ def test_names_and_filter():
     for pattern in ("*.nii.gz", "*.nhdr", "*.mhd", "*.tiff", "*.png", "*.vdb", "*.dcm", "DICOMDIR"):
         assert pattern in import_job.FILTER_GLOB.split(";")
     assert import_job.is_vdb("/x/Smoke.VDB") and not import_job.is_vdb("/x/a.nii")
+
+
+INFO = {"dims": (4, 3, 2), "dtype": "int16", "streamed": False, "level_count": 1}
+
+
+def test_import_report_names_what_the_reader_decided():
+    notes = "PixelSpacing missing: 1 mm assumed; 2 slices interpolated where slices are missing"
+    text = import_job.import_report("head", dict(INFO, notes=notes), "as an intensity volume")
+    assert text == ("Voxlight: imported head (4 x 3 x 2, int16) as an intensity volume - reader notes: "
+                    "PixelSpacing missing: 1 mm assumed; 2 slices interpolated where slices are missing")
+    assert import_job.note_lines(notes) == ["PixelSpacing missing: 1 mm assumed",
+                                            "2 slices interpolated where slices are missing"]
+
+
+def test_import_report_without_notes_is_unchanged():
+    for info in (INFO, dict(INFO, notes="")):  # an info from an older library has no notes
+        assert import_job.import_report("head", info, "as an intensity volume") == \
+            "Voxlight: imported head (4 x 3 x 2, int16) as an intensity volume"
+    streamed = dict(INFO, streamed=True, level_count=3, notes="cut...")
+    assert import_job.import_report("big", streamed, "as an intensity volume") == \
+        "Voxlight: imported big (4 x 3 x 2, int16, streamed from disk (3 levels)) as an intensity volume" \
+        " - reader notes: cut..."
+    assert import_job.note_lines("") == [] and import_job.note_lines(None) == []
+    assert import_job.note_lines("one;two; ; three") == ["one;two", "three"]
+
+
+def test_a_load_without_decisions_has_empty_notes(ball):
+    job = import_job.ImportJob(ball)
+    assert job.wait(120) and job.error is None
+    entry = job.take()
+    try:
+        assert entry.info["notes"] == ""
+    finally:
+        entry.close()

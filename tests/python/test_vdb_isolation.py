@@ -24,8 +24,9 @@ ABORTS = os.path.join(ROOT, "tests", "fuzz", "upstream", "openvdb_delayed_load_m
 # count, record_size, dims[3], src_dtype, texture_bits, nifti_version,
 # affine_source, frame_count, frame, reserved[2]; tex_lo, tex_hi, value_min,
 # value_max; spacing[3]; affine[16]; nan_count, inf_count, storage_bytes,
-# nbytes
-HEADER = "=8s16I4d3d16d4Q"
+# nbytes; notes[512]
+HEADER = "=8s16I4d3d16d4Q512s"
+HEADER_SIZE = 800
 HELPER_ENV = "VOXLIGHT_READ_OIIO"
 TIMEOUT_ENV = "VOXLIGHT_READER_TIMEOUT"
 VXL_DTYPE_F32 = 7
@@ -83,22 +84,28 @@ def _fake_helper(tmp_path, body):
     return str(p)
 
 
-def _header(status=0, dims=(4, 3, 2), nbytes=None, msg_len=0, magic=b"VXLRD01\0", kind=1, affine=None):
+def _header(status=0, dims=(4, 3, 2), nbytes=None, msg_len=0, magic=b"VXLRD02\0", kind=1, affine=None,
+            notes=b""):
     n = dims[0] * dims[1] * dims[2] * 4 if nbytes is None else nbytes
     a = np.eye(4).T.ravel() if affine is None else affine
     return struct.pack(HEADER, magic, status, msg_len, kind, 0, 0, *dims, VXL_DTYPE_F32, 32, 0, 2, 1, 0, 0, 0,
-                       0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *a, 0, 0, n, n)
+                       0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *a, 0, 0, n, n, notes)
 
 
-assert struct.calcsize(HEADER) == 288
+assert struct.calcsize(HEADER) == HEADER_SIZE
 
 
 @pytest.mark.parametrize("body, needle", [
     # a header that claims 2^30 voxels: refused by the budget before allocating
     ("out.write(%r)" % _header(dims=(1024, 1024, 1024)), r"over the memory budget of 1\.0 MiB"),
-    ("out.write(%r + bytes(10))" % _header(), r"output of the OpenVDB reader was cut short \(298 of 384 bytes\)"),
+    ("out.write(%r + bytes(10))" % _header(), r"output of the OpenVDB reader was cut short \(810 of 896 bytes\)"),
+    # an older helper's header (magic 01, no notes) is refused, not misread
+    ("out.write(%r + bytes(96))" % _header(magic=b"VXLRD01\0"), r"sent no valid header"),
+    # notes: terminated inside their 512 bytes, one line of text
+    ("out.write(%r + bytes(96))" % _header(notes=b"n" * 512), r"sent notes that are not one terminated line"),
+    ("out.write(%r + bytes(96))" % _header(notes=b"two\nlines"), r"sent notes that are not one terminated line"),
     ("out.write(%r)" % _header(nbytes=5), r"announced 5 bytes for 4x3x2 voxels of 32 bits"),
-    ("out.write(b'hello world' * 30)", r"sent no valid header"),
+    ("out.write(b'hello world' * 80)", r"sent no valid header"),
     ("out.write(%r + bytes(96) + b'x')" % _header(), r"more than it announced"),
     ("out.write(%r + bytes(96))" % _header(kind=2), r"reply of kind 2, not 1"),
     ("out.write(%r + bytes(96))" % _header(affine=[float("nan")] * 16), r"transform is not finite"),
@@ -114,6 +121,20 @@ def test_parent_trusts_nothing_the_helper_sends(lib, small_vdb, tmp_path, monkey
     with pytest.raises(native.VoxlightError, match=needle):
         native.Volume.load(small_vdb, memory_budget=1 << 20, lib=lib)
     assert _fds() == fds and _children() == []
+
+
+def test_helper_notes_reach_the_volume_info(lib, small_vdb, tmp_path, monkeypatch):
+    """What a reader decided (vxl_volume.notes) crosses the pipe whole,
+    UTF-8 included, into vxl_volume_info.notes."""
+    notes = "PixelSpacing missing: 1 mm assumed; 2 slices interpolated where slices are missing (\u00b5m)"
+    monkeypatch.setenv(HELPER_ENV, _fake_helper(tmp_path, "out.write(%r + bytes(96))"
+                                                % _header(notes=notes.encode("utf-8"))))
+    with native.Volume.load(small_vdb, lib=lib) as v:
+        assert v.info["notes"] == notes
+    monkeypatch.setenv(HELPER_ENV, _fake_helper(tmp_path, "out.write(%r + bytes(96))" % _header()))
+    with native.Volume.load(small_vdb, lib=lib) as v:
+        assert v.info["notes"] == ""
+    assert _children() == []
 
 
 def test_hung_helper_is_killed(lib, small_vdb, tmp_path, monkeypatch):

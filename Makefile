@@ -28,7 +28,12 @@ CSRC_DIRS := $(filter-out csrc/include,$(patsubst %/,%,$(sort $(dir $(wildcard c
 CSRC_INC := $(addprefix -I,$(CSRC_DIRS))
 vpath %.c $(CSRC_DIRS)
 vpath %.cpp $(CSRC_DIRS)
-CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include $(CSRC_INC) -I$(BUILD)/gen
+# openjpeg.h (Debian's libopenjp2-7-dev) for the types of io/dicom_j2k.c's
+# table: OpenJPEG itself is opened at run time, never linked. After every
+# other folder, as the system's own headers are.
+OPENJPEG_INC := $(patsubst -I%,-idirafter %,$(shell pkg-config --cflags-only-I libopenjp2))
+CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include $(CSRC_INC) -I$(BUILD)/gen \
+	$(OPENJPEG_INC)
 CXXFLAGS := -std=c++17 $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include $(CSRC_INC) $(shell pkg-config --cflags OpenImageIO)
 OIIO_LIBS := $(shell pkg-config --libs OpenImageIO)
 # dcmtk (DICOM, csrc/io/dicom.cpp): Debian 12's dcmtk.pc names sndfile, which is
@@ -42,8 +47,9 @@ DCMTK_LIBS := -ldcmdata -loflog -lofstd
 # voxlight-read-dicom (DICOM). csrc/*/helper_*.c are the helpers' own files.
 OIIO_CXX := csrc/io/image_stack.cpp csrc/io/vdb.cpp
 DICOM_CXX := csrc/io/dicom.cpp
-# the DICOM codecs in our own C (the helper links them; so do their tests)
-DICOM_CODECS := dicom_rle dicom_jpeg_lossless
+# the DICOM codecs in our own C, and JPEG 2000 through OpenJPEG opened at
+# run time (the helper links them; so do their tests and the fuzz build)
+DICOM_CODECS := dicom_rle dicom_jpeg_lossless dicom_j2k
 HELPER_C := $(wildcard csrc/*/helper_*.c)
 # csrc/cli/*.c: the command-line tool's own files, linked into it alone.
 CLI_C := $(wildcard csrc/cli/*.c)
@@ -283,7 +289,7 @@ $(WIN_BUILD)/render_scene.exe: tests/render_scene.c $(WIN_BUILD)/voxlight.dll
 # Windows-only markup), and links only Windows' own gdi32, user32 and shell32.
 WIN_LIB_C := $(filter-out $(CLI_C) $(HELPER_C) %_posix.c %/backend_osmesa.c %/backend_egl.c,$(wildcard csrc/*/*.c))
 WIN_LIB_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) -O2 -g0 -Icsrc/include $(CSRC_INC) -I$(BUILD)/gen \
-	-idirafter /usr/include -idirafter /usr/include/$(shell $(CC) -print-multiarch)
+	-idirafter /usr/include -idirafter /usr/include/$(shell $(CC) -print-multiarch) $(OPENJPEG_INC)
 $(WIN_BUILD)/voxlight.def: $(wildcard csrc/include/*.h)
 	@mkdir -p $(@D)
 	@{ echo 'LIBRARY voxlight.dll'; echo 'EXPORTS'; \
@@ -328,6 +334,12 @@ DICOM_CODECS_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,$(DICOM_CODECS) error $(P
 $(BUILD)/tests/test_dicom_codecs: tests/test_dicom_codecs.c tests/harness.h $(DICOM_CODECS_TEST_OBJ) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(DICOM_CODECS_TEST_OBJ) -o $@ -ldl -lpthread
 
+# test_dicom_j2k checks io/dicom_j2k.c through the system's OpenJPEG on
+# images Debian's opj_compress writes at test time (Linux only: the encoder
+# is a Debian program).
+$(BUILD)/tests/test_dicom_j2k: tests/test_dicom_j2k.c tests/harness.h $(DICOM_CODECS_TEST_OBJ) | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(DICOM_CODECS_TEST_OBJ) -o $@ -ldl -lpthread -lm
+
 # test_crc32 checks the library's internal CRC-32 against zlib's values.
 $(BUILD)/tests/test_crc32: tests/test_crc32.c tests/harness.h $(BUILD)/obj/crc32.o | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(BUILD)/obj/crc32.o -o $@
@@ -348,7 +360,7 @@ $(BUILD)/obj $(BUILD)/gen $(BUILD)/tests:
 FUZZ_BUILD := build/fuzz
 FUZZ_SAN := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include $(CSRC_INC) \
-	-I$(FUZZ_BUILD)/gen
+	-I$(FUZZ_BUILD)/gen $(OPENJPEG_INC)
 FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc/include $(CSRC_INC) \
 	$(shell pkg-config --cflags OpenImageIO)
 # the core's loaders and dispatch (the helper-run readers are called
@@ -358,8 +370,8 @@ FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_u
 # the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
-	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c dicom_rle.c \
-	dicom_jpeg_lossless.c $(PLATFORM:%=%.c))
+	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c \
+	$(DICOM_CODECS:%=%.c) $(PLATFORM:%=%.c))
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))

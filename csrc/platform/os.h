@@ -14,6 +14,11 @@ const char *vxl_os_name(void);
  * beside voxlight.dll. */
 const char *vxl_os_zlib_name(void);
 
+/* The file name under which this OS's OpenJPEG is opened for JPEG 2000
+ * frames (io/dicom_j2k.c): Debian's libopenjp2.so.7 (package libopenjp2-7),
+ * or openjp2.dll, looked for beside voxlight.dll, on Windows. */
+const char *vxl_os_openjpeg_name(void);
+
 /* 1 where the libraries of Debian's packages that some readers link or open
  * (OpenImageIO, dcmtk, libblosc, libzstd) can be present: POSIX systems; 0
  * on Windows, where no build of them is shipped. */

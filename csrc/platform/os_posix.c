@@ -7,6 +7,7 @@
 const char *vxl_os_name(void) { return "posix"; }
 int vxl_os_has_debian_libraries(void) { return 1; }
 const char *vxl_os_zlib_name(void) { return "libz.so.1"; }
+const char *vxl_os_openjpeg_name(void) { return "libopenjp2.so.7"; }
 
 int vxl_os_utf8_args(int *argc, char ***argv)
 {

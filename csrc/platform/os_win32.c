@@ -10,6 +10,7 @@
 const char *vxl_os_name(void) { return "windows"; }
 int vxl_os_has_debian_libraries(void) { return 0; }
 const char *vxl_os_zlib_name(void) { return "zlib1.dll"; }
+const char *vxl_os_openjpeg_name(void) { return "openjp2.dll"; }
 
 int vxl_os_utf8_args(int *argc, char ***argv)
 {

@@ -38,7 +38,7 @@ CXXFLAGS := -std=c++17 $(WARN) $(OPT) -fPIC -fvisibility=hidden -Icsrc/include $
 OIIO_LIBS := $(shell pkg-config --libs OpenImageIO)
 # dcmtk (DICOM, csrc/io/dicom.cpp): Debian 12's dcmtk.pc names sndfile, which is
 # not installed, so the three libraries dcmdata needs are named directly.
-DCMTK_LIBS := -ldcmdata -loflog -lofstd
+DCMTK_LIBS := -ldcmjpeg -ldcmjpls -ldcmdata -loflog -lofstd
 
 # libvoxlight.so is C and links only the C runtime (issue 13): the readers
 # that need OpenImageIO or dcmtk are built into helper processes next to it
@@ -46,7 +46,7 @@ DCMTK_LIBS := -ldcmdata -loflog -lofstd
 # its own formats: voxlight-read-oiio (TIFF/PNG stacks, OpenVDB) and
 # voxlight-read-dicom (DICOM). csrc/*/helper_*.c are the helpers' own files.
 OIIO_CXX := csrc/io/image_stack.cpp csrc/io/vdb.cpp
-DICOM_CXX := csrc/io/dicom.cpp
+DICOM_CXX := $(wildcard csrc/io/dicom*.cpp)
 # the DICOM codecs in our own C, and JPEG 2000 through OpenJPEG opened at
 # run time (the helper links them; so do their tests and the fuzz build)
 DICOM_CODECS := dicom_rle dicom_jpeg_lossless dicom_j2k
@@ -92,7 +92,7 @@ FORCE:
 $(BUILD)/obj/%.o: %.c $(wildcard csrc/*/*.h) $(LIB_CC_STAMP) | $(BUILD)/obj
 	$(LIB_CC) $(CFLAGS) -c $< -o $@
 
-$(BUILD)/obj/%.o: %.cpp $(wildcard csrc/*/*.h) | $(BUILD)/obj
+$(BUILD)/obj/%.o: %.cpp $(wildcard csrc/*/*.h csrc/*/*.hpp) | $(BUILD)/obj
 	$(CXX) $(CXXFLAGS) -c $< -o $@
 
 # Shaders are embedded at build time so an installed library needs no shader path.
@@ -372,7 +372,7 @@ FUZZ_LIB_C := volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_u
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
 	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c \
 	$(DICOM_CODECS:%=%.c) $(PLATFORM:%=%.c))
-FUZZ_LIB_CXX := image_stack.cpp vdb.cpp dicom.cpp
+FUZZ_LIB_CXX := image_stack.cpp vdb.cpp $(notdir $(DICOM_CXX))
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))
 
@@ -383,7 +383,7 @@ $(FUZZ_BUILD)/obj/%.o: %.c $(wildcard csrc/*/*.h) | $(FUZZ_BUILD)/obj
 
 $(FUZZ_BUILD)/obj/remote_readers.o: $(FUZZ_BUILD)/gen/reader_packages.h
 
-$(FUZZ_BUILD)/obj/%.o: %.cpp $(wildcard csrc/*/*.h) | $(FUZZ_BUILD)/obj
+$(FUZZ_BUILD)/obj/%.o: %.cpp $(wildcard csrc/*/*.h csrc/*/*.hpp) | $(FUZZ_BUILD)/obj
 	clang++ $(FUZZ_CXXFLAGS) -c $< -o $@
 
 $(FUZZ_BUILD)/obj/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h csrc/include/voxlight.h csrc/io/helper_main.h | $(FUZZ_BUILD)/obj

@@ -1,9 +1,12 @@
 /* test_dicom.c - DICOM series through the public API (vxl_volume_load,
  * vxl_dicom_list_series): geometry from positions with shuffled files and an
  * oblique orientation, rescale to Hounsfield units, several series, 4D
- * series (time points at every position), RLE and JPEG Lossless against dcmtk's encoders, and the refusals (missing slice,
- * mixed sizes, compressed, multi-frame, truncated,
- * garbage, over budget). Files come from tests/fuzz/dicom_writer.h, written
+ * series (time points at every position), RLE and JPEG Lossless against
+ * dcmtk's encoders, what is loaded with a note (a missing slice
+ * interpolated, a localizer left out, a multi-frame file without spacing)
+ * and the refusals (mixed sizes without a majority, mixed spacing, damaged
+ * frames, truncated, garbage, over budget). Multi-frame and enhanced files
+ * and the other codecs: test_dicom_frames.c. Files come from tests/fuzz/dicom_writer.h, written
  * from the standard independently of dcmtk. Voxel values are read back
  * through the texels (volume.h), so ordering mistakes show as wrong values. */
 #include <dirent.h>
@@ -15,31 +18,16 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "dicom_test_util.h"
 #include "fuzz/dicom_writer.h"
 #include "harness.h"
-#include "loader_test_util.h"
-#include "volume.h"
-#include "voxlight.h"
 
 static char g_dir[64];
 
 /* A fresh folder g_dir/name. */
-static const char *folder(char *buf, size_t n, const char *name)
-{
-    snprintf(buf, n, "%s/%s", g_dir, name);
-    mkdir(buf, 0755);
-    return buf;
-}
+static const char *folder(char *buf, size_t n, const char *name) { return dicom_folder(g_dir, buf, n, name); }
 
-static int contains(const char *s, const char *sub) { return strstr(s, sub) != NULL; }
-
-static vxl_volume *load_series(const char *path, const char *series)
-{
-    vxl_load_options opt = {.struct_size = sizeof opt, .series = series};
-    vxl_volume *v = NULL;
-    if (vxl_volume_load(path, &opt, &v) != VXL_OK) return NULL;
-    return v;
-}
+static vxl_volume *load_series(const char *path, const char *series) { return load_dicom(path, series, 0); }
 
 #define NC 4 /* columns */
 #define NR 3 /* rows */
@@ -248,25 +236,36 @@ TEST(several_series_are_listed_and_one_is_chosen_by_index_or_uid)
     CHECK(!strcmp(small[0].uid, "1.2.3.40"));
 }
 
-TEST(missing_slice_is_refused_naming_the_gap)
+TEST(missing_slice_is_interpolated_with_a_note)
 {
     char dir[256];
     folder(dir, sizeof dir, "gap");
     const double zs[] = {0, 2, 4, 8, 10};
-    uint16_t px[NC * NR] = {0};
+    uint16_t px[NC * NR];
     for (int k = 0; k < 5; k++) {
+        for (int i = 0; i < NC * NR; i++) px[i] = (uint16_t)(100 * k + i);
         dcmw_slice d = dcmw_axial("1.2.3.50", NC, NR, zs[k], px, sizeof px);
         char p[512];
         snprintf(p, sizeof p, "%s/%d.dcm", dir, k);
         REQUIRE(dcmw_write(p, &d) == 0);
     }
-    CHECK(load_series(dir, NULL) == NULL);
-    CHECKF(contains(vxl_last_error(), "missing slice") && contains(vxl_last_error(), "4 mm") &&
-           contains(vxl_last_error(), "2 mm"), "%s", vxl_last_error());
+    /* six slices every 2 mm; the one at z = 6 is the mean of its neighbours,
+     * the others are the files' own */
+    vxl_volume *v = load_series(dir, NULL);
+    REQUIRE(v);
+    vxl_volume_info info;
+    const char *notes = volume_notes(v, &info);
+    CHECK(v->dims[2] == 6 && fabs(v->spacing[2] - 2) < 1e-9 && fabs(v->affine[14]) < 1e-9);
+    const double expect[6] = {0, 100, 200, 250, 300, 400};
+    for (int k = 0; k < 6; k++)
+        for (int i = 0; i < NC * NR; i++)
+            CHECKF(fabs(voxel(v, (uint64_t)(k * NC * NR + i)) - (expect[k] + i)) < 1e-6, "slice %d voxel %d", k, i);
+    CHECKF(contains(notes, "uneven slice spacing") && contains(notes, "4 mm") && contains(notes, "2 mm") &&
+           contains(notes, "1 of them interpolated"), "%s", notes);
+    vxl_volume_destroy(v);
     vxl_dicom_series s = {.struct_size = sizeof s};
     uint32_t n = 0;
-    CHECK(vxl_dicom_list_series(dir, &s, 1, &n) == VXL_OK && n == 1 && !s.loadable &&
-          contains(s.problem, "missing slice"));
+    CHECK(vxl_dicom_list_series(dir, &s, 1, &n) == VXL_OK && n == 1 && s.loadable && s.dims[2] == 6);
 
     /* two slices at one position (4D acquisitions) */
     folder(dir, sizeof dir, "dup");
@@ -350,18 +349,35 @@ TEST(gantry_tilt_loads_with_a_sheared_affine_and_is_reported)
     CHECK(s.loadable && s.gantry_tilt_deg == 0);
 }
 
-TEST(mixed_sizes_compressed_and_multiframe_are_clear_errors)
+/* A series with a stray image (a localizer of another size) keeps the
+ * majority and says what it left out; equal numbers are refused; other
+ * mismatches, a damaged JPEG frame and a classic multi-frame file without
+ * spacing are handled as the notes and errors say. */
+TEST(localizers_mixed_sizes_damaged_jpeg_and_classic_multiframe)
 {
     char dir[256], p[512];
     uint16_t px[NC * NR * 2] = {0};
+    vxl_volume_info info;
     folder(dir, sizeof dir, "mixed");
     for (int k = 0; k < 3; k++) {
         dcmw_slice d = dcmw_axial("1.2.3.70", NC, k == 1 ? NR + 1 : NR, 2.0 * k, px, NC * (k == 1 ? NR + 1 : NR) * 2);
         snprintf(p, sizeof p, "%s/%d.dcm", dir, k);
         REQUIRE(dcmw_write(p, &d) == 0);
     }
+    vxl_volume *v = load_series(dir, NULL);
+    CHECKF(v && v->dims[2] == 2 && fabs(v->spacing[2] - 4) < 1e-9, "%s", v ? "wrong size" : vxl_last_error());
+    const char *notes = v ? volume_notes(v, &info) : "";
+    CHECKF(contains(notes, "left out 1 image") && contains(notes, "'1.dcm' (4x4)"), "%s", notes);
+    vxl_volume_destroy(v);
+
+    folder(dir, sizeof dir, "tie");
+    for (int k = 0; k < 4; k++) {
+        dcmw_slice d = dcmw_axial("1.2.3.74", NC, k % 2 ? NR + 1 : NR, 2.0 * k, px, NC * (k % 2 ? NR + 1 : NR) * 2);
+        snprintf(p, sizeof p, "%s/%d.dcm", dir, k);
+        REQUIRE(dcmw_write(p, &d) == 0);
+    }
     CHECK(load_series(dir, NULL) == NULL);
-    CHECKF(contains(vxl_last_error(), "mixed image sizes") && contains(vxl_last_error(), "4x3") &&
+    CHECKF(contains(vxl_last_error(), "no majority") && contains(vxl_last_error(), "4x3") &&
            contains(vxl_last_error(), "4x4"), "%s", vxl_last_error());
 
     folder(dir, sizeof dir, "spacing");
@@ -373,21 +389,29 @@ TEST(mixed_sizes_compressed_and_multiframe_are_clear_errors)
     }
     CHECKF(load_series(dir, NULL) == NULL && contains(vxl_last_error(), "mixed PixelSpacing"), "%s", vxl_last_error());
 
+    /* 17 bytes that are not a JPEG stream: dcmtk's decoder refuses them */
     folder(dir, sizeof dir, "jpeg");
     dcmw_slice d = dcmw_axial("1.2.3.71", NC, NR, 0, px, 17);
     d.transfer_syntax = DCMW_JPEG_BASELINE;
     snprintf(p, sizeof p, "%s/j.dcm", dir);
     REQUIRE(dcmw_write(p, &d) == 0);
     CHECK(load_series(p, NULL) == NULL);
-    CHECKF(contains(vxl_last_error(), "compressed transfer syntax") && contains(vxl_last_error(), "JPEG"), "%s",
+    CHECKF(contains(vxl_last_error(), "j.dcm") && contains(vxl_last_error(), "JPEG Baseline"), "%s",
            vxl_last_error());
 
+    /* two frames, one position, no spacing: stacked 1 mm apart, with a note */
     folder(dir, sizeof dir, "multiframe");
+    for (int i = 0; i < NC * NR * 2; i++) px[i] = (uint16_t)i;
     d = dcmw_axial("1.2.3.72", NC, NR, 0, px, sizeof px);
     d.frames = 2;
     snprintf(p, sizeof p, "%s/m.dcm", dir);
     REQUIRE(dcmw_write(p, &d) == 0);
-    CHECK(load_series(p, NULL) == NULL && contains(vxl_last_error(), "multi-frame"));
+    v = load_series(p, NULL);
+    CHECKF(v && v->dims[2] == 2 && fabs(v->spacing[2] - 1) < 1e-9 && fabs(voxel(v, NC * NR) - NC * NR) < 1e-6, "%s",
+           v ? "wrong volume" : vxl_last_error());
+    notes = v ? volume_notes(v, &info) : "";
+    CHECKF(contains(notes, "2 frames stacked along the normal every 1 mm (assumed"), "%s", notes);
+    vxl_volume_destroy(v);
 }
 
 TEST(truncated_garbage_and_oversized_files_are_refused)
@@ -512,15 +536,6 @@ static int compress_series(const char *src, const char *name, const char *tool, 
     return 0;
 }
 
-/* a and b hold the same voxels (same size, range and texels). */
-static int same_volume(const vxl_volume *a, const vxl_volume *b)
-{
-    const size_t bytes = (size_t)a->dims[0] * a->dims[1] * a->dims[2] * (a->texture_bits / 8);
-    return !memcmp(a->dims, b->dims, sizeof a->dims) && a->texture_bits == b->texture_bits &&
-           a->value_min == b->value_min && a->value_max == b->value_max && a->texels && b->texels &&
-           !memcmp(a->texels, b->texels, bytes);
-}
-
 /* The same series in RLE Lossless and in JPEG Lossless (SV1, every other
  * predictor, a frame split over several fragments), as dcmtk's own
  * encoders write them, reads voxel for voxel as the uncompressed files:
@@ -612,10 +627,10 @@ int main(void)
     RUN(rescale_slope_intercept_gives_hounsfield_units);
     RUN(signed_8_bit_and_bits_stored_below_bits_allocated);
     RUN(several_series_are_listed_and_one_is_chosen_by_index_or_uid);
-    RUN(missing_slice_is_refused_naming_the_gap);
+    RUN(missing_slice_is_interpolated_with_a_note);
     RUN(time_points_at_every_position_make_a_4d_series);
     RUN(gantry_tilt_loads_with_a_sheared_affine_and_is_reported);
-    RUN(mixed_sizes_compressed_and_multiframe_are_clear_errors);
+    RUN(localizers_mixed_sizes_damaged_jpeg_and_classic_multiframe);
     RUN(truncated_garbage_and_oversized_files_are_refused);
     RUN(dispatch_finds_dicom_folders_files_and_dicomdir);
     RUN(lossless_compressed_series_read_as_the_uncompressed_one);

@@ -270,8 +270,9 @@ VXL_API void vxl_volume_destroy(vxl_volume *vol);
  * or one file of the series; see vxl_load_options.series). */
 typedef struct vxl_dicom_series {
     uint32_t struct_size;
-    uint32_t slice_count;       /* files (single-frame images) in the series */
-    uint32_t dims[3];           /* columns, rows, positions (the first file's size) */
+    uint32_t slice_count;       /* images in the series (a multi-frame file counts its frames) */
+    uint32_t dims[3];           /* columns, rows, slices the volume will have (positions, or the
+                                   even grid an uneven series is resampled to) */
     uint32_t loadable;          /* 1: passes every check made before pixels are read */
     uint32_t frame_count;       /* time points (4D: as many files at every position) */
     double gantry_tilt_deg;     /* angle between the slice normal and the stacking

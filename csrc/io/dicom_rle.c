@@ -37,7 +37,7 @@ static int unpack_bits(const uint8_t *seg, size_t n, uint8_t *out, size_t want)
 int vxl_dicom_rle_decode(const uint8_t *frame, size_t n, uint32_t rows, uint32_t cols, uint32_t bytes_per_pixel,
                          void *dst, vxl_err *e)
 {
-    if (bytes_per_pixel != 1 && bytes_per_pixel != 2)
+    if (bytes_per_pixel != 1 && bytes_per_pixel != 2 && bytes_per_pixel != 4)
         return vxl_fail(e, VXL_ERR_FORMAT, "RLE of %u-byte pixels is not supported", bytes_per_pixel);
     if (n < HEADER_BYTES)
         return vxl_fail(e, VXL_ERR_FORMAT, "RLE frame of %zu bytes is shorter than its %d-byte header", n,
@@ -63,13 +63,15 @@ int vxl_dicom_rle_decode(const uint8_t *frame, size_t n, uint32_t rows, uint32_t
             break;
         }
         /* segment 0 holds the most significant byte */
+        const unsigned shift = 8u * (bytes_per_pixel - 1 - s);
         if (bytes_per_pixel == 1) {
             memcpy(dst, plane, pixels);
-        } else {
+        } else if (bytes_per_pixel == 2) {
             uint16_t *d = dst;
-            const unsigned shift = s == 0 ? 8u : 0u;
-            for (size_t i = 0; i < pixels; i++)
-                d[i] = (uint16_t)(s == 0 ? (unsigned)plane[i] << shift : (unsigned)(d[i] | plane[i]));
+            for (size_t i = 0; i < pixels; i++) d[i] = (uint16_t)((s ? d[i] : 0u) | (unsigned)plane[i] << shift);
+        } else {
+            uint32_t *d = dst;
+            for (size_t i = 0; i < pixels; i++) d[i] = (s ? d[i] : 0u) | (uint32_t)plane[i] << shift;
         }
     }
     free(plane);

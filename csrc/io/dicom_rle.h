@@ -13,7 +13,7 @@
 #include "voxlight.h"
 
 /* Decodes one frame of rows x cols single-sample pixels of bytes_per_pixel
- * (1 or 2) from the frame's fragments joined (frame[0..n)) into dst, native
+ * (1, 2 or 4) from the frame's fragments joined (frame[0..n)) into dst, native
  * byte order. VXL_OK, or a vxl_fail with the reason (VXL_ERR_FORMAT: the
  * frame is corrupt or cut short; every offset and run is checked against n
  * and the frame's size). */

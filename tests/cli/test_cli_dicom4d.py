@@ -63,14 +63,18 @@ def test_info_lists_series_and_render_needs_a_choice(tmp_path):
     assert r.returncode == 1 and "no series '5'" in r.stderr
 
 
-def test_missing_slice_is_one_clear_error(tmp_path):
+def test_missing_slice_is_interpolated_and_info_says_so(tmp_path):
     d = tmp_path / "gap"
     write_series(d, "1.2.840.99.3", "CT")
     (d / "1.2.840.99.3_005.dcm").unlink()
     r = run("info", d)
-    assert "NOT LOADABLE" in r.stdout and "missing slice" in r.stdout
-    r = run("render", d, "-o", tmp_path / "x.png")
-    assert r.returncode == 1 and "missing slice" in r.stderr and "3 mm" in r.stderr
+    assert r.returncode == 0, r.stderr
+    assert "dimensions:  12 x 12 x 12" in r.stdout  # the even grid keeps every position
+    notes = [line for line in r.stdout.splitlines() if line.startswith("notes:")]
+    assert len(notes) == 1 and "uneven slice spacing (a missing slice?): 3 mm" in notes[0], r.stdout
+    assert "1.5 mm" in notes[0] and "1 of them interpolated" in notes[0]
+    r = run("render", d, "-o", tmp_path / "x.png", "--size", "32x32")
+    assert r.returncode == 0, r.stderr
 
 
 def write_4d(path, frames=6, n=10):

@@ -77,6 +77,7 @@ if [ $replay_only -eq 0 ]; then
     /usr/bin/python3 tests/fuzz/vdb_seeds.py build/fuzz/seeds/vdb || { echo "fuzz: vdb seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
     /usr/bin/python3 tests/fuzz/zarr_seeds.py build/fuzz/seeds/zarr || { echo "fuzz: zarr seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
     /usr/bin/python3 tests/fuzz/jpeg_seeds.py build/fuzz/seeds/dicom_codecs || { echo "fuzz: jpeg seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
+    /usr/bin/python3 tests/fuzz/dicom_seeds.py build/fuzz/seeds/dicom || { echo "fuzz: dicom seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
     # brick caches of .nii.gz files, written by the cache's own test (the format's one writer)
     rm -rf build/fuzz/seeds/brick_cache
     { make -s -j"$(nproc)" build/tests/test_brick_cache && build/tests/test_brick_cache --write-seeds build/fuzz/seeds/brick_cache; } ||

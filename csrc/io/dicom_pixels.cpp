@@ -1,0 +1,282 @@
+// dicom_pixels.cpp - one DICOM file's frames as grey pixels. A file is read
+// once whatever number of its frames are wanted (a multi-frame file of 1000
+// frames is one read, not 1000).
+//
+// Who decodes what (docs/dicom.md gives the reasons):
+//   uncompressed (implicit/explicit little endian, explicit big endian,
+//     deflated): dcmtk's parser hands the values over in native order;
+//   RLE Lossless, JPEG Lossless process 14 and SV1: our C (dicom_rle.c,
+//     dicom_jpeg_lossless.c), given each frame's fragments joined;
+//   JPEG 2000 (lossless and lossy): OpenJPEG, opened on the first frame
+//     (dicom_j2k.c), given the same;
+//   JPEG Baseline and Extended, JPEG-LS lossless and near-lossless: dcmtk's
+//     own codecs (dcmjpeg on IJG, dcmjpls on CharLS), registered once.
+#include "dicom_series.hpp"
+
+#include <dcmtk/dcmdata/dcpixseq.h>
+#include <dcmtk/dcmdata/dcpxitem.h>
+#include <dcmtk/dcmjpeg/djdecode.h>
+#include <dcmtk/dcmjpls/djdecode.h>
+
+#include <algorithm>
+#include <cstring>
+#include <mutex>
+#include <type_traits>
+
+extern "C" {
+#include "dicom_j2k.h"
+#include "dicom_jpeg_lossless.h"
+#include "dicom_rle.h"
+#include "error.h"
+}
+
+namespace vxl_dicom {
+
+namespace {
+
+constexpr Uint32 kHeaderReadLength = 4096; // PixelData stays on disk until a frame is read
+
+enum class Codec { native, rle, jpeg_lossless, j2k, dcmtk, none };
+
+Codec codec_of(const Image &im)
+{
+    if (!im.encapsulated) return Codec::native;
+    if (im.xs == EXS_RLELossless) return Codec::rle;
+    if (im.xs == EXS_JPEGProcess14 || im.xs == EXS_JPEGProcess14SV1) return Codec::jpeg_lossless;
+    if (im.xs == EXS_JPEG2000LosslessOnly || im.xs == EXS_JPEG2000) return Codec::j2k;
+    if (im.xs == EXS_JPEGProcess1 || im.xs == EXS_JPEGProcess2_4 || im.xs == EXS_JPEGLSLossless ||
+        im.xs == EXS_JPEGLSLossy)
+        return Codec::dcmtk;
+    return Codec::none;
+}
+
+// Stored value of pixel i as a signed or unsigned integer of bits_stored.
+template <typename T> void unpack(const T *src, size_t n, unsigned bits, bool is_signed, T *dst)
+{
+    using U = typename std::make_unsigned<T>::type;
+    const unsigned width = sizeof(T) * 8;
+    const U mask = bits >= width ? U(~U(0)) : U((U(1) << bits) - 1);
+    for (size_t i = 0; i < n; i++) {
+        U u = U(U(src[i]) & mask);
+        if (is_signed && bits < width && (u >> (bits - 1)) & 1u) u = U(u | U(~mask)); // sign-extend
+        dst[i] = T(u);
+    }
+}
+
+void unpack_frame(const Image &s, const void *src, size_t n, void *dst)
+{
+    const bool sgn = s.pixel_rep == 1;
+    if (s.bits_alloc == 8) {
+        if (sgn) unpack(static_cast<const int8_t *>(src), n, s.bits_stored, true, static_cast<int8_t *>(dst));
+        else unpack(static_cast<const uint8_t *>(src), n, s.bits_stored, false, static_cast<uint8_t *>(dst));
+    } else if (s.bits_alloc == 32) {
+        if (sgn) unpack(static_cast<const int32_t *>(src), n, s.bits_stored, true, static_cast<int32_t *>(dst));
+        else unpack(static_cast<const uint32_t *>(src), n, s.bits_stored, false, static_cast<uint32_t *>(dst));
+    } else {
+        if (sgn) unpack(static_cast<const int16_t *>(src), n, s.bits_stored, true, static_cast<int16_t *>(dst));
+        else unpack(static_cast<const uint16_t *>(src), n, s.bits_stored, false, static_cast<uint16_t *>(dst));
+    }
+}
+
+// The fragments of an encapsulated PixelData (items after the basic offset
+// table), with their byte offsets as the table counts them.
+struct Fragments {
+    std::vector<std::pair<const uint8_t *, size_t>> items;
+    std::vector<uint64_t> at;  // offset of each item's tag from the first fragment's
+    std::vector<uint32_t> bot; // the basic offset table (empty when the encoder left it empty)
+};
+
+int fragments_of(const Image &s, DcmElement *el, Fragments &fr, vxl_err *e)
+{
+    const char *p = s.path.c_str();
+    DcmPixelSequence *seq = nullptr;
+    if (el->ident() != EVR_PixelData ||
+        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(s.xs, nullptr, seq).bad() || !seq ||
+        seq->card() < 1)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': compressed PixelData holds no fragments", p);
+    uint64_t at = 0;
+    for (unsigned long i = 0; i < seq->card(); i++) {
+        DcmPixelItem *item = nullptr;
+        Uint8 *b = nullptr;
+        if (seq->getItem(item, i).bad() || !item || (item->getLength() && (item->getUint8Array(b).bad() || !b)))
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read compressed item %lu", p, i);
+        const size_t len = item->getLength();
+        if (i == 0) {
+            if (len % 4) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': basic offset table of %zu bytes", p, len);
+            for (size_t k = 0; k < len; k += 4)
+                fr.bot.push_back(uint32_t(b[k]) | uint32_t(b[k + 1]) << 8 | uint32_t(b[k + 2]) << 16 |
+                                 uint32_t(b[k + 3]) << 24);
+            continue;
+        }
+        fr.items.emplace_back(b, len);
+        fr.at.push_back(at);
+        at += 8 + len; // item tag and length, then the value
+    }
+    if (fr.items.empty()) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': compressed PixelData holds no fragments", p);
+    return VXL_OK;
+}
+
+// Frame f's fragments joined (PS3.5 A.4): by the basic offset table when it
+// has one; else one fragment per frame when the counts agree; else, for
+// JPEG, a frame starts at each fragment that opens with an SOI marker.
+int frame_bytes(const Image &s, const Fragments &fr, unsigned f, std::vector<uint8_t> &out, vxl_err *e)
+{
+    const char *p = s.path.c_str();
+    const size_t n = fr.items.size(), frames = size_t(s.file_frames);
+    size_t first = 0, end = n;
+    if (frames == 1) {
+        // every fragment
+    } else if (!fr.bot.empty()) {
+        if (fr.bot.size() != frames)
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': basic offset table has %zu entries for %zu frames", p,
+                            fr.bot.size(), frames);
+        const uint64_t lo = fr.bot[f], hi = f + 1 < frames ? fr.bot[f + 1] : UINT64_MAX;
+        first = n;
+        for (size_t i = 0; i < n; i++) if (fr.at[i] == lo) { first = i; break; }
+        if (first == n || !(hi > lo))
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': basic offset table entry %u (%llu) is not at a fragment", p, f,
+                            (unsigned long long)lo);
+        end = first + 1;
+        while (end < n && fr.at[end] < hi) end++;
+    } else if (n == frames) {
+        first = f;
+        end = f + 1;
+    } else if (s.xs != EXS_RLELossless) {
+        size_t seen = 0;
+        first = n;
+        for (size_t i = 0; i < n; i++) {
+            const bool soi = fr.items[i].second >= 2 && fr.items[i].first[0] == 0xFF && fr.items[i].first[1] == 0xD8;
+            if (!soi) continue;
+            if (seen == f) first = i;
+            else if (seen == size_t(f) + 1) { end = i; break; }
+            seen++;
+        }
+        if (first == n)
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': frame %u of %zu not found among %zu fragments", p, f + 1,
+                            frames, n);
+    } else {
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': %zu RLE fragments for %zu frames (one per frame is required)", p,
+                        n, frames);
+    }
+    out.clear();
+    for (size_t i = first; i < end; i++) out.insert(out.end(), fr.items[i].first, fr.items[i].first + fr.items[i].second);
+    return VXL_OK;
+}
+
+// 32-bit values of uncompressed PixelData in native order. dcmtk holds the
+// OW element as 16-bit words already in native order, so on a little-endian
+// host a big-endian file's values have their two halves swapped; they are
+// swapped back in place.
+OFCondition native_32(DcmElement *el, const Image &s, const void *&all)
+{
+    Uint16 *w = nullptr;
+    OFCondition c = el->getUint16Array(w);
+    all = w;
+    if (c.bad() || !w || s.xs != EXS_BigEndianExplicit || gLocalByteOrder != EBO_LittleEndian) return c;
+    const size_t words = size_t(s.rows) * s.cols * 2 * size_t(s.file_frames);
+    for (size_t i = 0; i + 1 < words; i += 2) std::swap(w[i], w[i + 1]);
+    return c;
+}
+
+} // namespace
+
+void prepare_decoders()
+{
+    static std::once_flag once;
+    std::call_once(once, [] {
+        DJDecoderRegistration::registerCodecs();
+        DJLSDecoderRegistration::registerCodecs();
+    });
+}
+
+std::string decodable(const Image &im)
+{
+    if (codec_of(im) != Codec::none) return "";
+    return format("'%s': compressed transfer syntax '%s' is not supported (decompress first, e.g. gdcmconv --raw)",
+                  im.path.c_str(), im.xfer.c_str());
+}
+
+int read_frames(const std::vector<const Image *> &which, const std::vector<void *> &dst, vxl_err *e)
+{
+    const Image &s = *which[0];
+    const char *p = s.path.c_str();
+    const Codec codec = codec_of(s);
+    if (codec == Codec::dcmtk) prepare_decoders(); // a no-op after load_series' call
+    DcmFileFormat ff;
+    OFCondition c = ff.loadFile(p, EXS_Unknown, EGL_noChange, kHeaderReadLength, ERM_autoDetect);
+    if (c.bad()) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read: %s", p, c.text());
+    DcmDataset *ds = ff.getDataset();
+    DcmElement *el = nullptr;
+    if (ds->findAndGetElement(DCM_PixelData, el).bad() || !el)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': no PixelData", p);
+    const size_t n = size_t(s.rows) * s.cols, bytes = n * (s.bits_alloc / 8);
+    std::vector<uint8_t> raw, joined;
+    Fragments fr;
+    if (codec == Codec::rle || codec == Codec::jpeg_lossless || codec == Codec::j2k) {
+        int rc = fragments_of(s, el, fr, e);
+        if (rc) return rc;
+    }
+    const void *all = nullptr;
+    if (codec == Codec::native) {
+        const size_t need = bytes * size_t(s.file_frames);
+        if (el->getLength() < need)
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': truncated PixelData: %zu bytes for %ld frame(s) of %ux%u "
+                            "pixels of %u bits, got %lu", p, need, s.file_frames, s.cols, s.rows, s.bits_alloc,
+                            (unsigned long)el->getLength());
+        if (s.bits_alloc == 8) {
+            Uint8 *b = nullptr;
+            c = el->getUint8Array(b);
+            all = b;
+        } else if (s.bits_alloc == 32) {
+            c = native_32(el, s, all);
+        } else {
+            Uint16 *b = nullptr;
+            c = el->getUint16Array(b);
+            all = b;
+        }
+        if (c.bad() || !all) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read PixelData: %s", p, c.text());
+    }
+    // in frame order, so that dcmtk's codecs resume their fragment walk
+    // from the previous frame instead of starting over
+    std::vector<size_t> order(which.size());
+    for (size_t i = 0; i < order.size(); i++) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return which[a]->frame < which[b]->frame; });
+    Uint32 start_fragment = 0;
+    unsigned previous = 0;
+    for (size_t i : order) {
+        const unsigned f = which[i]->frame;
+        if (codec == Codec::native) {
+            unpack_frame(s, static_cast<const uint8_t *>(all) + size_t(f) * bytes, n, dst[i]);
+            continue;
+        }
+        raw.resize(bytes);
+        if (codec == Codec::dcmtk) {
+            OFString colour;
+            if (f == 0 || f != previous + 1) start_fragment = 0; // 0: the codec finds the frame itself
+            previous = f;
+            c = static_cast<DcmPixelData *>(el)->getUncompressedFrame(ds, f, start_fragment, raw.data(),
+                                                                      Uint32(bytes), colour);
+            if (c.bad())
+                return vxl_fail(e, VXL_ERR_FORMAT, "'%s': frame %u: %s decoder: %s", p, f + 1, s.xfer.c_str(),
+                                c.text());
+        } else {
+            int rc = frame_bytes(s, fr, f, joined, e);
+            if (rc) return rc;
+            vxl_err codec_err = {};
+            const uint8_t *b = joined.data();
+            const size_t len = joined.size();
+            const unsigned bytes_per = s.bits_alloc / 8;
+            if (codec == Codec::rle) rc = vxl_dicom_rle_decode(b, len, s.rows, s.cols, bytes_per, raw.data(), &codec_err);
+            else if (codec == Codec::j2k) rc = vxl_j2k_decode(b, len, s.rows, s.cols, bytes_per, 1, raw.data(), &codec_err);
+            else rc = vxl_jpeg_lossless_decode(b, len, s.rows, s.cols, bytes_per, raw.data(), &codec_err);
+            if (rc) {
+                if (s.file_frames > 1) return vxl_fail(e, rc, "'%s': frame %u: %s", p, f + 1, codec_err.msg);
+                return vxl_fail(e, rc, "'%s': %s", p, codec_err.msg);
+            }
+        }
+        unpack_frame(s, raw.data(), n, dst[i]);
+    }
+    return VXL_OK;
+}
+
+} // namespace vxl_dicom

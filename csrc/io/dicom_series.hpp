@@ -1,0 +1,90 @@
+// dicom_series.hpp - what the DICOM reader's rooms share: one image (a
+// file's frame) as its header describes it, a series of them, and the few
+// string helpers every room uses. The rooms, in pipeline order:
+//   dicom_header.cpp  one file's header -> one Image per frame (single-frame
+//                     files, classic multi-frame, enhanced functional groups)
+//   dicom_geometry.cpp a series' images -> their order, time points, affine
+//                     and the resampling plan for uneven spacing
+//   dicom_pixels.cpp  one file's frames -> pixels (dcmtk for the uncompressed
+//                     and the codecs it has, our C for RLE and lossless JPEG)
+//   dicom.cpp         folder scan, series choice, the parallel load
+// Only the helper process voxlight-read-dicom runs these: libvoxlight links
+// no C++.
+#ifndef VXL_DICOM_SERIES_HPP
+#define VXL_DICOM_SERIES_HPP
+
+#include <dcmtk/config/osconfig.h>
+#include <dcmtk/dcmdata/dctk.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+extern "C" {
+#include "error.h"
+}
+
+namespace vxl_dicom {
+
+// One 2D image: frame `frame` (0-based) of the file at `path`.
+struct Image {
+    std::string path, uid, modality, description, photometric;
+    unsigned frame = 0;
+    long file_frames = 1; // NumberOfFrames of the file
+    unsigned rows = 0, cols = 0, bits_alloc = 0, bits_stored = 0, pixel_rep = 0, samples = 1;
+    bool has_ipp = false, has_iop = false, has_spacing = false, encapsulated = false;
+    E_TransferSyntax xs = EXS_Unknown;
+    std::string xfer; // the transfer syntax's name, for messages
+    double ipp[3] = {0, 0, 0}, iop[6] = {1, 0, 0, 0, 1, 0}, ps[2] = {1, 1};
+    double slope = 1, inter = 0, thickness = 0, between = 0; // SliceThickness, SpacingBetweenSlices
+    double tkey = 0;       // time order (TemporalPosition*, TriggerTime, AcquisitionNumber, InstanceNumber)
+    double instance = 0;   // InstanceNumber: the order of last resort
+    std::string geometry;  // how a classic multi-frame's frame positions were found ("" = from its own header)
+    double dist = 0;       // position along the slice normal (geometry room)
+};
+
+// One output slice: a blend of two input positions (b == a when exact).
+struct Sample {
+    size_t a = 0, b = 0;
+    double t = 0; // weight of b
+};
+
+struct Series {
+    std::vector<Image> images; // after analyse(): sorted by position, then time; image t of position k is
+                               // images[k * frames + t]
+    size_t frames = 1;         // time points (4D: several images at every position)
+    std::vector<Sample> plan;  // the output slices, from positions (plan.size() slices)
+    double tilt_deg = 0;
+    double affine[16] = {0};
+    double spacing[3] = {1, 1, 1};
+    std::vector<std::string> notes; // decisions the user must hear about (vxl_volume.notes)
+    std::string problem;            // empty when loadable
+};
+
+std::string format(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+std::string basename_of(const std::string &p);
+std::string dirname_of(const std::string &p);
+
+enum class Parse { ok, not_dicom, bad };
+// A file's images (one per frame). not_dicom: no SeriesInstanceUID/Rows/
+// Columns (a README in the folder); bad: claims to be DICOM but cannot be
+// parsed, which is an error rather than a silently missing slice.
+Parse read_header(const std::string &path, std::vector<Image> &out, std::string &why);
+
+// Sorts and checks a series, derives its geometry and plan; sets
+// s.problem when it cannot become one volume.
+void analyse(Series &s);
+
+// Registers the decoders dcmtk keeps in a process-wide list: once, before
+// any thread reads, as dcmtk asks.
+void prepare_decoders();
+// Whether the pixels of this image can be decoded here; "" or the reason.
+std::string decodable(const Image &im);
+// Reads the frames `which` of one file (all images share the path), each
+// into dst[i] (rows*cols values of bits_alloc, native byte order, masked to
+// BitsStored and sign-extended). VXL_OK or a vxl_fail naming the file.
+int read_frames(const std::vector<const Image *> &which, const std::vector<void *> &dst, vxl_err *e);
+
+} // namespace vxl_dicom
+
+#endif

@@ -1,0 +1,109 @@
+"""Writes one Enhanced CT file (multi-frame, functional groups) with pydicom,
+a writer independent of the dcmtk we read with and of our C test writer.
+
+usage: make_enhanced_dicom.py OUT COLS ROWS SLICES TIMES IOP(6) ORIGIN(3) STEP(3) SEED [j2k]
+
+Frame (k, t): slice k at ORIGIN + k * STEP, time point t; pixel (i, j) holds
+1000 t + 100 k + 10 j + i, as tests/test_dicom_frames.c's single-frame copy
+does. The frames are stored in an order shuffled by SEED, each with its own
+Plane Position and Frame Content (TemporalPositionIndex t + 1 when TIMES > 1);
+orientation, pixel measures and the rescale are in the shared groups.
+With j2k, each frame is a JPEG 2000 codestream from Debian's opj_compress
+(lossless, 2 resolution levels: the frames are small), encapsulated with a basic offset table (transfer syntax
+1.2.840.10008.1.2.4.90): an encoder independent of our decoder.
+"""
+
+import os
+import random
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import pydicom
+from pydicom.dataset import Dataset, FileMetaDataset
+from pydicom.sequence import Sequence
+from pydicom.uid import ExplicitVRLittleEndian, generate_uid
+
+
+def item(**kw):
+    d = Dataset()
+    for k, v in kw.items():
+        setattr(d, k, v)
+    return d
+
+
+def j2k_frame(pixels):
+    """One frame through opj_compress (16-bit PGM in, lossless J2K out)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        pgm, j2k = os.path.join(tmp, "f.pgm"), os.path.join(tmp, "f.j2k")
+        rows, cols = pixels.shape
+        with open(pgm, "wb") as f:
+            f.write(b"P5\n%d %d\n65535\n" % (cols, rows) + pixels.astype(">u2").tobytes())
+        subprocess.run(["opj_compress", "-i", pgm, "-o", j2k, "-n", "2"], check=True, capture_output=True)
+        with open(j2k, "rb") as f:
+            return f.read()
+
+
+def main(argv):
+    out, cols, rows, slices, times = argv[0], *map(int, argv[1:5])
+    iop = [float(x) for x in argv[5:11]]
+    origin = [float(x) for x in argv[11:14]]
+    step = [float(x) for x in argv[14:17]]
+    rng = random.Random(int(argv[17]))
+    frames = [(k, t) for k in range(slices) for t in range(times)]
+    rng.shuffle(frames)
+
+    meta = FileMetaDataset()
+    meta.MediaStorageSOPClassUID = "1.2.840.10008.5.1.4.1.1.2.1"  # Enhanced CT Image Storage
+    meta.MediaStorageSOPInstanceUID = generate_uid()
+    meta.TransferSyntaxUID = ExplicitVRLittleEndian
+    ds = Dataset()
+    ds.file_meta = meta
+    ds.SOPClassUID = meta.MediaStorageSOPClassUID
+    ds.SOPInstanceUID = meta.MediaStorageSOPInstanceUID
+    ds.Modality = "CT"
+    ds.SeriesDescription = "enhanced test"
+    ds.StudyInstanceUID = generate_uid()
+    ds.SeriesInstanceUID = generate_uid()
+    ds.InstanceNumber = 1
+    ds.Rows, ds.Columns = rows, cols
+    ds.SamplesPerPixel = 1
+    ds.PhotometricInterpretation = "MONOCHROME2"
+    ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 0
+    ds.NumberOfFrames = len(frames)
+    ds.SharedFunctionalGroupsSequence = Sequence([item(
+        PlaneOrientationSequence=Sequence([item(ImageOrientationPatient=iop)]),
+        PixelMeasuresSequence=Sequence([item(PixelSpacing=[1.0, 1.0], SliceThickness=1.0)]),
+        PixelValueTransformationSequence=Sequence([item(RescaleIntercept=-1024, RescaleSlope=1,
+                                                        RescaleType="HU")]),
+    )])
+    per_frame, pixels = [], []
+    j, i = np.mgrid[0:rows, 0:cols]
+    for k, t in frames:
+        content = item(StackID="1", InStackPositionNumber=k + 1)
+        if times > 1:
+            content.TemporalPositionIndex = t + 1
+        per_frame.append(item(
+            PlanePositionSequence=Sequence([item(ImagePositionPatient=[origin[a] + k * step[a] for a in range(3)])]),
+            FrameContentSequence=Sequence([content]),
+        ))
+        pixels.append((1000 * t + 100 * k + 10 * j + i).astype("<u2"))
+    ds.PerFrameFunctionalGroupsSequence = Sequence(per_frame)
+    if len(argv) > 18 and argv[18] == "j2k":
+        from pydicom.encaps import encapsulate
+        meta.TransferSyntaxUID = "1.2.840.10008.1.2.4.90"  # JPEG 2000 Image Compression (Lossless Only)
+        ds.PixelData = encapsulate([j2k_frame(p) for p in pixels], has_bot=True)
+        ds["PixelData"].is_undefined_length = True
+        ds["PixelData"].VR = "OB"
+    else:
+        ds.PixelData = np.stack(pixels).tobytes()
+    if int(pydicom.__version__.split(".")[0]) >= 3:
+        ds.save_as(out, enforce_file_format=True)
+    else:  # pydicom 2 (Debian 12) takes the encoding from the dataset
+        ds.is_little_endian, ds.is_implicit_VR = True, False
+        ds.save_as(out, write_like_original=False)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,311 @@
+/* test_dicom_frames.c - the DICOM that hospitals send, through the public
+ * API: enhanced multi-frame files (frames shuffled, per-frame and shared
+ * functional groups, 4D) written by pydicom; classic multi-frame files; every
+ * transfer syntax dcmtk's tools and pydicom's reference files give us
+ * (implicit/explicit/big endian, deflated, RLE, JPEG Lossless, JPEG-LS
+ * lossless and near-lossless, JPEG Baseline and Extended). Each encoding
+ * must load voxel for voxel as the uncompressed volume, or within the
+ * codec's own bound for the lossy ones. The writers (pydicom, dcmtk's
+ * dcmcrle/dcmcjpeg/dcmcjpls/dcmconv) are independent of our decoders. */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dicom_test_util.h"
+#include "fuzz/dicom_writer.h"
+#include "harness.h"
+
+static char g_dir[64];
+/* pydicom's own test files, installed with Debian's python3-pydicom (asked
+ * of pydicom, so its version's layout does not matter) */
+static char g_pydicom_files[512];
+
+static int find_pydicom_files(void)
+{
+    FILE *p = popen("/usr/bin/python3 -c 'import os, pydicom.data; "
+                    "print(os.path.join(os.path.dirname(pydicom.data.__file__), \"test_files\"))'", "r");
+    if (!p) return -1;
+    const int ok = fgets(g_pydicom_files, sizeof g_pydicom_files, p) != NULL;
+    if (pclose(p) != 0 || !ok) return -1;
+    g_pydicom_files[strcspn(g_pydicom_files, "\n")] = 0;
+    return 0;
+}
+
+enum { C = 6, R = 5, K = 7, T = 3 };
+static const double k_iop[6] = {0.8, 0.6, 0, 0, 0, -1}; /* oblique: coronal-ish, rotated */
+static const double k_origin[3] = {-10, 20, 30};
+static const double k_step[3] = {-1.2, 1.6, 0}; /* 2 mm along the normal (-0.6, 0.8, 0) */
+
+/* Slice k of time point t as single-frame files, the classic way, with the
+ * enhanced file's geometry and pixels (1000 t + 100 k + 10 j + i). */
+static int write_reference(const char *dir, int t)
+{
+    for (int k = 0; k < K; k++) {
+        uint16_t px[C * R];
+        for (int j = 0; j < R; j++)
+            for (int i = 0; i < C; i++) px[i + C * j] = (uint16_t)(1000 * t + 100 * k + 10 * j + i);
+        dcmw_slice d = dcmw_axial("1.2.3.300", C, R, 0, px, sizeof px);
+        memcpy(d.iop, k_iop, sizeof d.iop);
+        for (int a = 0; a < 3; a++) d.ipp[a] = k_origin[a] + k * k_step[a];
+        d.ps[0] = d.ps[1] = 1;
+        d.has_rescale = 1;
+        d.slope = 1;
+        d.inter = -1024;
+        d.instance = k;
+        char p[512];
+        snprintf(p, sizeof p, "%s/IM%04d.dcm", dir, k);
+        if (dcmw_write(p, &d)) return -1;
+    }
+    return 0;
+}
+
+/* The enhanced file (tests/make_enhanced_dicom.py) at path; codec "" or
+ * "j2k" (frames from opj_compress). */
+static int write_enhanced(const char *path, int times, int seed, const char *codec)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd,
+             "/usr/bin/python3 tests/make_enhanced_dicom.py %s %d %d %d %d %g %g %g %g %g %g %g %g %g %g %g %g %d %s",
+             path, C, R, K, times, k_iop[0], k_iop[1], k_iop[2], k_iop[3], k_iop[4], k_iop[5], k_origin[0],
+             k_origin[1], k_origin[2], k_step[0], k_step[1], k_step[2], seed, codec);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+/* `tool IN OUT` (a dcmtk command line) into a fresh folder; its path in out. */
+static int convert(const char *in, const char *name, const char *tool, char *out, size_t n)
+{
+    char dir[256], cmd[1400];
+    dicom_folder(g_dir, dir, sizeof dir, name);
+    snprintf(out, n, "%s/f.dcm", dir);
+    snprintf(cmd, sizeof cmd, "%s %s %s", tool, in, out);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static int same_affine(const vxl_volume *a, const vxl_volume *b)
+{
+    for (int i = 0; i < 16; i++)
+        if (fabs(a->affine[i] - b->affine[i]) > 1e-9) return 0;
+    return 1;
+}
+
+/* An enhanced CT whose frames are stored shuffled loads in anatomical order
+ * with the affine the same slices get as single-frame files; dcmtk's
+ * encoders compress the multi-frame file (one or several fragments per
+ * frame, with and without a basic offset table) and it still loads the same. */
+TEST(enhanced_frames_in_shuffled_order_come_out_in_anatomical_order)
+{
+    char ref_dir[256], dir[256], path[512];
+    dicom_folder(g_dir, ref_dir, sizeof ref_dir, "reference");
+    REQUIRE(write_reference(ref_dir, 0) == 0);
+    vxl_volume *ref = load_dicom(ref_dir, NULL, 0);
+    REQUIRE(ref);
+    dicom_folder(g_dir, dir, sizeof dir, "enhanced");
+    snprintf(path, sizeof path, "%s/enhanced.dcm", dir);
+    REQUIRE(write_enhanced(path, 1, 7, "") == 0);
+    vxl_volume *v = load_dicom(path, NULL, 0);
+    CHECKF(v && same_volume(ref, v) && same_affine(ref, v), "%s", v ? "voxels or affine differ" : vxl_last_error());
+    CHECK(v && v->dims[2] == K && fabs(v->spacing[2] - 2) < 1e-9 && v->value_min == -1024);
+    vxl_volume_destroy(v);
+
+    static const char *const encodings[][2] = {
+        {"rle", "dcmcrle"},
+        {"jpeg_sv1", "dcmcjpeg"},
+        {"jpeg_fragments", "dcmcjpeg +fs 1"},         /* several fragments per frame, offset table */
+        {"jpeg_no_table", "dcmcjpeg +fs 1 -ot"},      /* ... without the table: frames found by SOI */
+        {"jpeg_ls", "dcmcjpls"},
+        {"jpeg_ls_no_table", "dcmcjpls -ot"},         /* one fragment per frame, no table */
+        {"big_endian", "dcmconv +tb"},
+        {"deflated", "dcmconv +td"},
+    };
+    for (size_t e = 0; e < sizeof encodings / sizeof encodings[0]; e++) {
+        char out[512];
+        REQUIRE(convert(path, encodings[e][0], encodings[e][1], out, sizeof out) == 0);
+        vxl_volume *c = load_dicom(out, NULL, 0);
+        CHECKF(c && same_volume(ref, c) && same_affine(ref, c), "%s: %s", encodings[e][1],
+               c ? "voxels or affine differ" : vxl_last_error());
+        vxl_volume_destroy(c);
+    }
+    /* JPEG 2000 frames (OpenJPEG's own encoder), with a basic offset table */
+    dicom_folder(g_dir, dir, sizeof dir, "enhanced_j2k");
+    snprintf(path, sizeof path, "%s/j2k.dcm", dir);
+    REQUIRE(write_enhanced(path, 1, 5, "j2k") == 0);
+    v = load_dicom(path, NULL, 0);
+    CHECKF(v && same_volume(ref, v) && same_affine(ref, v), "j2k: %s", v ? "voxels or affine differ" : vxl_last_error());
+    vxl_volume_destroy(v);
+    vxl_volume_destroy(ref);
+}
+
+/* Time points of an enhanced file (TemporalPositionIndex) become frames,
+ * each the same as its single-frame series. */
+TEST(enhanced_time_points_become_frames)
+{
+    char dir[256], path[512];
+    dicom_folder(g_dir, dir, sizeof dir, "enhanced_4d");
+    snprintf(path, sizeof path, "%s/e.dcm", dir);
+    REQUIRE(write_enhanced(path, T, 11, "") == 0);
+    for (int t = 0; t < T; t++) {
+        char ref_dir[256], name[32];
+        snprintf(name, sizeof name, "reference_t%d", t);
+        dicom_folder(g_dir, ref_dir, sizeof ref_dir, name);
+        REQUIRE(write_reference(ref_dir, t) == 0);
+        vxl_volume *ref = load_dicom(ref_dir, NULL, 0);
+        vxl_volume *v = load_dicom(path, NULL, (uint32_t)t);
+        CHECKF(ref && v && same_volume(ref, v) && same_affine(ref, v), "time point %d: %s", t,
+               v ? "voxels or affine differ" : vxl_last_error());
+        CHECK(v && v->frame_count == T && v->frame == (uint32_t)t);
+        vxl_volume_destroy(ref);
+        vxl_volume_destroy(v);
+    }
+    vxl_dicom_series s = {.struct_size = sizeof s};
+    uint32_t n = 0;
+    CHECK(vxl_dicom_list_series(path, &s, 1, &n) == VXL_OK && n == 1 && s.loadable && s.dims[2] == K &&
+          s.frame_count == T && s.slice_count == K * T);
+}
+
+/* The reference file at name under pydicom's test files, copied alone
+ * into its own folder (a file names its folder's series). */
+static vxl_volume *load_reference_file(const char *name)
+{
+    char dir[256], cmd[1024], path[512];
+    dicom_folder(g_dir, dir, sizeof dir, name);
+    snprintf(cmd, sizeof cmd, "cp '%s/%s' %s/", g_pydicom_files, name, dir);
+    if (system(cmd) != 0) return NULL;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return load_dicom(path, NULL, 0);
+}
+
+/* pydicom's reference files: one MR image and one 15-frame RT dose (32-bit,
+ * frames placed by GridFrameOffsetVector) in each encoding pydicom ships;
+ * every encoding reads voxel for voxel as the first. */
+TEST(reference_files_read_the_same_in_every_encoding)
+{
+    static const char *const sets[][6] = {
+        {"MR_small.dcm", "MR_small_implicit.dcm", "MR_small_bigendian.dcm", "MR_small_RLE.dcm",
+         "MR_small_jpeg_ls_lossless.dcm", "MR_small_jp2klossless.dcm"},
+        /* the RLE copy also stores most elements as UN (unknown VR) */
+        {"rtdose.dcm", "rtdose_expb.dcm", "rtdose_rle.dcm", NULL, NULL, NULL},
+    };
+    REQUIRE(find_pydicom_files() == 0);
+    for (size_t s = 0; s < sizeof sets / sizeof sets[0]; s++) {
+        vxl_volume *first = load_reference_file(sets[s][0]);
+        CHECKF(first, "%s: %s", sets[s][0], vxl_last_error());
+        if (!first) continue;
+        for (size_t i = 1; i < 6 && sets[s][i]; i++) {
+            vxl_volume *v = load_reference_file(sets[s][i]);
+            CHECKF(v && same_volume(first, v) && same_affine(first, v), "%s: %s", sets[s][i],
+                   v ? "voxels or affine differ" : vxl_last_error());
+            vxl_volume_destroy(v);
+        }
+        vxl_volume_destroy(first);
+    }
+    /* deflated, and without PixelSpacing: 1 mm with a note, the same voxels
+     * as dcmtk's inflated copy */
+    vxl_volume *deflated = load_reference_file("image_dfl.dcm");
+    char inflated[512], src[600];
+    snprintf(src, sizeof src, "%s/image_dfl.dcm", g_pydicom_files);
+    REQUIRE(convert(src, "inflated", "dcmconv +te", inflated, sizeof inflated) == 0);
+    vxl_volume *plain = load_dicom(inflated, NULL, 0);
+    vxl_volume_info info;
+    CHECKF(deflated && plain && same_volume(deflated, plain) && deflated->spacing[0] == 1, "%s", vxl_last_error());
+    const char *notes = deflated ? volume_notes(deflated, &info) : "";
+    CHECKF(contains(notes, "PixelSpacing missing or zero in 1 of 1 image(s): 1 mm assumed"), "%s", notes);
+    vxl_volume_destroy(deflated);
+    vxl_volume_destroy(plain);
+
+    vxl_volume *dose = load_reference_file("rtdose.dcm");
+    REQUIRE(dose);
+    CHECK(dose->dims[0] == 10 && dose->dims[2] == 15 && fabs(dose->spacing[2] - 5) < 1e-9 &&
+          dose->src_dtype == VXL_DTYPE_U32 && !strcmp(volume_notes(dose, &info), ""));
+    vxl_volume_destroy(dose);
+}
+
+/* A smooth series of `bits` stored bits (8: 8-bit unsigned), for the lossy
+ * codecs: noise would only measure the codec's worst case. */
+static int write_smooth(const char *dir, int bits)
+{
+    enum { W = 64, H = 48, S = 4 };
+    static uint16_t px[W * H];
+    static uint8_t px8[W * H];
+    const double top = (double)((1 << bits) - 1);
+    for (int k = 0; k < S; k++) {
+        for (int j = 0; j < H; j++)
+            for (int i = 0; i < W; i++) {
+                const double v = 0.5 + 0.4 * sin(i * 0.15 + k) * cos(j * 0.11 - k * 0.5);
+                px[i + W * j] = (uint16_t)lround(v * top);
+                px8[i + W * j] = (uint8_t)px[i + W * j];
+            }
+        dcmw_slice d = dcmw_axial("1.2.3.310", W, H, 2.0 * k, bits == 8 ? (const void *)px8 : (const void *)px,
+                                  (size_t)W * H * (bits == 8 ? 1 : 2));
+        d.bits_alloc = bits == 8 ? 8 : 16;
+        d.bits_stored = (uint16_t)bits;
+        d.instance = k;
+        char p[512];
+        snprintf(p, sizeof p, "%s/IM%04d.dcm", dir, k);
+        if (dcmw_write(p, &d)) return -1;
+    }
+    return 0;
+}
+
+/* Every file of src through `tool` into g_dir/name. */
+static int convert_series(const char *src, int slices, const char *name, const char *tool, char *out, size_t n)
+{
+    dicom_folder(g_dir, out, n, name);
+    char cmd[1400];
+    for (int k = 0; k < slices; k++) {
+        snprintf(cmd, sizeof cmd, "%s %s/IM%04d.dcm %s/IM%04d.dcm", tool, src, k, out, k);
+        if (system(cmd) != 0) return -1;
+    }
+    return 0;
+}
+
+/* The lossy codecs stay within their bounds: JPEG-LS near-lossless within
+ * its NEAR parameter exactly (the standard guarantees it), JPEG Baseline (8
+ * bits) and Extended (12 bits) at quality 90 within 2% and 0.5% of the
+ * range, bounds set from what dcmtk's encoder gives on this smooth series
+ * (observed: 3 of 255 and 6 of 4095); each differs somewhere, so the lossy
+ * path really ran. */
+TEST(lossy_codecs_stay_within_their_bounds)
+{
+    static const struct {
+        int bits;
+        const char *name, *tool;
+        double bound;
+    } cases[] = {
+        {8, "baseline", "dcmcjpeg +eb", 0.02 * 255},
+        {12, "extended", "dcmcjpeg +ee", 0.005 * 4095},
+        {12, "near_lossless", "dcmcjpls +en +md 3", 3},
+        {16, "near_lossless16", "dcmcjpls +en +md 5", 5},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        char src[256], dir[256], name[64];
+        snprintf(name, sizeof name, "smooth_%s", cases[c].name);
+        dicom_folder(g_dir, src, sizeof src, name);
+        REQUIRE(write_smooth(src, cases[c].bits) == 0);
+        vxl_volume *a = load_dicom(src, NULL, 0);
+        REQUIRE(a);
+        snprintf(name, sizeof name, "lossy_%s", cases[c].name);
+        REQUIRE(convert_series(src, 4, name, cases[c].tool, dir, sizeof dir) == 0);
+        vxl_volume *b = load_dicom(dir, NULL, 0);
+        const double d = b ? max_difference(a, b) : -1;
+        CHECKF(b && d > 0 && d <= cases[c].bound + 1e-6, "%s: max difference %g (bound %g) %s", cases[c].tool, d,
+               cases[c].bound, b ? "" : vxl_last_error());
+        vxl_volume_destroy(a);
+        vxl_volume_destroy(b);
+    }
+}
+
+int main(void)
+{
+    snprintf(g_dir, sizeof g_dir, "/tmp/vxl_dicom_frames_XXXXXX");
+    if (!mkdtemp(g_dir)) {
+        perror("mkdtemp");
+        return 1;
+    }
+    RUN(enhanced_frames_in_shuffled_order_come_out_in_anatomical_order);
+    RUN(enhanced_time_points_become_frames);
+    RUN(reference_files_read_the_same_in_every_encoding);
+    RUN(lossy_codecs_stay_within_their_bounds);
+    remove_tree(g_dir);
+    return TEST_SUMMARY();
+}

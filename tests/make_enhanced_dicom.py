@@ -1,14 +1,15 @@
 """Writes one Enhanced CT file (multi-frame, functional groups) with pydicom,
 a writer independent of the dcmtk we read with and of our C test writer.
 
-usage: make_enhanced_dicom.py OUT COLS ROWS SLICES TIMES IOP(6) ORIGIN(3) STEP(3) SEED [j2k]
+usage: make_enhanced_dicom.py OUT COLS ROWS SLICES TIMES IOP(6) ORIGIN(3) STEP(3) SEED [j2k|stacks]
 
 Frame (k, t): slice k at ORIGIN + k * STEP, time point t; pixel (i, j) holds
 1000 t + 100 k + 10 j + i, as tests/test_dicom_frames.c's single-frame copy
 does. The frames are stored in an order shuffled by SEED, each with its own
 Plane Position and Frame Content (TemporalPositionIndex t + 1 when TIMES > 1);
 orientation, pixel measures and the rescale are in the shared groups.
-With j2k, each frame is a JPEG 2000 codestream from Debian's opj_compress
+With stacks, the TIMES groups are stacks instead (StackID t + 1, no
+temporal index): one file holding several volumes. With j2k, each frame is a JPEG 2000 codestream from Debian's opj_compress
 (lossless, 2 resolution levels: the frames are small), encapsulated with a basic offset table (transfer syntax
 1.2.840.10008.1.2.4.90): an encoder independent of our decoder.
 """
@@ -80,9 +81,10 @@ def main(argv):
     )])
     per_frame, pixels = [], []
     j, i = np.mgrid[0:rows, 0:cols]
+    mode = argv[18] if len(argv) > 18 else ""
     for k, t in frames:
-        content = item(StackID="1", InStackPositionNumber=k + 1)
-        if times > 1:
+        content = item(StackID=str(t + 1) if mode == "stacks" else "1", InStackPositionNumber=k + 1)
+        if times > 1 and mode != "stacks":
             content.TemporalPositionIndex = t + 1
         per_frame.append(item(
             PlanePositionSequence=Sequence([item(ImagePositionPatient=[origin[a] + k * step[a] for a in range(3)])]),
@@ -90,7 +92,7 @@ def main(argv):
         ))
         pixels.append((1000 * t + 100 * k + 10 * j + i).astype("<u2"))
     ds.PerFrameFunctionalGroupsSequence = Sequence(per_frame)
-    if len(argv) > 18 and argv[18] == "j2k":
+    if mode == "j2k":
         from pydicom.encaps import encapsulate
         meta.TransferSyntaxUID = "1.2.840.10008.1.2.4.90"  # JPEG 2000 Image Compression (Lossless Only)
         ds.PixelData = encapsulate([j2k_frame(p) for p in pixels], has_bot=True)

@@ -136,6 +136,34 @@ TEST(enhanced_frames_in_shuffled_order_come_out_in_anatomical_order)
     vxl_volume_destroy(ref);
 }
 
+/* A damaged basic offset table (an entry that points inside a fragment) or
+ * one whose count is not the frame count is one line naming the file. */
+TEST(damaged_offset_tables_are_clear_errors)
+{
+    char dir[256], path[512], out[512];
+    dicom_folder(g_dir, dir, sizeof dir, "table_source");
+    snprintf(path, sizeof path, "%s/e.dcm", dir);
+    REQUIRE(write_enhanced(path, 1, 3, "") == 0);
+    REQUIRE(convert(path, "damaged_table", "dcmcjpeg +fs 1", out, sizeof out) == 0);
+    size_t n = 0;
+    unsigned char *f = read_all(out, &n);
+    REQUIRE(f);
+    /* PixelData (7FE0,0010) OB of undefined length, then the table's item */
+    static const unsigned char pixel_data[12] = {0xE0, 0x7F, 0x10, 0x00, 'O', 'B', 0, 0, 0xFF, 0xFF, 0xFF, 0xFF};
+    unsigned char *at = NULL;
+    for (size_t i = 0; i + 12 + 8 + 4 * K <= n && !at; i++)
+        if (!memcmp(f + i, pixel_data, 12)) at = f + i + 12;
+    REQUIRE(at && at[0] == 0xFE && at[1] == 0xFF && at[2] == 0x00 && at[3] == 0xE0 && at[4] == 4 * K);
+    unsigned char *entry1 = at + 8 + 4;
+    REQUIRE(entry1[0] || entry1[1] || entry1[2]);
+    entry1[0] = (unsigned char)(entry1[0] + 2); /* two bytes into a fragment */
+    REQUIRE(write_all(out, f, n) == 0);
+    free(f);
+    CHECK(load_dicom(out, NULL, 0) == NULL);
+    CHECKF(contains(vxl_last_error(), "f.dcm") && contains(vxl_last_error(), "basic offset table entry 1"), "%s",
+           vxl_last_error());
+}
+
 /* Time points of an enhanced file (TemporalPositionIndex) become frames,
  * each the same as its single-frame series. */
 TEST(enhanced_time_points_become_frames)
@@ -161,6 +189,35 @@ TEST(enhanced_time_points_become_frames)
     uint32_t n = 0;
     CHECK(vxl_dicom_list_series(path, &s, 1, &n) == VXL_OK && n == 1 && s.loadable && s.dims[2] == K &&
           s.frame_count == T && s.slice_count == K * T);
+}
+
+/* One enhanced file holding two stacks: two series, each its own volume;
+ * naming the file alone asks which. */
+TEST(stacks_of_one_enhanced_file_are_series_of_their_own)
+{
+    char dir[256], path[512];
+    dicom_folder(g_dir, dir, sizeof dir, "enhanced_stacks");
+    snprintf(path, sizeof path, "%s/s.dcm", dir);
+    REQUIRE(write_enhanced(path, 2, 13, "stacks") == 0);
+    vxl_dicom_series s[2] = {{.struct_size = sizeof s[0]}};
+    uint32_t n = 0;
+    REQUIRE(vxl_dicom_list_series(path, s, 2, &n) == VXL_OK);
+    CHECK(n == 2 && s[0].loadable && s[1].loadable && s[0].dims[2] == K && s[1].dims[2] == K &&
+          contains(s[0].description, "(stack 1)") && contains(s[1].description, "(stack 2)"));
+    CHECKF(load_dicom(path, NULL, 0) == NULL && contains(vxl_last_error(), "holds 2 DICOM series"), "%s",
+           vxl_last_error());
+    for (int t = 0; t < 2; t++) {
+        char ref_dir[256], name[32], index[4];
+        snprintf(name, sizeof name, "stack_reference_%d", t);
+        dicom_folder(g_dir, ref_dir, sizeof ref_dir, name);
+        REQUIRE(write_reference(ref_dir, t) == 0);
+        snprintf(index, sizeof index, "%d", t);
+        vxl_volume *ref = load_dicom(ref_dir, NULL, 0), *v = load_dicom(path, index, 0);
+        CHECKF(ref && v && same_volume(ref, v) && same_affine(ref, v), "stack %d: %s", t,
+               v ? "voxels or affine differ" : vxl_last_error());
+        vxl_volume_destroy(ref);
+        vxl_volume_destroy(v);
+    }
 }
 
 /* The reference file at name under pydicom's test files, copied alone
@@ -304,6 +361,8 @@ int main(void)
     }
     RUN(enhanced_frames_in_shuffled_order_come_out_in_anatomical_order);
     RUN(enhanced_time_points_become_frames);
+    RUN(stacks_of_one_enhanced_file_are_series_of_their_own);
+    RUN(damaged_offset_tables_are_clear_errors);
     RUN(reference_files_read_the_same_in_every_encoding);
     RUN(lossy_codecs_stay_within_their_bounds);
     remove_tree(g_dir);

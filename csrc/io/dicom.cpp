@@ -124,7 +124,7 @@ int scan(const std::string &path, Scan &out, vxl_err *e)
     if (!complete)
         return vxl_fail(e, VXL_ERR_LIMIT, "'%s': more than %zu files; name the series' own folder", where.c_str(),
                         kMaxFiles);
-    std::map<std::string, Series> by_uid;
+    std::map<std::string, Series> by_uid; // UID, then the stack of a file with several
     for (const std::string &f : files) {
         std::vector<Image> images;
         std::string why;
@@ -132,7 +132,7 @@ int scan(const std::string &path, Scan &out, vxl_err *e)
         if (p == Parse::bad || (p == Parse::not_dicom && f == out.origin))
             return vxl_fail(e, VXL_ERR_FORMAT, "%s", why.c_str());
         if (p == Parse::ok)
-            for (Image &im : images) by_uid[im.uid].images.push_back(std::move(im));
+            for (Image &im : images) by_uid[im.uid + '\n' + im.stack].images.push_back(std::move(im));
     }
     if (by_uid.empty()) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': no DICOM images found", where.c_str());
     for (auto &kv : by_uid) {
@@ -164,10 +164,15 @@ int choose(const Scan &sc, const std::string &path, const char *want, const Seri
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': no series '%s' (an index 0..%zu or a UID)%s",
                         path.c_str(), want, all.size() - 1, list.c_str());
     }
-    if (!sc.origin.empty()) {
+    if (!sc.origin.empty()) { // the named file's series, unless the file holds several (stacks)
+        const Series *found = nullptr;
+        size_t holders = 0;
         for (const Series &s : all)
-            for (const Image &t : s.images)
-                if (t.path == sc.origin) { *out = &s; return VXL_OK; }
+            if (std::any_of(s.images.begin(), s.images.end(), [&](const Image &t) { return t.path == sc.origin; })) {
+                found = &s;
+                holders++;
+            }
+        if (holders == 1) { *out = found; return VXL_OK; }
     }
     if (all.size() == 1) { *out = &all[0]; return VXL_OK; }
     std::string list;
@@ -227,6 +232,32 @@ int read_all(std::vector<FileTask> &tasks, vxl_err *e)
     for (size_t i = 0; i < tasks.size(); i++)
         if (pool.codes[i]) return vxl_fail(e, pool.codes[i], "%s", pool.errors[i].msg);
     return VXL_OK;
+}
+
+// A multi-frame file is one task, so an enhanced CT in one file would
+// decode on one core. Its compressed frames are split into a piece per core,
+// each piece reading the file for itself: decoding a frame costs far more
+// than rereading the compressed bytes. Uncompressed frames cost no decoding
+// and stay whole.
+void split_for_cores(std::vector<FileTask> &tasks)
+{
+    const size_t cores = std::min<size_t>(vxl_cpu_count(), kMaxReaders);
+    if (tasks.empty() || tasks.size() >= cores) return;
+    const size_t share = (cores + tasks.size() - 1) / tasks.size();
+    std::vector<FileTask> out;
+    for (FileTask &t : tasks) {
+        const size_t n = t.images.size();
+        const size_t pieces = t.images[0]->encapsulated ? std::min(n, share) : 1;
+        for (size_t p = 0; p < pieces; p++) {
+            FileTask piece;
+            for (size_t i = p * n / pieces; i < (p + 1) * n / pieces; i++) {
+                piece.images.push_back(t.images[i]);
+                piece.dst.push_back(t.dst[i]);
+            }
+            out.push_back(std::move(piece));
+        }
+    }
+    tasks.swap(out);
 }
 
 uint32_t dtype_of(const Image &s)
@@ -289,6 +320,7 @@ int load_series(const Series &s, const char *path, const vxl_load_options *opt, 
         tasks[it->second].images.push_back(pos[i]);
         tasks[it->second].dst.push_back(decoded.data() + i * per * elem);
     }
+    split_for_cores(tasks);
     prepare_decoders();
     rc = read_all(tasks, e);
     if (rc) return rc;

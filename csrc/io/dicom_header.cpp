@@ -99,6 +99,7 @@ void apply_groups(DcmItem *per_frame, DcmItem *shared, Image &im)
         double t;
         if (get_number(fc, DCM_TemporalPositionIndex, t)) im.tkey = t;
         else im.tkey = im.frame; // frames at one position without a temporal index: file order
+        im.stack = get_string(fc, DCM_StackID);
     }
 }
 
@@ -209,6 +210,16 @@ Parse read_header(const std::string &path, std::vector<Image> &out, std::string 
     if (shared || (per && per->card())) {
         for (size_t i = 0; i < out.size(); i++) apply_groups(per ? per->getItem(static_cast<unsigned long>(i)) : nullptr,
                                                               shared, out[i]);
+        // several stacks in one file (orthogonal stacks of one enhanced MR)
+        // are several volumes: each becomes its own series; one stack is the
+        // file's series as it is
+        bool several = false;
+        for (const Image &im : out) several = several || im.stack != out[0].stack;
+        for (Image &im : out) {
+            if (!several) im.stack.clear();
+            else if (im.description.empty()) im.description = "stack " + im.stack;
+            else im.description += " (stack " + im.stack + ")";
+        }
     } else if (s.file_frames > 1) {
         stack_classic_frames(ds, out);
     }

@@ -29,6 +29,7 @@ namespace vxl_dicom {
 // One 2D image: frame `frame` (0-based) of the file at `path`.
 struct Image {
     std::string path, uid, modality, description, photometric;
+    std::string stack; // StackID of an enhanced file that holds several stacks ("" otherwise): a series each
     unsigned frame = 0;
     long file_frames = 1; // NumberOfFrames of the file
     unsigned rows = 0, cols = 0, bits_alloc = 0, bits_stored = 0, pixel_rep = 0, samples = 1;

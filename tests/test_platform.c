@@ -6,7 +6,8 @@
  * folders with non-ASCII UTF-8 names written, renamed, listed, read at
  * offsets and removed; a child program's output, exit code and kill (the
  * child is tests/child_program.c, built next to this test); the monotonic
- * clock and the processor count. */
+ * clock and the processor count; paths split and judged absolute as the
+ * OS does, and the user's cache folder. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -266,6 +267,28 @@ TEST(a_child_program_writes_exits_and_is_killed)
     }
 }
 
+/* Paths as the OS spells them: both separators split on every OS (a
+ * Windows program is handed either); what is absolute differs; the user's
+ * cache folder is the OS's own. */
+TEST(paths_are_split_and_judged_as_the_os_does)
+{
+    const int windows = !strcmp(vxl_os_name(), "windows");
+    const char *p = "scans/one\\two.nhdr";
+    CHECK(vxl_path_last_separator(p) == p + 9 && vxl_path_last_separator("name") == NULL);
+    CHECK(vxl_path_is_separator('/') && vxl_path_is_separator('\\') && !vxl_path_is_separator(':'));
+    CHECK(vxl_path_is_absolute("/data/a.nii") == 1 && !vxl_path_is_absolute("a.raw") &&
+          !vxl_path_is_absolute("sub/a.raw") && !vxl_path_is_absolute(""));
+    CHECK(vxl_path_is_absolute("C:\\scans\\a.raw") == windows && vxl_path_is_absolute("d:/a.raw") == windows &&
+          vxl_path_is_absolute("\\\\server\\share\\a.raw") == windows && !vxl_path_is_absolute("C:a.raw"));
+    char dir[4096];
+    REQUIRE(vxl_user_cache_dir(dir, sizeof dir) == 0);
+    const char *tail = windows ? "\\voxlight" : "/voxlight";
+    CHECKF(strlen(dir) > strlen(tail) && !strcmp(dir + strlen(dir) - strlen(tail), tail) && vxl_path_is_absolute(dir),
+           "%s", dir);
+    char tiny[4];
+    CHECK(vxl_user_cache_dir(tiny, sizeof tiny) == -1);
+}
+
 int main(void)
 {
     RUN(threads_take_turns_and_keep_their_own_values);
@@ -273,5 +296,6 @@ int main(void)
     RUN(the_clock_never_goes_back);
     RUN(files_with_utf8_names_are_written_renamed_listed_and_read);
     RUN(a_child_program_writes_exits_and_is_killed);
+    RUN(paths_are_split_and_judged_as_the_os_does);
     return TEST_SUMMARY();
 }

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "files.h"
 #include "os.h"
 
 #define CLI_DEFAULT_BUDGET (2ull << 30) /* voxlight.h: a budget of 0 means 2 GiB */
@@ -66,7 +67,7 @@ int vxl_cli_stream_option(int argc, char **argv, int *i, vxl_cli_stream *s, char
 
 static const char *base_name(const char *path)
 {
-    const char *slash = strrchr(path, '/');
+    const char *slash = vxl_path_last_separator(path);
     return slash && slash[1] ? slash + 1 : path;
 }
 

@@ -23,10 +23,11 @@ static int make_dirs(const char *dir)
     char p[4096];
     if (snprintf(p, sizeof p, "%s", dir) >= (int)sizeof p) return -1;
     for (char *c = p + 1; *c; c++)
-        if (*c == '/') {
+        if (vxl_path_is_separator(*c) && c[-1] != ':') { /* "C:" is a drive, not a folder to make */
+            const char sep = *c;
             *c = 0;
             if (vxl_mkdir(p) != 0) return -1;
-            *c = '/';
+            *c = sep;
         }
     return vxl_mkdir(p);
 }
@@ -49,7 +50,7 @@ static int shared_name(const char *dir, const vxl_raw_layout *l, const char *bas
 /* opt->cache_dir, else beside the source, else the user's cache folder. */
 static int cache_path(const vxl_raw_layout *l, const vxl_load_options *opt, char *out, size_t n, vxl_err *e)
 {
-    const char *slash = strrchr(l->path, '/');
+    const char *slash = vxl_path_last_separator(l->path);
     const char *base = slash ? slash + 1 : l->path;
     char suffix[32] = "";
     if (l->frame) snprintf(suffix, sizeof suffix, ".frame%u", l->frame);
@@ -65,14 +66,11 @@ static int cache_path(const vxl_raw_layout *l, const vxl_load_options *opt, char
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "the cache path beside %s is too long", l->path);
         return VXL_OK;
     }
-    const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
     char user[4096];
-    if (xdg && xdg[0] == '/') snprintf(user, sizeof user, "%s/voxlight", xdg);
-    else if (home && home[0]) snprintf(user, sizeof user, "%s/.cache/voxlight", home);
-    else
+    if (vxl_user_cache_dir(user, sizeof user) != 0)
         return vxl_fail(e, VXL_ERR_IO,
-                        "%s's folder is not writable and neither XDG_CACHE_HOME nor HOME is set: set a cache folder",
-                        l->path);
+                        "%s's folder is not writable and the system names no cache folder for this user (XDG_CACHE_HOME "
+                        "or HOME; LOCALAPPDATA on Windows): set a cache folder", l->path);
     return shared_name(user, l, base, suffix, out, n, e);
 }
 

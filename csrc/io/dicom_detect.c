@@ -22,7 +22,7 @@ static int has_dicm_magic(const char *path)
 
 static int is_dicomdir_name(const char *path)
 {
-    const char *slash = strrchr(path, '/');
+    const char *slash = vxl_path_last_separator(path);
     return strcasecmp(slash ? slash + 1 : path, "DICOMDIR") == 0;
 }
 

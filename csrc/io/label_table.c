@@ -59,7 +59,7 @@ static int has_suffix(const char *s, const char *suffix)
 /* path with its last extension (".lut"/".txt") replaced; malloc'd. */
 static char *swap_extension(const char *path, const char *ext)
 {
-    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    const char *dot = strrchr(path, '.'), *slash = vxl_path_last_separator(path);
     size_t stem = dot && (!slash || dot > slash) ? (size_t)(dot - path) : strlen(path);
     char *p = malloc(stem + strlen(ext) + 1);
     if (!p) return NULL;

@@ -135,8 +135,8 @@ int vxl_parse_u64s(const char *s, uint64_t *out, int n, uint64_t max)
 char *vxl_sibling_path(const char *base_path, const char *name)
 {
     size_t dn = 0;
-    if (name[0] != '/') {
-        const char *slash = strrchr(base_path, '/');
+    if (!vxl_path_is_absolute(name)) {
+        const char *slash = vxl_path_last_separator(base_path);
         dn = slash ? (size_t)(slash - base_path) + 1 : 0;
     }
     size_t nn = strlen(name);

@@ -59,7 +59,7 @@ static uint64_t input_bytes(const char *path, const vxl_path_info *st, int reads
     if (st->kind == VXL_PATH_DIR) return folder_bytes(path, depth, &entries);
     if (!reads_siblings) return st->size;
     char dir[4096];
-    const char *slash = strrchr(path, '/');
+    const char *slash = vxl_path_last_separator(path);
     if (!slash) snprintf(dir, sizeof dir, ".");
     else snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
     return st->size + folder_bytes(dir, 0, &entries);

@@ -23,7 +23,7 @@ int vxl_zarr_path_is_zarr(const char *path)
     if (n <= 0 || n >= (int)sizeof folder) return 0;
     snprintf(folder, sizeof folder, "%.*s", n, path);
     /* a file browser hands over the metadata file picked inside the store */
-    char *slash = strrchr(folder, '/');
+    char *slash = (char *)vxl_path_last_separator(folder);
     if (slash && vxl_zarr_metadata_name(slash + 1)) *slash = '\0';
     if (!vxl_is_dir(folder)) return 0;
     for (size_t i = 0; i < sizeof marks / sizeof marks[0]; i++) {

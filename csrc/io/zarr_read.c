@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "files.h"
 #include "loader_util.h"
 #include "loaders.h"
 #include "zarr.h"
@@ -28,8 +29,8 @@ int vxl_zarr_parse_path(const char *path, char *folder, size_t size, vxl_zarr_ch
     if (n >= size) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': path too long", path);
     memcpy(folder, path, n);
     folder[n] = '\0';
-    while (n > 1 && folder[n - 1] == '/') folder[--n] = '\0';
-    char *slash = strrchr(folder, '/'); /* a metadata file picked inside the store: its folder */
+    while (n > 1 && vxl_path_is_separator(folder[n - 1])) folder[--n] = '\0';
+    char *slash = (char *)vxl_path_last_separator(folder); /* a metadata file picked inside the store: its folder */
     if (slash && vxl_zarr_metadata_name(slash + 1)) *slash = '\0';
     if (!hash) return VXL_OK;
     char opts[256];

@@ -9,6 +9,8 @@ const char *vxl_path_last_separator(const char *path)
     return back > slash ? back : slash;
 }
 
+int vxl_path_is_separator(char c) { return c == '/' || c == '\\'; }
+
 int vxl_is_file(const char *path)
 {
     vxl_path_info i;

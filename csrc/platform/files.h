@@ -60,6 +60,15 @@ char *vxl_real_path(const char *path, char *out, size_t size);
 /* The last folder separator of path, '/' or '\\' (Windows takes both), or
  * NULL when it has none. */
 const char *vxl_path_last_separator(const char *path);
+/* 1 when c separates folders ('/', and '\\' too: Windows takes both). */
+int vxl_path_is_separator(char c);
+/* 1 when path names a file without a base folder: "/a" on POSIX; "C:\\a",
+ * "C:/a", "\\\\server\\a" or "\\a" on Windows. */
+int vxl_path_is_absolute(const char *path);
+/* The per-user folder for Voxlight's caches into out (no trailing
+ * separator): $XDG_CACHE_HOME/voxlight or $HOME/.cache/voxlight on POSIX,
+ * %LOCALAPPDATA%\\voxlight on Windows. 0, or -1 when the OS names none. */
+int vxl_user_cache_dir(char *out, size_t size);
 
 /* A folder's entries, "." and ".." left out. */
 typedef struct vxl_dir vxl_dir;

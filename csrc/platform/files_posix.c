@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -111,6 +112,18 @@ int vxl_mkdir(const char *path)
 }
 
 int vxl_dir_writable(const char *folder) { return access(folder, W_OK) == 0; }
+
+int vxl_path_is_absolute(const char *path) { return path && path[0] == '/'; }
+
+int vxl_user_cache_dir(char *out, size_t size)
+{
+    const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+    int n;
+    if (xdg && xdg[0] == '/') n = snprintf(out, size, "%s/voxlight", xdg);
+    else if (home && home[0]) n = snprintf(out, size, "%s/.cache/voxlight", home);
+    else return -1;
+    return n > 0 && (size_t)n < size ? 0 : -1;
+}
 
 char *vxl_real_path(const char *path, char *out, size_t size)
 {

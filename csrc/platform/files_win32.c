@@ -203,6 +203,25 @@ int vxl_dir_writable(const char *folder)
     return ok;
 }
 
+int vxl_path_is_absolute(const char *path)
+{
+    if (!path || !path[0]) return 0;
+    if (vxl_path_is_separator(path[0])) return 1; /* \\server\\share or the current drive's root */
+    const char c = (char)(path[0] | 32);
+    return c >= 'a' && c <= 'z' && path[1] == ':' && vxl_path_is_separator(path[2]);
+}
+
+int vxl_user_cache_dir(char *out, size_t size)
+{
+    /* read in UTF-16: a user name outside the ANSI code page stays whole */
+    const wchar_t *local = _wgetenv(L"LOCALAPPDATA");
+    if (!local || !local[0] || !vxl_utf16_to_utf8(local, out, (int)size)) return -1;
+    const size_t n = strlen(out);
+    if (n + sizeof "\\voxlight" > size) return -1;
+    memcpy(out + n, "\\voxlight", sizeof "\\voxlight");
+    return 0;
+}
+
 char *vxl_real_path(const char *path, char *out, size_t size)
 {
     wchar_t *w = wide(path), *full = w ? malloc(VXL_WPATH * sizeof *full) : NULL;

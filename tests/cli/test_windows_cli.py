@@ -68,6 +68,16 @@ def inputs(tmp_path_factory):
                                 codec="gzip", chunks=[8, 8, 8])
     files["tiff"] = d / "ball.tif"
     write_tiff(files["tiff"], list(ball.astype(np.float32)))
+    # detached headers: the data file is found beside the header, whose
+    # path the Windows program gets with backslashes
+    files["nhdr"] = d / "ball.nhdr"
+    (d / "ball_nrrd.raw").write_bytes(ball.astype("<i2").tobytes())
+    files["nhdr"].write_text("NRRD0004\ntype: short\ndimension: 3\nsizes: 24 24 24\nencoding: raw\n"
+                             "endian: little\ndata file: ball_nrrd.raw\n\n")
+    files["mhd"] = d / "ball.mhd"
+    (d / "ball_mhd.raw").write_bytes(ball.astype("<i2").tobytes())
+    files["mhd"].write_text("ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
+                            "DimSize = 24 24 24\nElementType = MET_SHORT\nElementDataFile = ball_mhd.raw\n")
     return files
 
 
@@ -77,7 +87,8 @@ def without_paths(text, *paths):
 
 
 @pytest.mark.parametrize("fmt,extra", [("nifti", []), ("nrrd", []), ("metaimage", []), ("zarr", []),
-                                       ("zarr", ["--streaming", "on"]), ("tiff", ["--streaming", "on"])])
+                                       ("zarr", ["--streaming", "on"]), ("tiff", ["--streaming", "on"]),
+                                       ("nhdr", []), ("mhd", [])])
 def test_info_matches_linux(inputs, fmt, extra):
     src = inputs[fmt]
     lin = run_linux("info", src, *extra)

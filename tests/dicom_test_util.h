@@ -6,6 +6,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
@@ -50,6 +51,21 @@ static inline double max_difference(const vxl_volume *a, const vxl_volume *b)
     double worst = 0;
     for (uint64_t i = 0; i < n; i++) worst = fmax(worst, fabs(voxel(a, i) - voxel(b, i)));
     return worst;
+}
+
+/* Every file IMkkkk.dcm (k < slices) of src through `tool` (a command
+ * line taking IN OUT, e.g. one of dcmtk's encoders, independent of our
+ * decoders) into the fresh folder root/name, its path in out. */
+static inline int convert_series(const char *root, const char *src, int slices, const char *name, const char *tool,
+                                 char *out, size_t n)
+{
+    dicom_folder(root, out, n, name);
+    char cmd[1400];
+    for (int k = 0; k < slices; k++) {
+        snprintf(cmd, sizeof cmd, "%s %s/IM%04d.dcm %s/IM%04d.dcm", tool, src, k, out, k);
+        if (system(cmd) != 0) return -1;
+    }
+    return 0;
 }
 
 /* The volume's notes (what the reader decided), "" when none. */

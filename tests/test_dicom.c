@@ -527,13 +527,7 @@ static int write_busy_series(const char *dir, const char *uid, int eight_bit)
  * independent of our decoders) into a fresh folder g_dir/name. */
 static int compress_series(const char *src, const char *name, const char *tool, char *out, size_t n)
 {
-    folder(out, n, name);
-    char cmd[1400];
-    for (int k = 0; k < NS; k++) {
-        snprintf(cmd, sizeof cmd, "%s %s/IM%04d.dcm %s/IM%04d.dcm", tool, src, k, out, k);
-        if (system(cmd) != 0) return -1;
-    }
-    return 0;
+    return convert_series(g_dir, src, NS, name, tool, out, n);
 }
 
 /* The same series in RLE Lossless and in JPEG Lossless (SV1, every other

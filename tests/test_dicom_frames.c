@@ -304,18 +304,6 @@ static int write_smooth(const char *dir, int bits)
     return 0;
 }
 
-/* Every file of src through `tool` into g_dir/name. */
-static int convert_series(const char *src, int slices, const char *name, const char *tool, char *out, size_t n)
-{
-    dicom_folder(g_dir, out, n, name);
-    char cmd[1400];
-    for (int k = 0; k < slices; k++) {
-        snprintf(cmd, sizeof cmd, "%s %s/IM%04d.dcm %s/IM%04d.dcm", tool, src, k, out, k);
-        if (system(cmd) != 0) return -1;
-    }
-    return 0;
-}
-
 /* The lossy codecs stay within their bounds: JPEG-LS near-lossless within
  * its NEAR parameter exactly (the standard guarantees it), JPEG Baseline (8
  * bits) and Extended (12 bits) at quality 90 within 2% and 0.5% of the
@@ -342,7 +330,7 @@ TEST(lossy_codecs_stay_within_their_bounds)
         vxl_volume *a = load_dicom(src, NULL, 0);
         REQUIRE(a);
         snprintf(name, sizeof name, "lossy_%s", cases[c].name);
-        REQUIRE(convert_series(src, 4, name, cases[c].tool, dir, sizeof dir) == 0);
+        REQUIRE(convert_series(g_dir, src, 4, name, cases[c].tool, dir, sizeof dir) == 0);
         vxl_volume *b = load_dicom(dir, NULL, 0);
         const double d = b ? max_difference(a, b) : -1;
         CHECKF(b && d > 0 && d <= cases[c].bound + 1e-6, "%s: max difference %g (bound %g) %s", cases[c].tool, d,

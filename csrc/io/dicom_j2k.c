@@ -63,15 +63,10 @@ static void load(void)
     _Static_assert(sizeof(vxl_openjpeg) == sizeof names / sizeof names[0] * sizeof(vxl_dynlib_fn),
                    "one pointer per name");
     /* VOXLIGHT_LIBOPENJP2 names another file (tests: a missing library) */
-    const char *so = getenv("VOXLIGHT_LIBOPENJP2");
-    if (!so || !*so) so = vxl_os_openjpeg_name();
-    vxl_dynlib *lib = vxl_dynlib_open(so, state.why, sizeof state.why);
+    vxl_dynlib *lib = vxl_dynlib_open_table("VOXLIGHT_LIBOPENJP2", vxl_os_openjpeg_name(), names,
+                                            sizeof names / sizeof names[0], (vxl_dynlib_fn *)&state.api, state.why,
+                                            sizeof state.why);
     if (!lib) return;
-    if (vxl_dynlib_symbols(lib, names, sizeof names / sizeof names[0], (vxl_dynlib_fn *)&state.api, state.why,
-                           sizeof state.why)) {
-        vxl_dynlib_close(lib);
-        return;
-    }
     /* the structures the table's types describe are those of major 2 */
     if (state.api.version()[0] != '0' + OPJ_VERSION_MAJOR) {
         snprintf(state.why, sizeof state.why, "it is OpenJPEG %s, not %d.x", state.api.version(), OPJ_VERSION_MAJOR);

@@ -30,15 +30,9 @@ static vxl_once once = VXL_ONCE_INIT;
 static void load(void)
 {
     _Static_assert(sizeof(vxl_zlib) == sizeof names / sizeof names[0] * sizeof(vxl_dynlib_fn), "one pointer per name");
-    const char *so = getenv("VOXLIGHT_LIBZ");
-    if (!so || !*so) so = vxl_os_zlib_name();
-    vxl_dynlib *lib = vxl_dynlib_open(so, state.why, sizeof state.why);
+    vxl_dynlib *lib = vxl_dynlib_open_table("VOXLIGHT_LIBZ", vxl_os_zlib_name(), names, sizeof names / sizeof names[0],
+                                            (vxl_dynlib_fn *)&state.api, state.why, sizeof state.why);
     if (!lib) return;
-    if (vxl_dynlib_symbols(lib, names, sizeof names / sizeof names[0], (vxl_dynlib_fn *)&state.api, state.why,
-                           sizeof state.why)) {
-        vxl_dynlib_close(lib);
-        return;
-    }
     /* The major version must match the header the table's types come from. */
     if (state.api.zlibVersion()[0] != ZLIB_VERSION[0]) {
         snprintf(state.why, sizeof state.why, "it is zlib %s, not %c.x", state.api.zlibVersion(), ZLIB_VERSION[0]);

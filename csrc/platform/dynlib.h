@@ -24,6 +24,13 @@ vxl_dynlib_fn vxl_dynlib_symbol(vxl_dynlib *lib, const char *name);
 int vxl_dynlib_symbols(vxl_dynlib *lib, const char *const *names, size_t count, vxl_dynlib_fn *table, char *why,
                        size_t why_size);
 
+/* A library opened for a table of its functions: the file the variable
+ * `env` names when it is set (tests point it at a missing library), else
+ * `name`; then the count functions names[i] into table[i]. The library, or
+ * NULL with why ("it lacks inflate", the loader's reason). */
+vxl_dynlib *vxl_dynlib_open_table(const char *env, const char *name, const char *const *names, size_t count,
+                                  vxl_dynlib_fn *table, char *why, size_t why_size);
+
 void vxl_dynlib_close(vxl_dynlib *lib);
 
 /* The file of the loaded module (library or program) holding `address`,

@@ -130,6 +130,31 @@ def reader_notes_reach_the_object():
 
 
 @test
+def dicom_as_hospitals_send_it_imports_with_its_notes():
+    """The add-on imports the DICOM the library reads through its helper: an
+    enhanced multi-frame CT (pydicom's writer, frames shuffled) lands with
+    its slices; a series with a missing slice is resampled and the object
+    keeps the note that says so."""
+    import subprocess
+    u.reset_scene()
+    enhanced = os.path.join(u.TMP, "enhanced", "e.dcm")
+    os.makedirs(os.path.dirname(enhanced), exist_ok=True)
+    subprocess.run(["/usr/bin/python3", os.path.join(u.ROOT, "tests", "make_enhanced_dicom.py"), enhanced, "6", "5",
+                    "7", "1", "1", "0", "0", "0", "1", "0", "0", "0", "0", "0", "0", "2", "5"], check=True)
+    ob = u.import_volume(enhanced)
+    assert tuple(ob.voxlight.dims) == (6, 5, 7) and ob.voxlight.reader_notes == "", ob.voxlight.reader_notes
+    sys.path.insert(0, os.path.join(u.ROOT, "tests", "python"))
+    from dicom_write import write_dicom
+    gap = os.path.join(u.TMP, "gap")
+    os.makedirs(gap, exist_ok=True)
+    for k, z in enumerate((0, 2, 4, 8, 10)):
+        write_dicom(os.path.join(gap, "%d.dcm" % k), "1.2.840.99.501", np.full((5, 6), 100 * k, np.uint16), z)
+    ob = u.import_volume(gap)
+    assert tuple(ob.voxlight.dims) == (6, 5, 6), tuple(ob.voxlight.dims)
+    assert "uneven slice spacing" in ob.voxlight.reader_notes and "1 of them interpolated" in ob.voxlight.reader_notes
+
+
+@test
 def openvdb_abort_is_an_error_and_blender_lives_on():
     """libopenvdb aborts on this file (tests/fuzz/upstream/): the add-on's
     helper process dies instead of Blender, the import reports it, and the

@@ -32,11 +32,14 @@ Per region and volume, on every redraw:
          as it is stale (the view or anything else changed); a timer polls
          for the result and redraws. The draw handler never waits for a
          refined frame: at most for the band in flight.
-  5. Draw a full-screen quad with gl_FragDepth from the library's depth,
-     depth test LESS_EQUAL and premultiplied blending (no depth writes).
-     Where the volume has no hit the fragment gets the scene's own depth,
-     so its colour (in front of that geometry, since the rays stopped
-     there) always blends.
+  5. Draw a full-screen quad, depth test LESS_EQUAL and premultiplied
+     blending (no depth writes). A frame at a reduced scale is upsampled
+     in the shader with a depth-aware bilinear filter against the scene's
+     full-resolution depth (core/upsample.py holds the same maths and
+     why): no blocks in a preview, and no band of wrong texels along a
+     mesh's silhouette. gl_FragDepth is the volume's hit, never behind the
+     scene's own depth, so its colour (in front of that geometry, since
+     the rays stopped there) always blends.
 
 VOXLIGHT_PROFILE=1 in the environment prints where each draw's time goes
 (_Profile).
@@ -54,6 +57,7 @@ from bpy.app.handlers import persistent
 
 from . import app_handlers, gpu_quad, overlay_frames, params, scene_shadows, scene_shadows_viewport
 from .core import depth as _depth
+from .core import upsample as _upsample
 from .core import native, resolution_policy, runtime, volume_space
 
 _handle = None
@@ -151,8 +155,10 @@ class _Image:
     made_at = 0.0
     stalled_since = None
 
-    def __init__(self, key, rgba, vdepth, win_small, proj, full, scale=1.0, rect=None):
+    def __init__(self, key, rgba, vdepth, win_small, proj, full, scale=1.0, rect=None,
+                 box=(0.0, 1e30, 0.0)):
         self.key = key
+        self.box = box     # (near, far, tolerance): the shader's depth comparison
         self.full = full
         self.scale = scale
         self.height, self.width = rgba.shape[:2]
@@ -167,17 +173,17 @@ class _Image:
         self.update_depth(win_small)
 
     def update_depth(self, win_small):
-        """Fragment depth from the volume's hit depth and the scene depth
-        now on screen. Cheap (no library call); redone only when the scene
-        depth at this resolution changed, e.g. by less than the quantum of
-        the frame key."""
+        """The (hit, stop) depths the shader composites with, from the
+        volume's hit depth and the scene depth now on screen at this
+        resolution. Cheap (no library call); redone only when that scene
+        depth changed, e.g. by less than the quantum of the frame key."""
         crc = _crc(win_small) if win_small is not None else None
         if crc == self.depth_crc and self.depth is not None:
             _profile.mark("depth_check")
             return
         frag = _fragment_depth(self.vdepth, self.proj, win_small, self.rect)
         _profile.mark("fragment_depth")
-        self.depth = _texture(frag, "R32F")
+        self.depth = _texture(frag, "RG32F")
         self.depth_crc = crc
         _profile.mark("depth_texture")
 
@@ -223,14 +229,94 @@ class _State:
         _ensure_poll()
 
 
-_FRAG = ("void main() { fragColor = texture(color_tex, uv);"
-         " gl_FragDepth = texture(depth_tex, uv).r; }")
+# The compositing shader: plugin/core/upsample.py in GLSL (its docstring
+# says why). color_tex is the frame's premultiplied RGBA, depth_tex its
+# (hit, stop) window depths, scene_tex the scene's window depth at full
+# resolution. proj_rows = (p22, p23, p32, p33) of the projection, box =
+# (near, far, tolerance) in planar distance, filter_mode 1 = bilateral,
+# 0 = nearest (the compositing before it, kept for the bench and tests).
+_FRAG = """
+float planar(float w)
+{
+    if (w >= 1.0) {
+        return box.y;
+    }
+    float ndc = w * 2.0 - 1.0;
+    float d = -(proj_rows.y - ndc * proj_rows.w) / (ndc * proj_rows.z - proj_rows.x);
+    return clamp(d, box.x, box.y);
+}
+
+void main()
+{
+    ivec2 cs = textureSize(color_tex, 0);
+    ivec2 ss = textureSize(scene_tex, 0);
+    float scene = texelFetch(scene_tex, clamp(ivec2(uv * vec2(ss)), ivec2(0), ss - 1), 0).r;
+    if (filter_mode == 0) {
+        ivec2 t = clamp(ivec2(uv * vec2(cs)), ivec2(0), cs - 1);
+        vec2 hs = texelFetch(depth_tex, t, 0).rg;
+        fragColor = texelFetch(color_tex, t, 0);
+        gl_FragDepth = hs.r < 1.0 ? min(hs.r, hs.g) : hs.g;
+        return;
+    }
+    float dp = planar(scene);
+    vec2 f = uv * vec2(cs) - 0.5;
+    vec2 i0 = floor(f);
+    vec2 fr = f - i0;
+    /* a: stopped at this pixel's depth, b: stopped nearer; weighted sum,
+       plain sum, count, nearest hit (no arrays: Mesa's llvmpipe got the
+       dynamically indexed ones wrong) */
+    vec4 acc_a = vec4(0.0), accu_a = vec4(0.0), acc_b = vec4(0.0), accu_b = vec4(0.0);
+    float w_a = 0.0, n_a = 0.0, hit_a = 1.0, w_b = 0.0, n_b = 0.0, hit_b = 1.0;
+    for (int k = 0; k < 4; k++) {
+        int ox = k - 2 * (k / 2);
+        int oy = k / 2;
+        ivec2 t = clamp(ivec2(i0) + ivec2(ox, oy), ivec2(0), cs - 1);
+        float wx = ox == 1 ? fr.x : 1.0 - fr.x;
+        float wy = oy == 1 ? fr.y : 1.0 - fr.y;
+        float wb = wx * wy;
+        vec2 hs = texelFetch(depth_tex, t, 0).rg;
+        float ds = planar(hs.g);
+        vec4 c = texelFetch(color_tex, t, 0);
+        if (abs(ds - dp) <= box.z) {
+            acc_a += wb * c;
+            accu_a += c;
+            w_a += wb;
+            n_a += 1.0;
+            hit_a = min(hit_a, hs.r);
+        }
+        else if (ds < dp - box.z) {
+            acc_b += wb * c;
+            accu_b += c;
+            w_b += wb;
+            n_b += 1.0;
+            hit_b = min(hit_b, hs.r);
+        }
+    }
+    float hit = 1.0;
+    fragColor = vec4(0.0);
+    if (n_a > 0.0) {
+        fragColor = w_a > 1e-4 ? acc_a / w_a : accu_a / n_a;
+        hit = hit_a;
+    }
+    else if (n_b > 0.0) {
+        fragColor = w_b > 1e-4 ? acc_b / w_b : accu_b / n_b;
+        hit = hit_b;
+    }
+    gl_FragDepth = min(hit, scene);
+}
+"""
+
+# "bilateral" (the default) or "nearest" (how frames were composited
+# before: blocks at preview scales); the bench and the GUI test switch it.
+PREVIEW_FILTER = os.environ.get("VOXLIGHT_PREVIEW_FILTER", "bilateral")
 
 
 def _get_shader():
     global _shader, _batch
     if _shader is None:
-        _shader, _batch = gpu_quad.quad_shader("voxlight", ("color_tex", "depth_tex"), _FRAG)
+        _shader, _batch = gpu_quad.quad_shader(
+            "voxlight", ("color_tex", "depth_tex", "scene_tex"), _FRAG,
+            constants=(("VEC4", "proj_rows"), ("VEC4", "box"), ("INT", "filter_mode")))
     return _shader, _batch
 
 
@@ -291,24 +377,34 @@ def _library_depth(win_small, proj, near, far, quantum, rect):
 
 
 def _fragment_depth(vdepth, proj, win_small, rect):
-    """Window depth written by the volume's quad: the volume's hit depth
-    where its rays hit (never behind the scene), the scene's own depth
-    elsewhere (1 without one). Outside `rect` a frame has no hit
-    (render_tiled leaves +inf there), so only the footprint is computed;
-    the result equals the whole image's."""
-    def compute(vd, win):
-        frag = _depth.planar_to_window(vd, proj)
-        if win is not None:
-            frag = np.where(np.isfinite(vd), np.minimum(frag, win), win)
-        return frag
-    if rect is None:
-        return compute(vdepth, win_small)
-    x0, y0, x1, y1 = rect
-    out = (np.array(win_small, np.float32) if win_small is not None
-           else np.ones(vdepth.shape, np.float32))
-    out[y0:y1, x0:x1] = compute(vdepth[y0:y1, x0:x1],
-                                None if win_small is None else win_small[y0:y1, x0:x1])
+    """(h, w, 2): the window depth of the volume's hit (1 where its ray hit
+    nothing) and of the scene depth that stopped the frame's rays (1
+    without one), as upsample.composite takes them. Outside `rect` a frame
+    has no hit (render_tiled leaves +inf there), so only the footprint is
+    converted; the result equals the whole image's."""
+    h, w = vdepth.shape
+    out = np.ones((h, w, 2), np.float32)
+    if win_small is not None:
+        out[..., 1] = win_small
+    x0, y0, x1, y1 = rect if rect is not None else (0, 0, w, h)
+    out[y0:y1, x0:x1, 0] = _depth.planar_to_window(vdepth[y0:y1, x0:x1], proj)
     return out
+
+
+# The scene's window depth at full resolution as a texture, for the
+# shader's depth-aware upsampling; one upload per new depth buffer.
+_scene_tex = {}
+
+
+def _scene_texture(window):
+    key = None if window is None else (window.crc, window.pixels.shape)
+    tex = _scene_tex.get(key)
+    if tex is None:
+        _scene_tex.clear()
+        tex = _scene_tex[key] = _texture(window.pixels if window is not None
+                                         else np.ones((1, 1), np.float32), "R32F")
+        _profile.mark("scene_texture")
+    return tex
 
 
 # Scene depth converted for the library, per frame size and footprint,
@@ -461,8 +557,9 @@ class _Frame:
         self.rect = overlay_frames.screen_rect(model, dims, ovl, view, proj, w, h)
         self.win_small = None
         scene_depth = None
+        near, far = overlay_frames.planar_range(model, dims, ovl, view)
+        self.box = (max(near, 0.0), far, _upsample.tolerance(volume_space.voxel_size(model)))
         if window_depth is not None:
-            near, far = overlay_frames.planar_range(model, dims, ovl, view)
             quantum = 0.125 * volume_space.voxel_size(model)
             self.win_small, scene_depth = _scene_depth(window_depth, w, h, proj, near, far,
                                                        quantum, self.rect)
@@ -491,12 +588,17 @@ def _rect_pixels(rect):
     return 0 if rect is None else (rect[2] - rect[0]) * (rect[3] - rect[1])
 
 
-def _draw_image(img, shader, batch):
+def _draw_image(img, shader, batch, scene_tex):
     if img is None or img.color is None:
         return
     shader.bind()
     shader.uniform_sampler("color_tex", img.color)
     shader.uniform_sampler("depth_tex", img.depth)
+    shader.uniform_sampler("scene_tex", scene_tex)
+    p = np.asarray(img.proj, np.float64).reshape(4, 4)
+    shader.uniform_float("proj_rows", (p[2, 2], p[2, 3], p[3, 2], p[3, 3]))
+    shader.uniform_float("box", (img.box[0], img.box[1], img.box[2], 0.0))
+    shader.uniform_int("filter_mode", 0 if PREVIEW_FILTER == "nearest" else 1)
     gpu.state.depth_test_set("LESS_EQUAL")
     # No depth writes: Blender may redraw only the overlays and keep the
     # scene's depth buffer, and the next frame's depth read must not see
@@ -634,7 +736,7 @@ def _draw():
                                   shown.height))
             st.shown = shown
             _profile.mark("update")
-            _draw_image(shown, shader, batch)
+            _draw_image(shown, shader, batch, _scene_texture(window_depth))
             _profile.mark("gpu_draw")
             if shown is not None:
                 _profile.note("%s %dx%d scale %.3f" % (_kind(st, shown), shown.width, shown.height,
@@ -751,7 +853,8 @@ def _refine_still(st, s, args, owner):
             rgba, vdepth, stats = job.result
             if _rect_pixels(fr.rect) > 0 and stats.get("seconds", 0.0) > 0.0:
                 st.refine_spp = stats["seconds"] / _rect_pixels(fr.rect)
-            img = _Image(fr.key, rgba, vdepth, fr.win_small, args[5], fr is full, fr.scale, fr.rect)
+            img = _Image(fr.key, rgba, vdepth, fr.win_small, args[5], fr is full, fr.scale, fr.rect,
+                         fr.box)
             _note_streaming(img, stats, st.full if fr is full and st.full is not None
                             and st.full.key == fr.key else None)
             st.job = None
@@ -852,7 +955,8 @@ def _preview(st, s, args):
     pixels = _rect_pixels(fast.rect)
     st.policy.observe(time.perf_counter() - t, pixels)
     st.pixels_at_scale_1 = pixels / (fast.scale * fast.scale)
-    st.fast = _Image(fast.key, rgba, vdepth, fast.win_small, args[5], False, fast.scale, fast.rect)
+    st.fast = _Image(fast.key, rgba, vdepth, fast.win_small, args[5], False, fast.scale, fast.rect,
+                     fast.box)
     return st.fast
 
 
@@ -862,6 +966,7 @@ def _forget_all():
     _states.clear()
     scene_shadows_viewport.forget()
     _depth_cache.clear()
+    _scene_tex.clear()
 
 
 @persistent

@@ -250,11 +250,19 @@ class VOXLIGHT_PT_slice_plane(bpy.types.Panel):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "object"
+    bl_order = -1  # on top of Object properties, like the volume's panel
 
     @classmethod
     def poll(cls, context):
+        """A slice plane, or a flat mesh (a plane: the slice is its
+        bounding rectangle) while the file has a Voxlight volume to slice;
+        never the default Cube or other solid meshes."""
         ob = context.object
-        return ob is not None and ob.type == "MESH"
+        if slice_planes.is_slice(ob):
+            return True
+        if ob is None or ob.type != "MESH" or min(ob.dimensions) > 1e-6:
+            return False
+        return any(o.voxlight.is_volume for o in bpy.data.objects)
 
     def draw(self, context):
         layout = _split(self.layout)

@@ -18,8 +18,9 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
 from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix
 
-from . import label_props, preferences, tf
-from .core import framing, import_job, label_import, orientation, runtime, volume_space
+from . import label_props, mode_start, preferences, tf
+from .core import (framing, import_job, label_import, orientation, runtime, startup_cube,
+                   volume_space)
 
 
 def _to_matrix(a):
@@ -69,27 +70,30 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
                                           "(image stack or DICOM series)")
     # Default 0.01: 1 mm becomes 1 cm, so a 180 mm head is 1.8 units across,
     # the size of Blender's default cube. Use 0.001 for true metres.
-    unit_scale: FloatProperty(name="Scene Units per mm", default=0.01, min=1e-6, max=1e3,
+    unit_scale: FloatProperty(name="Units per mm", default=0.01, min=1e-6, max=1e3,
                               soft_min=0.0001, soft_max=1.0,
-                              description="Scene units per millimetre of the scan "
-                                          "(OpenVDB files are in scene units already)")
-    center: BoolProperty(name="Center at 3D Cursor", default=True,
+                              description="Scene units per millimetre of the scan (0.01: a "
+                                          "180 mm head is 1.8 units, the default cube's size; "
+                                          "0.001: true metres). OpenVDB files are in scene "
+                                          "units already")
+    center: BoolProperty(name="Center at Cursor", default=True,
                          description="Put the volume's centre at the 3D cursor instead of "
                                      "at the scanner origin")
-    voxel_size: FloatVectorProperty(name="Voxel Size (mm)", size=3, default=(1.0, 1.0, 1.0),
+    voxel_size: FloatVectorProperty(name="Voxel Size", size=3, default=(1.0, 1.0, 1.0),
                                     min=1e-6, soft_min=0.001, soft_max=100.0, precision=4,
-                                    description="x, y, z voxel size for inputs without geometry "
-                                                "(TIFF/PNG stacks); files with geometry ignore it")
+                                    description="x, y, z voxel size in millimetres for inputs "
+                                                "without geometry (TIFF/PNG stacks); files with "
+                                                "geometry ignore it")
     # DICOM folders with several series: which one (index or UID, as
     # native.list_dicom_series / `voxlight info` list them); "" = the only one.
-    series: StringProperty(name="DICOM Series", default="",
+    series: StringProperty(name="Series", default="",
                            description="Series of a DICOM folder to import: index or "
                                        "SeriesInstanceUID (empty = the only series)")
     # orientation.py: 180 degrees about Z, so Front (numpad 1) shows the face.
     anatomical_views: BoolProperty(
-        name="Blender Views Match Anatomy", default=True,
-        description="Turn the scan so Front (numpad 1) shows the face, Top the top of the head, "
-                    "and Left/Right the patient's right/left side, as for a Blender character. "
+        name="Anatomical Views", default=True,
+        description="Blender's views match the anatomy: turn the scan so Front (numpad 1) "
+                    "shows the face, Top the top of the head, and Left/Right the patient's right/left side, as for a Blender character. "
                     "Off keeps the scanner's (RAS) axes. Image stacks and OpenVDB have no anatomy "
                     "and are never turned")
     frame_in_view: BoolProperty(name="Frame in View", default=True,
@@ -103,6 +107,12 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
     lookup_file: StringProperty(name="Lookup File", default="", subtype="FILE_PATH",
                                 description="Label names and colours (empty = the first lookup "
                                             "file found beside the image)")
+    # core/startup_cube.py: why hiding it is the right first sight.
+    hide_startup_cube: BoolProperty(
+        name="Hide Startup Cube", default=True,
+        description="Hide the factory startup Cube (unedited, at the origin) from the viewport "
+                    "and renders when it overlaps the volume, so the volume is what you see. "
+                    "The Outliner's eye (or Alt+H) shows it again; undo restores it")
     # Set by invoke: the file browser path runs modal, scripts block.
     use_modal: BoolProperty(default=False, options={"HIDDEN", "SKIP_SAVE"})
 
@@ -182,7 +192,8 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             self.report({"ERROR"}, "Voxlight: cannot import %s: %s" % (name, e))
             return {"CANCELLED"}
         runtime.adopt(entry)
-        self.report({"INFO"}, import_job.import_report(name, entry.info, self._why))
+        self.report({"INFO"}, import_job.import_report(name, entry.info, self._why)
+                    + self._cube_note)
         return {"FINISHED"}
 
     def _label_plan(self, context, path, info):
@@ -239,6 +250,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             obj.voxlight.orientation = turn
             context.collection.objects.link(obj)
             tf.ensure_texture(obj, info)  # the preset that suits the data, fitted to it
+            mode_start.fit_iso(obj, info)  # ISO shows a surface the first time it is picked
         except Exception:
             tex = obj.voxlight.tf_texture
             if tex is not None:
@@ -249,9 +261,31 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
             o.select_set(False)
         obj.select_set(True)
         context.view_layer.objects.active = obj
+        self._cube_note = hide_startup_cube(context, obj) if self.hide_startup_cube else ""
         if self.frame_in_view:
             frame_in_views(context, obj)
         return obj
+
+
+def hide_startup_cube(context, obj):
+    """Hides the factory Cube when it overlaps the new volume's box
+    (core/startup_cube.py says when and why); returns the sentence the
+    import report adds, "" when nothing was hidden."""
+    model = np.array(obj.matrix_world, np.float64) @ \
+        np.array(obj.voxlight.voxel_to_local, np.float64).reshape(4, 4).T
+    corners = volume_space.world_corners(model, tuple(obj.voxlight.dims))
+    box = (np.min(corners, 0), np.max(corners, 0))
+    for ob in context.view_layer.objects:
+        if ob.type != "MESH" or ob.hide_get() or not startup_cube.is_factory_cube(
+                ob.name, ob.type, len(ob.data.vertices), ob.matrix_world,
+                [tuple(c) for c in ob.bound_box]):
+            continue
+        if not startup_cube.overlaps(box, startup_cube.world_box(ob.matrix_world, ob.bound_box)):
+            continue
+        ob.hide_set(True)
+        ob.hide_render = True
+        return "; hid the startup Cube, which hid the volume (Outliner or Alt+H shows it)"
+    return ""
 
 
 def _lookup_ids(path):

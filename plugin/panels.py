@@ -48,6 +48,12 @@ class _VolumePanel(OnActiveVolume):
 class VOXLIGHT_PT_volume(_VolumePanel, bpy.types.Panel):
     bl_label = "Voxlight"
     bl_idname = "VOXLIGHT_PT_volume"
+    # Add-ons cannot add a Properties tab, and the volume is an object, so
+    # its settings belong in the Object tab (as a Light's or Camera's own
+    # settings are their object's data); Blender's own Object panels are
+    # order 0 and registered first, so -1 puts this one on top, in reach
+    # without scrolling past Transform, Relations and the rest.
+    bl_order = -1
 
     def draw(self, context):
         layout = _split(self.layout, decorate=False)
@@ -185,11 +191,13 @@ class VOXLIGHT_PT_volume_lighting(_VolumePanel, bpy.types.Panel):
         sub.active = p.shading_model == "scatter"
         sub.prop(p, "anisotropy", slider=True)
         # Scene shadows (issue 18): the volume and the scene's meshes.
-        col = layout.column(heading="Scene", align=True)
-        col.prop(p, "cast_shadows")
+        # Short texts: a checkbox's text shares the value column with the
+        # checkbox (the tooltips keep the detail).
+        col = layout.column(heading="Scene Shadows", align=True)
+        col.prop(p, "cast_shadows", text="Cast")
         sub = col.column(align=True)
         sub.active = p.shading_model != "phong"  # Phong has no shadows to cut
-        sub.prop(p, "receive_shadows")
+        sub.prop(p, "receive_shadows", text="Receive")
 
 
 class VOXLIGHT_PT_volume_advanced(_VolumePanel, bpy.types.Panel):

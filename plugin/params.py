@@ -9,6 +9,7 @@ from .core import lights as _lights
 from .core import native
 from . import cutaway
 from . import label_props
+from . import mode_start
 from . import tf as _tf
 
 
@@ -46,7 +47,9 @@ def look_kwargs(props, fast=False, dragging=False):
         opacity_scale=props.opacity_scale,
         shading=props.shading,
         material=(props.ambient, props.diffuse, props.specular, props.shininess),
-        tf_rgba=_tf.table(props) if props.use_color_ramp or not legacy else None,
+        # Projections scale the ramp's opacity to full (mode_start.look_table).
+        tf_rgba=mode_start.look_table(
+            props, _tf.table(props) if props.use_color_ramp or not legacy else None),
         classify=props.classify,
         gradient_opacity=props.gradient_opacity,
         gradient_ref=props.gradient_ref,

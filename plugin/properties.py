@@ -128,6 +128,12 @@ def tag_redraw(self=None, context=None):
                 area.tag_redraw()
 
 
+def _render_mode_changed(self, context):
+    from . import mode_start
+    mode_start.switched(self, context)
+    tag_redraw(self, context)
+
+
 class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     # --- identity, set by the importer (not animatable: they are data, not looks)
     is_volume: BoolProperty(name="Voxlight Volume", default=False, options=set(),
@@ -324,9 +330,19 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                                               "and Scatter models)")
     # --- render mode, MatCap and cutaways (issue 19; cutaway_props.py, cutaway.py)
     render_mode: EnumProperty(name="Render Mode", items=MODE_ITEMS, default="dvr",
-                              update=tag_redraw,
+                              update=_render_mode_changed,
                               description="How each ray's samples become a pixel: volume "
                                           "rendering, a projection, or an iso-surface")
+    # Each mode's own window (mode_start.py): (low, high) per mode in
+    # mode_fit.MODES order, a bit per mode that has one, and the mode the
+    # current Low/High belong to.
+    mode_windows: FloatVectorProperty(name="Mode Windows", size=10, options={"HIDDEN"},
+                                      description="Low/High of each render mode, kept while "
+                                                  "another mode is shown")
+    mode_windows_set: IntProperty(name="Mode Windows Set", default=0, options={"HIDDEN"},
+                                  description="Which render modes have a kept window")
+    window_mode: StringProperty(name="Window Mode", default="dvr", options={"HIDDEN"},
+                                description="The render mode the current window belongs to")
     matcap: EnumProperty(name="MatCap", items=cutaway_props.matcap_items, update=tag_redraw,
                          description="Shade surfaces with one of Blender's MatCaps (a picture "
                                      "of a lit sphere, as in Solid mode) instead of the "

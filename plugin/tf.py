@@ -189,6 +189,11 @@ def fit_window(obj, low_quantile=0.0, high_quantile=0.995):
     stretched over the non-background voxels from low_quantile to
     high_quantile. Returns (low, high)."""
     p = obj.voxlight
+    if p.render_mode != "dvr":  # the other modes have their own windows
+        from . import mode_start
+        lo_hi = mode_start.fit_window(obj)
+        if lo_hi is not None:
+            return lo_hi
     name, modified = preset_state(p)
     if name and not modified:
         load_preset(obj, p.tf_preset)

@@ -121,7 +121,7 @@ class VOXLIGHT_PT_volume_object(bpy.types.Panel):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "object"
-    bl_order = -1  # above the Voxlight settings panel that appears when on
+    bl_order = -2  # above the Voxlight settings panel (order -1) that appears when on
 
     @classmethod
     def poll(cls, context):

@@ -56,10 +56,13 @@ class _Recorder:
             if name == "prop" and len(args) >= 2:
                 data, ident = args[0], args[1]
                 text = kw.get("text")
+                prop = data.bl_rna.properties[ident]
                 if text is None:
-                    text = data.bl_rna.properties[ident].name
+                    text = prop.name
                 if text:
-                    self.labels.append((ident, text))
+                    # A checkbox's text sits in the value column beside the box.
+                    box = prop.type == "BOOLEAN" and not getattr(prop, "is_array", False)
+                    self.labels.append((ident, text, box))
             return _Recorder(self.labels)
         return call
 
@@ -74,11 +77,30 @@ def panel_labels(ob):
         object = ob
         region = None
         preferences = bpy.context.preferences
-    for name in ("VOXLIGHT_PT_volume", "VOXLIGHT_PT_volume_rendering", "VOXLIGHT_PT_volume_tf",
-                 "VOXLIGHT_PT_volume_lighting", "VOXLIGHT_PT_volume_advanced"):
+        scene = bpy.context.scene
+    failed = []
+    # Every Voxlight panel of the Properties editor, drawn for the volume.
+    for name in sorted(n for n in dir(bpy.types) if n.startswith("VOXLIGHT_PT_")):
         panel = getattr(bpy.types, name)
-        getattr(panel, "draw")(type("P", (), {"layout": _Recorder(labels)})(), Ctx)
-    return labels
+        if getattr(panel, "bl_space_type", "") != "PROPERTIES":
+            continue
+        try:
+            getattr(panel, "draw")(type("P", (), {"layout": _Recorder(labels)})(), Ctx)
+        except Exception as e:  # a draw that needs more context than the stand-in has
+            failed.append("%s: %s" % (name, e))
+    return labels, failed
+
+
+def import_option_labels():
+    """(ident, text, is checkbox) of every import option the file
+    browser's side bar shows (the operator's visible properties)."""
+    rna = bpy.ops.voxlight.import_volume.get_rna_type()
+    out = []
+    for prop in rna.properties:
+        if prop.identifier == "rna_type" or prop.is_hidden or not prop.name:
+            continue
+        out.append((prop.identifier, prop.name, prop.type == "BOOLEAN"))
+    return out
 
 
 def text_width(text):
@@ -136,14 +158,27 @@ def steps():
     width = region.width * max(1.0, 1920.0 / win.width)
     content = width - 2 * 20 * scale  # panel margins and the keyframe-dot column
     room = SPLIT * content - LABEL_MARGIN_PX * scale
+    # A checkbox's text shares the value column with the box (a UI unit).
+    box_room = (1.0 - SPLIT) * content - (20 + LABEL_MARGIN_PX) * scale
     too_long = []
-    for ident, text in panel_labels(ob):
+    labels, failed = panel_labels(ob)
+    check("every_panel_drawn", not failed, failed)
+    for ident, text, box in labels:
         w = text_width(text)
-        if w > room:
+        if w > (box_room if box else room):
             too_long.append("%s %r %.0f px" % (ident, text, w))
     check("labels_fit_at_default_width", not too_long,
-          "editor %d px wide (%d here), label column %.0f px; too long: %s"
-          % (width, region.width, room, too_long))
+          "editor %d px wide (%d here), label column %.0f px, checkbox text %.0f px; too "
+          "long: %s" % (width, region.width, room, box_room, too_long))
+    # The import options in the file browser's side bar, measured against
+    # the same columns (an assumption: the side bar's default width is not
+    # measured here, the file browser is not opened).
+    too_long = []
+    for ident, text, box in import_option_labels():
+        w = text_width(text)
+        if w > (box_room if box else room):
+            too_long.append("%s %r %.0f px" % (ident, text, w))
+    check("import_options_fit", not too_long, "too long: %s" % too_long)
 
     out_dir = os.environ.get("VOXLIGHT_SCREENSHOT_DIR", u.TMP)
     os.makedirs(out_dir, exist_ok=True)

@@ -36,7 +36,7 @@ static const char usage_format[] =
     "                  [--mode %s] [--iso-value V] [--matcap FILE.png] [--ortho]\n"
     "                  [--view x|-x|y|-y|z|-z] [--streaming %s] [--cache-dir DIR]\n"
     "                  [--clip-plane A,B,C,D[,T]]... [--crop X0:X1,Y0:Y1,Z0:Z1] [--no-caps]\n"
-    "                  [--labels LABELS [--label-lut FILE] [--label-mode surface|mask|tint]\n"
+    "                  [--labels LABELS [--label-lut FILE] [--label-mode surface|mask|tint] [--label-surface smooth|voxels]\n"
     "                   [--hide-labels ID,...] [--label-opacity ID:ALPHA,...]]\n"
     "                  [--overlay FILE[:PRESET][:LO:HI] [--overlay-blend over|add|max] [--overlay-opacity X]]...\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID] [--streaming MODE] [--cache-dir DIR]\n"

@@ -29,7 +29,7 @@ int vxl_cli_labels_option(int argc, char **argv, int *i, vxl_cli_labels *l, char
                         : !strcmp(o, "--hide-labels")   ? &l->hide
                         : !strcmp(o, "--label-opacity") ? &l->opacity
                                                         : NULL;
-    if (!slot && strcmp(o, "--label-mode")) return 0;
+    if (!slot && strcmp(o, "--label-mode") && strcmp(o, "--label-surface")) return 0;
     if (*i + 1 >= argc) {
         snprintf(err, err_size, "%s needs a value", o);
         return -1;
@@ -37,6 +37,15 @@ int vxl_cli_labels_option(int argc, char **argv, int *i, vxl_cli_labels *l, char
     const char *val = argv[++*i];
     if (slot) {
         *slot = val;
+        return 1;
+    }
+    if (!strcmp(o, "--label-surface")) {
+        if (strcmp(val, "smooth") && strcmp(val, "voxels")) {
+            snprintf(err, err_size, "unknown --label-surface '%s' (smooth, voxels)", val);
+            return -1;
+        }
+        l->boundary = !strcmp(val, "voxels") ? VXL_LABEL_BOUNDARY_VOXELS : VXL_LABEL_BOUNDARY_SMOOTH;
+        l->boundary_set = 1;
         return 1;
     }
     if (vxl_label_mode_from_name(val, &l->mode) != VXL_OK) {
@@ -169,8 +178,8 @@ static int load_table(vxl_cli_labels *l, const vxl_volume *v, char *err, size_t 
 int vxl_cli_labels_apply(vxl_cli_labels *l, vxl_renderer *r, vxl_render_params *p, char *err, size_t err_size)
 {
     if (!l->path) {
-        if (l->lut || l->hide || l->opacity) {
-            snprintf(err, err_size, "--label-lut, --hide-labels and --label-opacity need --labels FILE");
+        if (l->lut || l->hide || l->opacity || l->boundary_set) {
+            snprintf(err, err_size, "--label-lut, --hide-labels, --label-opacity and --label-surface need --labels FILE");
             return 1;
         }
         return 0;
@@ -188,7 +197,7 @@ int vxl_cli_labels_apply(vxl_cli_labels *l, vxl_renderer *r, vxl_render_params *
     vxl_volume_destroy(v);
     if (rc || apply_lists(l, err, err_size)) return 1;
     l->style = (vxl_label_style){.struct_size = sizeof l->style, .mode = l->mode, .entry_count = l->count,
-                                 .entries = l->entries};
+                                 .entries = l->entries, .boundary = l->boundary};
     p->labels = &l->style;
     return 0;
 }

@@ -1,6 +1,7 @@
 /* cli_labels_render.h - the render command's label options (issue 20):
  * --labels FILE, --label-lut FILE, --label-mode surface|mask|tint,
- * --hide-labels ID,... and --label-opacity ID:ALPHA,... into
+ * --hide-labels ID,..., --label-opacity ID:ALPHA,... and
+ * --label-surface smooth|voxels into
  * vxl_renderer_set_labels and params.labels (docs/labels.md). Without
  * --label-lut the lookup file is looked for beside FILE (same stem with
  * .lut, .txt, .ctbl or .label, as plugin/core/label_files.py does); without
@@ -16,6 +17,8 @@
 typedef struct vxl_cli_labels {
     const char *path, *lut;          /* --labels, --label-lut */
     uint32_t mode;                   /* --label-mode */
+    uint32_t boundary;               /* --label-surface: VXL_LABEL_BOUNDARY_* */
+    int boundary_set;
     const char *hide, *opacity;      /* the option values, applied once the table is known */
     vxl_label_entry *entries;        /* the table (owned) */
     uint32_t count;

@@ -95,6 +95,7 @@ typedef struct vxl_frame {
     struct {
         int on;
         uint32_t mode;                  /* VXL_LABEL_MODE_* */
+        int voxels;                     /* boundary VXL_LABEL_BOUNDARY_VOXELS: the voxels' faces */
         const vxl_label_entry *entries; /* the caller's, checked */
         uint32_t count, stride;         /* entries and their stride in bytes */
         uint64_t key;                   /* hash of the table (ids, colours, visibility) */

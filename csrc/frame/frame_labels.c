@@ -16,6 +16,14 @@ int vxl_frame_resolve_labels(vxl_frame *f, const vxl_render_params *p, vxl_err *
     if (s->mode >= VXL_LABEL_MODE_COUNT)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown label mode %u (0 surface, 1 mask, 2 tint)", s->mode);
     if (s->reserved) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "labels.reserved is %u: it must be 0", s->reserved);
+    uint32_t boundary = VXL_LABEL_BOUNDARY_SMOOTH;
+    if (s->struct_size >= offsetof(vxl_label_style, reserved2) + sizeof s->reserved2) {
+        if (s->boundary > VXL_LABEL_BOUNDARY_VOXELS)
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown label boundary %u (0 smooth, 1 voxels)", s->boundary);
+        if (s->reserved2)
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "labels.reserved2 is %u: it must be 0", s->reserved2);
+        boundary = s->boundary;
+    }
     if (s->entry_count && !s->entries)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "labels.entries is NULL with entry_count %u", s->entry_count);
     if (s->entry_count > VXL_MAX_LABEL_ID + 1u)
@@ -70,6 +78,7 @@ int vxl_frame_resolve_labels(vxl_frame *f, const vxl_render_params *p, vxl_err *
     if (rc) return rc;
     f->labels.on = 1;
     f->labels.mode = s->mode;
+    f->labels.voxels = boundary == VXL_LABEL_BOUNDARY_VOXELS;
     f->labels.entries = s->entries;
     f->labels.count = s->entry_count;
     f->labels.stride = stride;

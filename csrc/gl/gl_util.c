@@ -99,8 +99,8 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
                      (flags & VXL_FLAG_CUT_CONVEX) ? "#define CUT_CONVEX 1\n" : "",
                      (flags & VXL_FLAG_CUT_CUTTERS) ? "#define CUT_CUTTERS 1\n" : "");
         if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* issue 20: label mode + 1 */
-            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABELS %u\n",
-                     (flags >> VXL_FLAG_LABELS_SHIFT) & 3);
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABELS %u\n%s",
+                     (flags >> VXL_FLAG_LABELS_SHIFT) & 3, (flags & VXL_FLAG_LABEL_VOXELS) ? "#define LABEL_VOXELS 1\n" : "");
         if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3) /* issue 20: the number of overlays */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define OVERLAYS %u\n",
                      (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3);
@@ -147,8 +147,8 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         snprintf(defines, sizeof defines, "%s#define PASS %u\n#define GOPACITY %u\n%s", paged, flags & 3, (flags >> 2) & 3,
                  (flags & VXL_FLAG_CUT_CONVEX) ? "#define CUT_KEEPS 1\n" : "");
         if ((flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* the extinction leaves hidden labels out: label mode + 1 */
-            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABEL_SHADOWS %u\n",
-                     (flags >> VXL_FLAG_LABELS_SHIFT) & 3);
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABEL_SHADOWS %u\n%s",
+                     (flags >> VXL_FLAG_LABELS_SHIFT) & 3, (flags & VXL_FLAG_LABEL_VOXELS) ? "#define LABEL_VOXELS 1\n" : "");
         rc = compile(g, GL_COMPUTE_SHADER, "compute/illumination.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_SLICE_PLANE: /* slice_plane.c: flags & 3 the interpolation (VXL_INTERP_*), plus the sample flags */

@@ -55,6 +55,8 @@
 #define VXL_FLAG_LABELS_SHIFT 16u
 /* Ray caster program flag of issue 20 (overlay/overlays.c): bits 18-19 hold the number of overlays (OVERLAYS); 0 none. */
 #define VXL_FLAG_OVERLAYS_SHIFT 18u
+/* With the LABELS bits: label boundaries as the voxels' faces (LABEL_VOXELS), not smooth. */
+#define VXL_FLAG_LABEL_VOXELS (1u << 21)
 
 typedef struct vxl_program_entry {
     uint64_t key; /* kind | filter << 5 | flags << 12 (gl_util.c): every flag bit fits */

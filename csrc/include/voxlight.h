@@ -524,14 +524,17 @@ typedef struct vxl_scene_shadows {
 } vxl_scene_shadows;
 
 /* Label maps (issue 20), params.labels with a label volume set by
- * vxl_renderer_set_labels. Label ids are never interpolated as numbers: the
- * boundary of each label is the 0.5 level of its indicator function
- * (1 inside the label's voxels, 0 elsewhere) filtered with the cubic
- * B-spline (trilinear filtering left +-0.4 voxel bumps), so a labelled
- * sphere renders round and its normal is the indicator's gradient.
- * At a sample, the label is the visible one of the eight surrounding voxels
- * with the largest filtered indicator (the sample is outside every label
- * where that is below 0.5, or where the label is hidden or unlisted).
+ * vxl_renderer_set_labels. Label ids are never interpolated as numbers.
+ * Boundaries (`boundary`):
+ *   SMOOTH (0, the default) each label's indicator (1 on its voxels)
+ *          smoothed with a Gaussian (sigma 1.2 voxels) when the label volume
+ *          is set, with every voxel centre kept inside its own label; the
+ *          boundary is its 0.5 level, interpolated trilinearly, the normal
+ *          its gradient: no voxel stairs (docs/labels.md).
+ *   VOXELS (1) each sample is in the label of its nearest voxel: the
+ *          voxels' cube faces, with their face normals.
+ * At a sample, the label is the one of the eight surrounding voxels the
+ * sample lies deepest in (none where that one is hidden or unlisted).
  * Labels take the DVR mode and the ray caster (technique 0).
  *   SURFACE  label-only: the first visible label the ray meets is shaded as
  *            an opaque-per-alpha surface with its colour and the lights.
@@ -555,7 +558,12 @@ typedef struct vxl_label_style {
     const vxl_label_entry *entries; /* colour (alpha = opacity per voxel of path) and visibility per id;
                                        ids not listed are hidden; stride entries[0].struct_size. Changing
                                        them re-uploads only a small table, never the label volume */
+    /* appended: read only when struct_size covers it (older callers get SMOOTH) */
+    uint32_t boundary;           /* VXL_LABEL_BOUNDARY_*: 0 smooth */
+    uint32_t reserved2;          /* must be 0 */
 } vxl_label_style;
+#define VXL_LABEL_BOUNDARY_SMOOTH 0 /* smoothed per label, no voxel stairs */
+#define VXL_LABEL_BOUNDARY_VOXELS 1 /* the raw voxels' faces */
 
 /* Overlays (issue 20): up to VXL_MAX_OVERLAYS more volumes in the same ray
  * march as the renderer's volume, each set with vxl_renderer_set_overlay

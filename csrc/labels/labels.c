@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "holdings.h"
+#include "label_margin.h"
 #include "mat4.h"
 #include "volume.h"
 
@@ -25,6 +26,7 @@ static void release_volume(vxl_labels_state *s)
 {
     delete_tex(s, &s->volume_tex);
     delete_tex(s, &s->bricks_tex);
+    delete_tex(s, &s->margin_tex);
     vxl_label_bricks_free(&s->bricks);
     s->volume_bytes = 0;
     s->bytes = s->table_bytes;
@@ -76,23 +78,33 @@ int vxl_labels_set(vxl_labels_state *s, const vxl_volume *v)
     const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
     uint64_t bricks = 1; /* the brick texture: one word per brick */
     for (int a = 0; a < 3; a++) bricks *= (v->dims[a] + VXL_LABEL_BRICK - 1) / VXL_LABEL_BRICK;
-    const uint64_t bytes = n * sizeof(uint16_t) + bricks * sizeof(uint32_t);
+    /* the ids, the margins (one byte a voxel: smooth boundaries) and the brick words */
+    const uint64_t bytes = n * sizeof(uint16_t) + n + bricks * sizeof(uint32_t);
     /* the volume it replaces is not charged against it, the table is */
     uint64_t kept = s->volume_bytes;
     s->bytes -= kept;
-    int rc = vxl_holdings_ask(g, VXL_HOLD_LABELS, bytes + s->table_bytes, " (labels are stored densely, 2 bytes a voxel)",
+    int rc = vxl_holdings_ask(g, VXL_HOLD_LABELS, bytes + s->table_bytes, " (labels are stored densely, 3 bytes a voxel)",
                               "the %ux%ux%u label volume", v->dims[0], v->dims[1], v->dims[2]);
     s->bytes += kept;
     if (rc) return rc;
-    uint16_t *ids = malloc(bytes ? bytes : 1);
-    if (!ids) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the label volume");
+    uint16_t *ids = malloc(n ? n * sizeof(uint16_t) : 1);
+    uint8_t *margin = malloc(n ? n : 1);
+    if (!ids || !margin) {
+        free(ids);
+        free(margin);
+        return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the label volume");
+    }
     rc = convert_ids(v, ids, n, &g->err);
     vxl_label_bricks grid;
     memset(&grid, 0, sizeof grid);
     if (!rc && vxl_label_bricks_build(&grid, ids, v->dims))
         rc = vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the label volume's brick grid");
+    if (!rc && vxl_label_margin_build(margin, ids, v->dims))
+        rc = vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the label volume's margins");
     if (rc) {
+        vxl_label_bricks_free(&grid);
         free(ids);
+        free(margin);
         return rc;
     }
     vxl_gl *gl = &g->gl;
@@ -102,14 +114,22 @@ int vxl_labels_set(vxl_labels_state *s, const vxl_volume *v)
     gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R16UI, (GLsizei)v->dims[0], (GLsizei)v->dims[1], (GLsizei)v->dims[2], 0,
                    GL_RED_INTEGER, GL_UNSIGNED_SHORT, ids);
     free(ids);
+    /* the margins are read with texelFetch too: each corner's sign depends on the label asked about */
+    GLuint mtex = vxl_texture_new(g, GL_TEXTURE_3D, GL_NEAREST);
+    gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R8, (GLsizei)v->dims[0], (GLsizei)v->dims[1], (GLsizei)v->dims[2], 0, GL_RED,
+                   GL_UNSIGNED_BYTE, margin);
+    free(margin);
     rc = vxl_gl_check(g, "uploading the label volume");
     if (rc) {
         gl->DeleteTextures(1, &tex);
+        gl->DeleteTextures(1, &mtex);
         vxl_label_bricks_free(&grid);
         return rc;
     }
     release_volume(s);
     s->volume_tex = tex;
+    s->margin_tex = mtex;
     s->bricks = grid;
     s->bricks_stale = 1;
     memcpy(s->dims, v->dims, sizeof s->dims);
@@ -122,7 +142,8 @@ int vxl_labels_set(vxl_labels_state *s, const vxl_volume *v)
 
 uint32_t vxl_labels_flags(const vxl_frame *f)
 {
-    return f->labels.on ? (f->labels.mode + 1u) << VXL_FLAG_LABELS_SHIFT : 0u;
+    if (!f->labels.on) return 0u;
+    return (f->labels.mode + 1u) << VXL_FLAG_LABELS_SHIFT | (f->labels.voxels ? VXL_FLAG_LABEL_VOXELS : 0u);
 }
 
 /* Entry i of f's labels (the caller's stride). */
@@ -246,6 +267,9 @@ int vxl_labels_prepare(vxl_labels_state *s, const vxl_frame *f, GLuint prog, con
     gl->BindTexture(GL_TEXTURE_2D, s->table_tex);
     gl->ActiveTexture(GL_TEXTURE0 + VXL_LABEL_BRICKS_UNIT);
     gl->BindTexture(GL_TEXTURE_3D, s->bricks_tex);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_LABEL_MARGIN_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, s->margin_tex);
+    vxl_uniform_i(g, prog, "u_label_margin", VXL_LABEL_MARGIN_UNIT);
     vxl_uniform_i(g, prog, "u_labels", VXL_LABELS_UNIT);
     vxl_uniform_i(g, prog, "u_label_bricks", VXL_LABEL_BRICKS_UNIT);
     vxl_uniform_i(g, prog, "u_label_table", VXL_LABEL_TABLE_UNIT);

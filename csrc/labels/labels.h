@@ -4,7 +4,9 @@
  * per-label table (65536 ids as a 256x256 RGBA32F texture: colour and
  * alpha, alpha -1 for a hidden or unlisted id) rebuilt only when the
  * frame's table hash changes. shaders/lib/labels.glsl reads both.
- * Storage is dense (2 bytes per voxel), charged to the budget as a holding.
+ * Beside the ids, one byte a voxel: how far inside its own label the voxel
+ * lies (label_margin.h), which the smooth boundaries interpolate.
+ * Storage is dense (3 bytes per voxel), charged to the budget as a holding.
  * Beside them, the label bricks (label_bricks.h): where visible labels can
  * be, re-derived with the table, so the ray caster leaps over the rest. */
 #ifndef VXL_LABELS_H
@@ -22,6 +24,7 @@
 typedef struct vxl_labels_state {
     vxl_gpu *gpu;
     GLuint volume_tex;        /* R16UI label ids; 0 without a label volume */
+    GLuint margin_tex;        /* R8 per voxel: its margin inside its own label (label_margin.h) */
     GLuint table_tex;         /* RGBA32F id -> colour (alpha -1: hidden) */
     uint32_t dims[3];
     double affine[16];        /* the label volume's voxel -> world, column-major */

@@ -238,7 +238,9 @@ static int build_extinction(vxl_illumination_state *s, const vxl_frame *f)
     vxl_gl *gl = &s->gpu->gl;
     GLuint prog;
     uint32_t flags = f->gopacity << 2 | (cuts_convex(f) ? VXL_FLAG_CUT_CONVEX : 0) |
-                     (masks_labels(s, f) ? (f->labels.mode + 1u) << VXL_FLAG_LABELS_SHIFT : 0);
+                     (masks_labels(s, f) ? (f->labels.mode + 1u) << VXL_FLAG_LABELS_SHIFT |
+                                                (f->labels.voxels ? VXL_FLAG_LABEL_VOXELS : 0u)
+                                          : 0);
     int rc = pass_program(s, PASS_EXTINCTION, flags, s->extinction_cells, &prog);
     if (rc) return rc;
     if (cuts_convex(f)) bind_cut(s, prog, f);

@@ -1,11 +1,16 @@
 // labels.glsl - issue 20 label maps (docs/labels.md; the GL side is
 // csrc/labels/labels.c). LABELS is the label mode + 1: 1 SURFACE (label_march
 // replaces march), 2 MASK and 3 TINT (label_leap and label_mask in march).
-// Ids are never interpolated: ids are fetched with texelFetch and each
-// visible id's indicator (1 on its voxels) is filtered with the cubic
-// B-spline (4^3 taps; trilinear filtering leaves +-0.4 voxel bumps on a
-// labelled sphere); the sample lies in the id with the largest filtered
-// indicator when that is >= 0.5: boundaries are its smooth 0.5 level.
+// Ids are never interpolated: ids are fetched with texelFetch. Smooth
+// boundaries (the default): each voxel's margin inside its own label
+// (labels/label_margin.h: its label's indicator smoothed with a Gaussian,
+// minus 0.5, at least 0.05) makes label L's field +margin on L's voxels and
+// -margin on the others'; a sample lies in the label of the 8 nearest
+// voxels whose field, interpolated trilinearly, is largest, and L's
+// boundary is where its field crosses that of its neighbour (0 between two
+// labels). The cubic B-spline of the bare indicator tried before left the
+// voxels' stairs on gently sloping faces (its 4 taps span one step).
+// LABEL_VOXELS: the label of the nearest voxel, the voxels' faces.
 // Speed: the label bricks (labels/label_bricks.h) say per brick of label
 // voxels how far the nearest visible label may be, and which brick holds
 // one visible id alone; rays leap over the rest exactly as the samples
@@ -64,21 +69,14 @@ void label_corners(vec3 q, out uint ids[8], out vec3 f)
     }
 }
 
-// Cubic B-spline weights of the 4 taps at floor - 1 .. floor + 2 (w) and
-// their derivatives (d), per axis.
-void label_bspline(float f, out vec4 w, out vec4 d)
-{
-    float g = 1.0 - f, f2 = f * f;
-    w = vec4(g * g * g, 3.0 * f2 * f - 6.0 * f2 + 4.0, -3.0 * f2 * f + 3.0 * f2 + 3.0 * f + 1.0, f2 * f) / 6.0;
-    d = vec4(-0.5 * g * g, 1.5 * f2 - 2.0 * f, -1.5 * f2 + f + 0.5, 0.5 * f2);
-}
+#ifndef LABEL_VOXELS
+uniform sampler3D u_label_margin;   // R8 per label voxel: margin * 2 (label_margin.h)
+#endif
 
-// The visible id at a point with the largest filtered indicator (ind), its
-// table entry; id LABEL_NONE where that indicator is below 0.5 or no id is
-// visible.
+// The visible id at a point (LABEL_NONE where the label there is hidden,
+// unlisted or none) and its table entry.
 struct LabelHit {
     uint id;
-    float ind;
     vec4 color;
 };
 
@@ -86,112 +84,147 @@ LabelHit label_nothing()
 {
     LabelHit h;
     h.id = LABEL_NONE;
-    h.ind = 0.0;
     h.color = vec4(0.0);
     return h;
 }
 
-// The label at a point where s[c] is the filtered indicator of corner c's id
-// over the taps read so far, and r the weight of the taps not read: the id
-// with the most, once that is >= 0.5, is the one (no other can reach it; if
-// it is hidden, nothing is); when even r could not lift it to 0.5, no id
-// reaches 0.5. False while undecided.
-bool label_decide(uint ids[8], float s[8], float r, inout LabelHit h)
+LabelHit label_hit(uint id)
 {
-    float top = s[0];
-    uint id = ids[0];
-    for (int c = 1; c < 8; c++) { // no index chosen at run time: llvmpipe would put the arrays in memory
-        id = s[c] > top ? ids[c] : id;
-        top = max(top, s[c]);
-    }
-    if (top + r < 0.5) return true;
-    if (top < 0.5) return false;
+    LabelHit h = label_nothing();
     vec4 e = label_entry(id);
     if (e.a >= 0.0) {
         h.id = id;
-        h.ind = top;
         h.color = e;
     }
-    return true;
-}
-
-// w[i] without an index chosen at run time.
-float label_pick(vec4 w, int i)
-{
-    return dot(w, vec4(equal(ivec4(i), ivec4(0, 1, 2, 3))));
-}
-
-// Adds tap v of weight w to s[c] of every corner c with its id.
-void label_tap(ivec3 v, float w, uint ids[8], inout float s[8])
-{
-    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, textureSize(u_labels, 0)))) return;
-    uint id = texelFetch(u_labels, v, 0).r;
-    for (int c = 0; c < 8; c++) s[c] += id == ids[c] ? w : 0.0;
-}
-
-// label_at in a brick where visible labels can be but not one alone. Only
-// the ids of the 8 nearest voxels can win (an id none of them has cannot
-// reach 0.5: the outer taps weigh < 0.43 in all). The 64 taps of the
-// B-spline are read in stages, nearest first (the 8 inner ones, then the 8
-// beyond each pair of faces, then the 32 others) until the winner is
-// certain (label_decide): most samples stop after the first. ind is a lower
-// bound of the winner's filtered indicator.
-LabelHit label_at_mixed(vec3 q)
-{
-    LabelHit h = label_nothing();
-    uint ids[8];
-    vec3 f;
-    label_corners(q, ids, f);
-    // One id on all 8: inside it when it is visible (the 8 inner taps weigh
-    // >= 0.579), one table fetch.
-    bool same = true;
-    for (int c = 1; c < 8; c++) same = same && ids[c] == ids[0];
-    if (same) {
-        vec4 e = label_entry(ids[0]);
-        if (e.a >= 0.0) {
-            h.id = ids[0];
-            h.ind = 1.0;
-            h.color = e;
-        }
-        return h;
-    }
-    vec4 wx, wy, wz, dd;
-    label_bspline(f.x, wx, dd);
-    label_bspline(f.y, wy, dd);
-    label_bspline(f.z, wz, dd);
-    float s[8], w8[8];
-    for (int c = 0; c < 8; c++)
-        w8[c] = ((c & 1) != 0 ? wx.z : wx.y) * ((c & 2) != 0 ? wy.z : wy.y) * ((c & 4) != 0 ? wz.z : wz.y);
-    for (int c = 0; c < 8; c++) {
-        s[c] = 0.0;
-        for (int d = 0; d < 8; d++) s[c] += ids[d] == ids[c] ? w8[d] : 0.0;
-        if (ids[c] == LABEL_NONE) s[c] = 0.0;
-    }
-    vec3 inner = vec3(wx[1] + wx[2], wy[1] + wy[2], wz[1] + wz[2]), out3 = 1.0 - inner;
-    float r = 1.0 - inner.x * inner.y * inner.z;
-    if (label_decide(ids, s, r, h)) return h;
-    ivec3 b = ivec3(floor(q)) - 1;
-    // the taps beyond the faces across x, then y, then z
-    for (int a = 0; a < 3; a++) {
-        for (int k = 0; k < 8; k++) {
-            int o = (k & 1) * 3, u = 1 + ((k >> 1) & 1), v = 1 + (k >> 2); // outer along a, inner along the others
-            ivec3 t = a == 0 ? ivec3(o, u, v) : a == 1 ? ivec3(u, o, v) : ivec3(u, v, o);
-            label_tap(b + t, label_pick(wx, t.x) * label_pick(wy, t.y) * label_pick(wz, t.z), ids, s);
-        }
-        vec3 face = a == 0 ? vec3(out3.x, inner.y, inner.z) : a == 1 ? vec3(inner.x, out3.y, inner.z) : vec3(inner.xy, out3.z);
-        r -= face.x * face.y * face.z;
-        if (label_decide(ids, s, max(r, 0.0), h)) return h;
-    }
-    // the 32 taps outer along two or three axes
-    for (int z = 0; z < 4; z++)
-        for (int y = 0; y < 4; y++)
-            for (int x = 0; x < 4; x++) {
-                int outer = int(x == 0 || x == 3) + int(y == 0 || y == 3) + int(z == 0 || z == 3);
-                if (outer >= 2) label_tap(b + ivec3(x, y, z), label_pick(wx, x) * label_pick(wy, y) * label_pick(wz, z), ids, s);
-            }
-    label_decide(ids, s, 0.0, h);
     return h;
 }
+
+bool label_voxel_in(ivec3 v)
+{
+    return all(greaterThanEqual(v, ivec3(0))) && all(lessThan(v, textureSize(u_labels, 0)));
+}
+
+#ifdef LABEL_VOXELS
+// The id of the voxel nearest to label point q, visible or not.
+uint label_nearest(vec3 q)
+{
+    ivec3 v = ivec3(floor(q + 0.5));
+    return label_voxel_in(v) ? texelFetch(u_labels, v, 0).r : LABEL_NONE;
+}
+
+LabelHit label_at_mixed(vec3 q)
+{
+    return label_hit(label_nearest(q));
+}
+#else
+// The 8 voxels around label point q (the cell at floor(q)): their ids and
+// margins (outside the label volume: no label, as deep as a margin gets).
+struct LabelCell {
+    ivec3 base;
+    uint ids[8];
+    float mu[8];
+};
+
+void label_cell_fill(inout LabelCell c, vec3 q)
+{
+    ivec3 base = ivec3(floor(q));
+    if (base == c.base) return;
+    c.base = base;
+    for (int k = 0; k < 8; k++) {
+        ivec3 v = base + ivec3(k & 1, (k >> 1) & 1, k >> 2);
+        bool in_vol = label_voxel_in(v);
+        c.ids[k] = in_vol ? texelFetch(u_labels, v, 0).r : LABEL_NONE;
+        c.mu[k] = in_vol ? 0.5 * texelFetch(u_label_margin, v, 0).r : 0.5;
+    }
+}
+
+LabelCell label_cell_new()
+{
+    LabelCell c;
+    c.base = ivec3(-0x7fffffff);
+    for (int k = 0; k < 8; k++) {
+        c.ids[k] = LABEL_NONE;
+        c.mu[k] = 0.0;
+    }
+    return c;
+}
+
+// Trilinear weights of the cell's corners at fraction f.
+void label_weights(vec3 f, out float w[8])
+{
+    vec3 g = 1.0 - f;
+    for (int k = 0; k < 8; k++)
+        w[k] = ((k & 1) != 0 ? f.x : g.x) * ((k & 2) != 0 ? f.y : g.y) * ((k & 4) != 0 ? f.z : g.z);
+}
+
+// The field of label id at the cell's point with weights w: +margin on its
+// voxels, -margin on the others'.
+float label_field_w(LabelCell c, float w[8], uint id)
+{
+    float s = 0.0;
+    for (int k = 0; k < 8; k++) s += w[k] * (c.ids[k] == id ? c.mu[k] : -c.mu[k]);
+    return s;
+}
+
+// The id (visible or not) of the corner whose label's field is largest,
+// given the corners' ids and margins and the point's weights w: the label
+// the point lies in. A label's field is 2 S - T, with S the sum of w * margin
+// over its own corners and T that over all, so the largest S wins. No
+// index chosen at run time (llvmpipe would put the arrays in memory).
+uint label_winner_w(uint ids[8], float mu[8], float w[8])
+{
+    float wm[8];
+    for (int k = 0; k < 8; k++) wm[k] = w[k] * mu[k];
+    uint id = ids[0];
+    float top = -1.0;
+    for (int k = 0; k < 8; k++) {
+        float s = 0.0;
+        for (int d = 0; d < 8; d++) s += ids[d] == ids[k] ? wm[d] : 0.0;
+        id = s > top ? ids[k] : id;
+        top = max(top, s);
+    }
+    return id;
+}
+
+uint label_winner(inout LabelCell c, vec3 q)
+{
+    label_cell_fill(c, q);
+    float w[8];
+    label_weights(q - floor(q), w);
+    return label_winner_w(c.ids, c.mu, w);
+}
+
+// Label id's field at label point q, read afresh (the normal's taps).
+float label_field(vec3 q, uint id)
+{
+    LabelCell c = label_cell_new();
+    label_cell_fill(c, q);
+    float w[8];
+    label_weights(q - floor(q), w);
+    return label_field_w(c, w, id);
+}
+
+// label_at in a brick where visible labels can be but not one alone.
+LabelHit label_at_mixed(vec3 q)
+{
+    ivec3 b = ivec3(floor(q));
+    uint ids[8];
+    bool same = true;
+    for (int k = 0; k < 8; k++) {
+        ivec3 v = b + ivec3(k & 1, (k >> 1) & 1, k >> 2);
+        ids[k] = label_voxel_in(v) ? texelFetch(u_labels, v, 0).r : LABEL_NONE;
+        same = same && ids[k] == ids[0];
+    }
+    if (same) return label_hit(ids[0]); // one id on all 8 corners: in it, the margins unread
+    float mu[8], w[8];
+    for (int k = 0; k < 8; k++) {
+        ivec3 v = b + ivec3(k & 1, (k >> 1) & 1, k >> 2);
+        mu[k] = ids[k] != LABEL_NONE ? 0.5 * texelFetch(u_label_margin, v, 0).r : 0.5;
+    }
+    label_weights(q - vec3(b), w);
+    return label_hit(label_winner_w(ids, mu, w));
+}
+#endif
 
 // One ray in label voxels (label point qo + t qd at ray parameter t), the
 // part of it inside the label volume, its samples (t_start + i step) and the
@@ -241,7 +274,7 @@ uint label_word(inout LabelRay lr, vec3 q)
 
 // The label at label point q (label_at_mixed's meaning): nothing outside the
 // label volume or where no visible label can be, a UNIFORM brick's id with
-// no voxel read (every tap is that id: the indicator is exactly 1).
+// no voxel read (every corner is that id).
 LabelHit label_at(inout LabelRay lr, vec3 q)
 {
     if (!label_inside(q)) return label_nothing();
@@ -250,7 +283,6 @@ LabelHit label_at(inout LabelRay lr, vec3 q)
     if ((w & LABEL_UNIFORM) == 0u) return label_at_mixed(q);
     LabelHit h;
     h.id = w >> 16u;
-    h.ind = 1.0;
     h.color = lr.color;
     return h;
 }
@@ -299,63 +331,32 @@ int label_leap(inout LabelRay lr, int i, float t, vec3 q, inout uint keep)
 }
 
 #if LABELS == 1
-// The indicator of one label on the 4^3 taps of one label cell, as 64 bits
-// (bit x + 4 y + 16 z): the bisection and the normal at a crossing read the
-// cell's voxels once, not once per step.
-struct LabelCell {
-    ivec3 base; // the first tap: floor(q) - 1
-    uint id;
-    uvec2 bits;
-};
-
-void label_cell_fill(inout LabelCell c, vec3 q, uint id)
+// Whether label point q lies in label id (the crossing's bisection).
+#ifdef LABEL_VOXELS
+bool label_in(vec3 q, uint id)
 {
-    ivec3 base = ivec3(floor(q)) - 1;
-    if (base == c.base && id == c.id) return;
-    c.base = base;
-    c.id = id;
-    c.bits = uvec2(0u);
-    ivec3 dims = textureSize(u_labels, 0);
-    for (int z = 0; z < 4; z++)
-        for (int y = 0; y < 4; y++)
-            for (int x = 0; x < 4; x++) {
-                ivec3 v = base + ivec3(x, y, z);
-                if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, dims))) continue;
-                if (texelFetch(u_labels, v, 0).r != id) continue;
-                int bit = x + 4 * y + 16 * z;
-                if (bit < 32) c.bits.x |= 1u << uint(bit);
-                else c.bits.y |= 1u << uint(bit - 32);
-            }
+    return label_inside(q) && label_nearest(q) == id;
+}
+#else
+bool label_in(inout LabelCell c, vec3 q, uint id)
+{
+    return label_inside(q) && label_winner(c, q) == id;
 }
 
-// The filtered indicator of label id at label point q (inside or not) and its
-// gradient in intensity voxels (analytic: the derivative of the B-spline weights).
-float label_indicator(inout LabelCell c, vec3 q, uint id, out vec3 grad)
+// The gradient of label id's field at label point q, in intensity voxels:
+// central differences one label voxel apart, which interpolate the voxels'
+// own differences, so the normal turns smoothly from cell to cell.
+vec3 label_normal(vec3 q, uint id)
 {
-    label_cell_fill(c, q, id);
-    vec3 f = q - floor(q);
-    vec4 wx, wy, wz, dx, dy, dz;
-    label_bspline(f.x, wx, dx);
-    label_bspline(f.y, wy, dy);
-    label_bspline(f.z, wz, dz);
-    float s = 0.0;
-    vec3 gq = vec3(0.0);
-    for (int z = 0; z < 4; z++)
-        for (int y = 0; y < 4; y++) {
-            int row = y + 4 * z;
-            uint nib = ((row < 8 ? c.bits.x : c.bits.y) >> uint(4 * (row & 7))) & 15u;
-            vec4 m = vec4(uvec4(nib, nib >> 1u, nib >> 2u, nib >> 3u) & 1u);
-            float sx = dot(wx, m), dsx = dot(dx, m);
-            float wyy = label_pick(wy, y), wzz = label_pick(wz, z), dyy = label_pick(dy, y), dzz = label_pick(dz, z);
-            s += sx * wyy * wzz;
-            gq += vec3(dsx * wyy * wzz, sx * dyy * wzz, sx * wyy * dzz);
-        }
-    grad = u_label_grad_to_vox * gq;
-    return s;
+    vec3 gq = vec3(label_field(q + vec3(0.5, 0.0, 0.0), id) - label_field(q - vec3(0.5, 0.0, 0.0), id),
+                   label_field(q + vec3(0.0, 0.5, 0.0), id) - label_field(q - vec3(0.0, 0.5, 0.0), id),
+                   label_field(q + vec3(0.0, 0.0, 0.5), id) - label_field(q - vec3(0.0, 0.0, 0.5), id));
+    return u_label_grad_to_vox * gq;
 }
+#endif
 
 // SURFACE: the first crossing into each visible label along the ray,
-// refined by bisection to the label's 0.5 level, shaded with the label's
+// refined by bisection to the label's boundary, shaded with the label's
 // colour (the lights, shading model or MatCap), its alpha as opacity. The
 // intensity volume is not read; the label bricks skip empty space and
 // the inside of uniform bricks of the label the ray is in.
@@ -365,10 +366,9 @@ vec4 label_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float dep
     depth = uintBitsToFloat(0x7f800000u);
     taken = 0u;
     LabelRay lr = label_ray(o, dir, t0, u_step);
-    LabelCell cell;
-    cell.base = ivec3(-0x7fffffff);
-    cell.id = LABEL_NONE;
-    cell.bits = uvec2(0u);
+#ifndef LABEL_VOXELS
+    LabelCell cell = label_cell_new();
+#endif
     uint prev = LABEL_NONE;
     float t_prev = t0;
     for (int i = 0; i < u_max_steps; i++) {
@@ -384,20 +384,32 @@ vec4 label_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float dep
         taken++;
         LabelHit h = label_at(lr, q);
         if (h.id != LABEL_NONE && h.id != prev) {
-            float th = t;
-            vec3 g;
-            if (i > 0) { // the crossing lies in (t_prev, t]: bisect on "in this label" (its indicator >= 0.5)
+            float th = t, ta = t;
+            if (i > 0) { // the crossing lies in (t_prev, t]: bisect on "in this label"
                 float a = t_prev, b = t;
                 for (int k = 0; k < 12; k++) {
                     float m = 0.5 * (a + b);
                     vec3 qm = label_q(o + m * dir);
-                    if (label_inside(qm) && label_indicator(cell, qm, h.id, g) >= 0.5) b = m;
+#ifdef LABEL_VOXELS
+                    if (label_in(qm, h.id)) b = m;
+#else
+                    if (label_in(cell, qm, h.id)) b = m;
+#endif
                     else a = m;
                 }
                 th = b;
+                ta = a;
             }
             vec3 p = o + th * dir;
-            label_indicator(cell, label_q(p), h.id, g);
+#ifdef LABEL_VOXELS
+            // the face crossed: from the voxel before it to the one after
+            // (the ray's own direction where it starts inside the label)
+            vec3 gq = vec3(ivec3(floor(label_q(p) + 0.5)) - ivec3(floor(label_q(o + ta * dir) + 0.5)));
+            if (i == 0 || gq == vec3(0.0)) gq = lr.qd;
+            vec3 g = u_label_grad_to_vox * gq;
+#else
+            vec3 g = label_normal(label_q(p), h.id);
+#endif
             vec3 rgb = h.color.rgb;
 #ifdef SHADING
             g_label_material = label_material(h.id);

@@ -14,17 +14,15 @@ temporal index): one file holding several volumes. With j2k, each frame is a JPE
 1.2.840.10008.1.2.4.90): an encoder independent of our decoder.
 """
 
-import os
 import random
-import subprocess
 import sys
-import tempfile
 
 import numpy as np
-import pydicom
 from pydicom.dataset import Dataset, FileMetaDataset
 from pydicom.sequence import Sequence
 from pydicom.uid import ExplicitVRLittleEndian, generate_uid
+
+from pydicom_util import encapsulated, j2k_frame, save
 
 
 def item(**kw):
@@ -34,16 +32,9 @@ def item(**kw):
     return d
 
 
-def j2k_frame(pixels):
-    """One frame through opj_compress (16-bit PGM in, lossless J2K out)."""
-    with tempfile.TemporaryDirectory() as tmp:
-        pgm, j2k = os.path.join(tmp, "f.pgm"), os.path.join(tmp, "f.j2k")
-        rows, cols = pixels.shape
-        with open(pgm, "wb") as f:
-            f.write(b"P5\n%d %d\n65535\n" % (cols, rows) + pixels.astype(">u2").tobytes())
-        subprocess.run(["opj_compress", "-i", pgm, "-o", j2k, "-n", "2"], check=True, capture_output=True)
-        with open(j2k, "rb") as f:
-            return f.read()
+def pgm(pixels):
+    rows, cols = pixels.shape
+    return b"P5\n%d %d\n65535\n" % (cols, rows) + pixels.astype(">u2").tobytes()
 
 
 def main(argv):
@@ -92,19 +83,11 @@ def main(argv):
         ))
         pixels.append((1000 * t + 100 * k + 10 * j + i).astype("<u2"))
     ds.PerFrameFunctionalGroupsSequence = Sequence(per_frame)
-    if mode == "j2k":
-        from pydicom.encaps import encapsulate
-        meta.TransferSyntaxUID = "1.2.840.10008.1.2.4.90"  # JPEG 2000 Image Compression (Lossless Only)
-        ds.PixelData = encapsulate([j2k_frame(p) for p in pixels], has_bot=True)
-        ds["PixelData"].is_undefined_length = True
-        ds["PixelData"].VR = "OB"
+    if mode == "j2k":  # JPEG 2000 Image Compression (Lossless Only)
+        encapsulated(ds, [j2k_frame(pgm(p)) for p in pixels], "1.2.840.10008.1.2.4.90")
     else:
         ds.PixelData = np.stack(pixels).tobytes()
-    if int(pydicom.__version__.split(".")[0]) >= 3:
-        ds.save_as(out, enforce_file_format=True)
-    else:  # pydicom 2 (Debian 12) takes the encoding from the dataset
-        ds.is_little_endian, ds.is_implicit_VR = True, False
-        ds.save_as(out, write_like_original=False)
+    save(ds, out)
 
 
 if __name__ == "__main__":

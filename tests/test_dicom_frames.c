@@ -340,6 +340,65 @@ TEST(lossy_codecs_stay_within_their_bounds)
     }
 }
 
+/* Luminance (Rec. 709) of tests/make_colour_dicom.py's pattern at (i, j)
+ * of frame k, as the reader rounds it. */
+static double colour_luminance(int i, int j, int k)
+{
+    const double r = (40 * i + 10 * k) % 256, g = (50 * j + 30) % 256, b = (7 * i * j + k) % 256;
+    return (double)lround(0.2126 * r + 0.7152 * g + 0.0722 * b);
+}
+
+/* Colour DICOM (RGB by pixel and by plane, YBR_FULL, YBR_FULL_422, JPEG
+ * 2000 with its colour transform, and dcmtk's RLE, lossless JPEG, JPEG-LS
+ * and Baseline of the RGB file) loads as its luminance, with a note saying
+ * so: exact where the encoding is lossless and RGB; within 1 of the
+ * YCbCr the writer rounded; within 12 for YBR_FULL_422, whose two pixels
+ * share one averaged chroma (measured 10 on this sharp pattern); within 24
+ * for Baseline at quality 90 (measured 12). */
+TEST(colour_in_every_encoding_reads_as_its_luminance)
+{
+    static const struct {
+        const char *mode, *tool; /* tool: a dcmtk encoder run on the mode's file, or NULL */
+        double bound;
+    } cases[] = {
+        {"rgb", NULL, 0},           {"rgb-planar", NULL, 0},     {"ybr", NULL, 1},
+        {"ybr422", NULL, 12},       {"j2k", NULL, 0},            {"rgb", "dcmcrle", 0},
+        {"rgb-planar", "dcmcrle", 0}, {"rgb", "dcmcjpeg", 0},    {"rgb", "dcmcjpls", 0},
+        {"rgb", "dcmcjpeg +eb", 24},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        char dir[256], path[512], cmd[1024], name[64];
+        snprintf(name, sizeof name, "colour_%zu", c);
+        dicom_folder(g_dir, dir, sizeof dir, name);
+        snprintf(path, sizeof path, "%s/c.dcm", dir);
+        snprintf(cmd, sizeof cmd, "/usr/bin/python3 tests/make_colour_dicom.py %s %s", path, cases[c].mode);
+        REQUIRE(system(cmd) == 0);
+        if (cases[c].tool) {
+            char out[512];
+            snprintf(name, sizeof name, "colour_%zu_coded", c);
+            REQUIRE(convert(path, name, cases[c].tool, out, sizeof out) == 0);
+            snprintf(path, sizeof path, "%s", out);
+        }
+        vxl_volume *v = load_dicom(path, NULL, 0);
+        CHECKF(v && v->dims[0] == 8 && v->dims[1] == 6 && v->dims[2] == 2, "%s %s: %s", cases[c].mode,
+               cases[c].tool ? cases[c].tool : "", v ? "wrong size" : vxl_last_error());
+        if (!v || v->dims[0] != 8 || v->dims[1] != 6 || v->dims[2] != 2) {
+            vxl_volume_destroy(v);
+            continue;
+        }
+        double worst = 0;
+        for (int k = 0; k < 2; k++)
+            for (int j = 0; j < 6; j++)
+                for (int i = 0; i < 8; i++)
+                    worst = fmax(worst, fabs(voxel(v, (uint64_t)(i + 8 * j + 48 * k)) - colour_luminance(i, j, k)));
+        vxl_volume_info info;
+        CHECKF(worst <= cases[c].bound + 1e-6, "%s %s: luminance off by %g (bound %g)", cases[c].mode,
+               cases[c].tool ? cases[c].tool : "", worst, cases[c].bound);
+        CHECK(contains(volume_notes(v, &info), "shown as its luminance"));
+        vxl_volume_destroy(v);
+    }
+}
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/vxl_dicom_frames_XXXXXX");
@@ -353,6 +412,7 @@ int main(void)
     RUN(damaged_offset_tables_are_clear_errors);
     RUN(reference_files_read_the_same_in_every_encoding);
     RUN(lossy_codecs_stay_within_their_bounds);
+    RUN(colour_in_every_encoding_reads_as_its_luminance);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

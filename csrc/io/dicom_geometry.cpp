@@ -102,9 +102,17 @@ std::string check_pixels(std::vector<Image> &sl, std::vector<std::string> &notes
         const char *p = s.path.c_str();
         std::string why = decodable(s);
         if (!why.empty()) return why;
-        if (s.samples != 1)
-            return format("'%s': %u samples per pixel (colour, %s) is not supported; greyscale only", p, s.samples,
-                          s.photometric.c_str());
+        if (s.samples != 1 && !is_colour(s))
+            return format("'%s': %u samples per pixel of '%s' is not supported (grey, RGB and YBR_FULL, _422, "
+                          "_ICT, _RCT are)", p, s.samples, s.photometric.c_str());
+        if (s.photometric == "PALETTE COLOR")
+            return format("'%s': PALETTE COLOR is not supported yet (grey, RGB and YBR are)", p);
+        if (is_colour(s) && (s.bits_alloc == 32 || s.pixel_rep))
+            return format("'%s': colour of %u %s bits per sample is not supported (8 or 16, unsigned)", p,
+                          s.bits_alloc, s.pixel_rep ? "signed" : "unsigned");
+        if (s.photometric != f.photometric)
+            return format("mixed PhotometricInterpretation in the series: %s ('%s') and %s ('%s')",
+                          f.photometric.c_str(), f.path.c_str(), s.photometric.c_str(), p);
         if (s.bits_alloc != 8 && s.bits_alloc != 16 && s.bits_alloc != 32)
             return format("'%s': BitsAllocated %u is not supported (8, 16 or 32)", p, s.bits_alloc);
         if (s.bits_stored < 1 || s.bits_stored > s.bits_alloc)
@@ -121,6 +129,9 @@ std::string check_pixels(std::vector<Image> &sl, std::vector<std::string> &notes
             s.ps[0] = s.ps[1] = 1;
             assumed++;
         }
+    if (is_colour(f))
+        notes.push_back(format("colour (%s) shown as its luminance (Rec. 709): colour volumes are not rendered yet",
+                               f.photometric.c_str()));
     if (assumed)
         notes.push_back(format("PixelSpacing missing or zero in %zu of %zu image(s): 1 mm assumed", assumed,
                                sl.size()));

@@ -167,6 +167,7 @@ Parse read_header(const std::string &path, std::vector<Image> &out, std::string 
     s.bits_stored = get_us(ds, DCM_BitsStored, s.bits_alloc);
     s.pixel_rep = get_us(ds, DCM_PixelRepresentation, 0);
     s.samples = get_us(ds, DCM_SamplesPerPixel, 1);
+    s.planar = get_us(ds, DCM_PlanarConfiguration, 0);
     double v[6];
     if (get_number(ds, DCM_NumberOfFrames, v[0])) {
         if (!(v[0] >= 1 && v[0] <= double(kMaxFrames))) {

@@ -19,6 +19,7 @@
 #include <dcmtk/dcmjpls/djdecode.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <type_traits>
@@ -42,7 +43,9 @@ Codec codec_of(const Image &im)
 {
     if (!im.encapsulated) return Codec::native;
     if (im.xs == EXS_RLELossless) return Codec::rle;
-    if (im.xs == EXS_JPEGProcess14 || im.xs == EXS_JPEGProcess14SV1) return Codec::jpeg_lossless;
+    // our lossless JPEG decoder is grey only; dcmtk's takes colour
+    if (im.xs == EXS_JPEGProcess14 || im.xs == EXS_JPEGProcess14SV1)
+        return im.samples == 1 ? Codec::jpeg_lossless : Codec::dcmtk;
     if (im.xs == EXS_JPEG2000LosslessOnly || im.xs == EXS_JPEG2000) return Codec::j2k;
     if (im.xs == EXS_JPEGProcess1 || im.xs == EXS_JPEGProcess2_4 || im.xs == EXS_JPEGLSLossless ||
         im.xs == EXS_JPEGLSLossy)
@@ -76,6 +79,50 @@ void unpack_frame(const Image &s, const void *src, size_t n, void *dst)
         if (sgn) unpack(static_cast<const int16_t *>(src), n, s.bits_stored, true, static_cast<int16_t *>(dst));
         else unpack(static_cast<const uint16_t *>(src), n, s.bits_stored, false, static_cast<uint16_t *>(dst));
     }
+}
+
+// How a decoded colour frame lies in memory: the samples of a pixel
+// together, planes (all of the first sample, then ...), or uncompressed
+// YBR_FULL_422's Y0 Y1 Cb Cr for every two pixels of a row.
+enum class Layout { interleaved, planar, ybr422 };
+
+// Luminance (Rec. 709 weights of RGB) of a colour frame of n pixels into
+// dst, the container's type kept; ybr: the samples are full-range YCbCr
+// (PS3.3 C.7.6.3.1.2), turned into RGB first.
+template <typename T> void colour_to_grey(const T *src, size_t n, Layout layout, bool ybr, unsigned bits, T *dst)
+{
+    const double half = double(1u << (bits - 1)), top = double((1ull << bits) - 1);
+    for (size_t i = 0; i < n; i++) {
+        double a, b, c;
+        if (layout == Layout::interleaved) { a = src[3 * i]; b = src[3 * i + 1]; c = src[3 * i + 2]; }
+        else if (layout == Layout::planar) { a = src[i]; b = src[n + i]; c = src[2 * n + i]; }
+        else { a = src[4 * (i / 2) + (i & 1)]; b = src[4 * (i / 2) + 2]; c = src[4 * (i / 2) + 3]; }
+        if (ybr) {
+            const double y = a, cb = b - half, cr = c - half;
+            a = y + 1.402 * cr;
+            b = y - 0.344136 * cb - 0.714136 * cr;
+            c = y + 1.772 * cb;
+        }
+        const double l = 0.2126 * a + 0.7152 * b + 0.0722 * c;
+        dst[i] = T(std::lround(std::min(top, std::max(0.0, l))));
+    }
+}
+
+void grey_of_colour(const Image &s, const void *src, Layout layout, bool ybr, void *dst)
+{
+    const size_t n = size_t(s.rows) * s.cols;
+    if (s.bits_alloc == 8)
+        colour_to_grey(static_cast<const uint8_t *>(src), n, layout, ybr, s.bits_stored, static_cast<uint8_t *>(dst));
+    else
+        colour_to_grey(static_cast<const uint16_t *>(src), n, layout, ybr, s.bits_stored,
+                       static_cast<uint16_t *>(dst));
+}
+
+// The layout an uncompressed colour frame has.
+Layout native_layout(const Image &s)
+{
+    if (s.photometric == "YBR_FULL_422") return Layout::ybr422;
+    return s.planar == 1 ? Layout::planar : Layout::interleaved;
 }
 
 // The fragments of an encapsulated PixelData (items after the basic offset
@@ -189,6 +236,13 @@ void prepare_decoders()
     });
 }
 
+bool is_colour(const Image &im)
+{
+    if (im.samples != 3) return false;
+    const std::string &p = im.photometric;
+    return p == "RGB" || p == "YBR_FULL" || p == "YBR_FULL_422" || p == "YBR_ICT" || p == "YBR_RCT";
+}
+
 std::string decodable(const Image &im)
 {
     if (codec_of(im) != Codec::none) return "";
@@ -209,7 +263,12 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
     DcmElement *el = nullptr;
     if (ds->findAndGetElement(DCM_PixelData, el).bad() || !el)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': no PixelData", p);
+    const bool colour = is_colour(s);
     const size_t n = size_t(s.rows) * s.cols, bytes = n * (s.bits_alloc / 8);
+    // a frame as stored uncompressed (YBR_FULL_422: two samples a pixel) and as decoded
+    const size_t stored = colour ? (native_layout(s) == Layout::ybr422 ? 2 : 3) * bytes : bytes;
+    const size_t decoded = colour ? 3 * bytes : bytes;
+    const bool ybr = s.photometric.compare(0, 8, "YBR_FULL") == 0; // YBR_ICT/RCT: the J2K decoder returns RGB
     std::vector<uint8_t> raw, joined;
     Fragments fr;
     if (codec == Codec::rle || codec == Codec::jpeg_lossless || codec == Codec::j2k) {
@@ -218,7 +277,7 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
     }
     const void *all = nullptr;
     if (codec == Codec::native) {
-        const size_t need = bytes * size_t(s.file_frames);
+        const size_t need = stored * size_t(s.file_frames);
         if (el->getLength() < need)
             return vxl_fail(e, VXL_ERR_FORMAT, "'%s': truncated PixelData: %zu bytes for %ld frame(s) of %ux%u "
                             "pixels of %u bits, got %lu", p, need, s.file_frames, s.cols, s.rows, s.bits_alloc,
@@ -246,19 +305,27 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
     for (size_t i : order) {
         const unsigned f = which[i]->frame;
         if (codec == Codec::native) {
-            unpack_frame(s, static_cast<const uint8_t *>(all) + size_t(f) * bytes, n, dst[i]);
+            const uint8_t *frame = static_cast<const uint8_t *>(all) + size_t(f) * stored;
+            if (colour) grey_of_colour(s, frame, native_layout(s), ybr, dst[i]);
+            else unpack_frame(s, frame, n, dst[i]);
             continue;
         }
-        raw.resize(bytes);
+        raw.resize(decoded);
+        Layout layout = Layout::interleaved;
+        bool frame_ybr = ybr;
         if (codec == Codec::dcmtk) {
-            OFString colour;
+            OFString model; // what the codec produced: RGB, or YCbCr it left as it was
             if (f == 0 || f != previous + 1) start_fragment = 0; // 0: the codec finds the frame itself
             previous = f;
-            c = static_cast<DcmPixelData *>(el)->getUncompressedFrame(ds, f, start_fragment, raw.data(),
-                                                                      Uint32(bytes), colour);
+            // dcmtk's codecs want room for an even number of bytes (a 3x3 RGB
+            // frame of 27 needs 28)
+            const Uint32 room = Uint32((decoded + 1) & ~size_t(1));
+            raw.resize(room);
+            c = static_cast<DcmPixelData *>(el)->getUncompressedFrame(ds, f, start_fragment, raw.data(), room, model);
             if (c.bad())
                 return vxl_fail(e, VXL_ERR_FORMAT, "'%s': frame %u: %s decoder: %s", p, f + 1, s.xfer.c_str(),
                                 c.text());
+            frame_ybr = model.compare(0, 8, "YBR_FULL") == 0;
         } else {
             int rc = frame_bytes(s, fr, f, joined, e);
             if (rc) return rc;
@@ -266,15 +333,23 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
             const uint8_t *b = joined.data();
             const size_t len = joined.size();
             const unsigned bytes_per = s.bits_alloc / 8;
-            if (codec == Codec::rle) rc = vxl_dicom_rle_decode(b, len, s.rows, s.cols, bytes_per, raw.data(), &codec_err);
-            else if (codec == Codec::j2k) rc = vxl_j2k_decode(b, len, s.rows, s.cols, bytes_per, 1, raw.data(), &codec_err);
-            else rc = vxl_jpeg_lossless_decode(b, len, s.rows, s.cols, bytes_per, raw.data(), &codec_err);
+            const unsigned spp = colour ? 3 : 1;
+            if (codec == Codec::rle) {
+                rc = vxl_dicom_rle_decode_samples(b, len, s.rows, s.cols, bytes_per, spp, raw.data(), &codec_err);
+                layout = Layout::planar; // RLE keeps colour as planes
+            } else if (codec == Codec::j2k) {
+                rc = vxl_j2k_decode(b, len, s.rows, s.cols, bytes_per, spp, raw.data(), &codec_err);
+                frame_ybr = s.photometric == "YBR_FULL";
+            } else {
+                rc = vxl_jpeg_lossless_decode(b, len, s.rows, s.cols, bytes_per, raw.data(), &codec_err);
+            }
             if (rc) {
                 if (s.file_frames > 1) return vxl_fail(e, rc, "'%s': frame %u: %s", p, f + 1, codec_err.msg);
                 return vxl_fail(e, rc, "'%s': %s", p, codec_err.msg);
             }
         }
-        unpack_frame(s, raw.data(), n, dst[i]);
+        if (colour) grey_of_colour(s, raw.data(), layout, frame_ybr, dst[i]);
+        else unpack_frame(s, raw.data(), n, dst[i]);
     }
     return VXL_OK;
 }

@@ -37,15 +37,23 @@ static int unpack_bits(const uint8_t *seg, size_t n, uint8_t *out, size_t want)
 int vxl_dicom_rle_decode(const uint8_t *frame, size_t n, uint32_t rows, uint32_t cols, uint32_t bytes_per_pixel,
                          void *dst, vxl_err *e)
 {
-    if (bytes_per_pixel != 1 && bytes_per_pixel != 2 && bytes_per_pixel != 4)
-        return vxl_fail(e, VXL_ERR_FORMAT, "RLE of %u-byte pixels is not supported", bytes_per_pixel);
+    return vxl_dicom_rle_decode_samples(frame, n, rows, cols, bytes_per_pixel, 1, dst, e);
+}
+
+int vxl_dicom_rle_decode_samples(const uint8_t *frame, size_t n, uint32_t rows, uint32_t cols,
+                                 uint32_t bytes_per_sample, uint32_t samples, void *dst, vxl_err *e)
+{
+    if (bytes_per_sample != 1 && bytes_per_sample != 2 && bytes_per_sample != 4)
+        return vxl_fail(e, VXL_ERR_FORMAT, "RLE of %u-byte pixels is not supported", bytes_per_sample);
+    if (samples != 1 && samples != 3)
+        return vxl_fail(e, VXL_ERR_FORMAT, "RLE of %u samples per pixel is not supported", samples);
     if (n < HEADER_BYTES)
         return vxl_fail(e, VXL_ERR_FORMAT, "RLE frame of %zu bytes is shorter than its %d-byte header", n,
                         HEADER_BYTES);
     const uint32_t segments = le32(frame);
-    if (segments != bytes_per_pixel)
-        return vxl_fail(e, VXL_ERR_FORMAT, "RLE frame has %u segments, expected %u (one per byte of a grey pixel)",
-                        segments, bytes_per_pixel);
+    if (segments != bytes_per_sample * samples)
+        return vxl_fail(e, VXL_ERR_FORMAT, "RLE frame has %u segments, expected %u (%u sample(s) of %u byte(s))",
+                        segments, bytes_per_sample * samples, samples, bytes_per_sample);
     const size_t pixels = (size_t)rows * cols;
     uint8_t *plane = malloc(pixels ? pixels : 1);
     if (!plane) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for a %ux%u RLE frame", cols, rows);
@@ -62,16 +70,17 @@ int vxl_dicom_rle_decode(const uint8_t *frame, size_t n, uint32_t rows, uint32_t
                           pixels);
             break;
         }
-        /* segment 0 holds the most significant byte */
-        const unsigned shift = 8u * (bytes_per_pixel - 1 - s);
-        if (bytes_per_pixel == 1) {
-            memcpy(dst, plane, pixels);
-        } else if (bytes_per_pixel == 2) {
-            uint16_t *d = dst;
-            for (size_t i = 0; i < pixels; i++) d[i] = (uint16_t)((s ? d[i] : 0u) | (unsigned)plane[i] << shift);
+        /* sample by sample; within one, the most significant byte first */
+        const uint32_t sample = s / bytes_per_sample, byte = s % bytes_per_sample;
+        const unsigned shift = 8u * (bytes_per_sample - 1 - byte);
+        if (bytes_per_sample == 1) {
+            memcpy((uint8_t *)dst + sample * pixels, plane, pixels);
+        } else if (bytes_per_sample == 2) {
+            uint16_t *d = (uint16_t *)dst + sample * pixels;
+            for (size_t i = 0; i < pixels; i++) d[i] = (uint16_t)((byte ? d[i] : 0u) | (unsigned)plane[i] << shift);
         } else {
-            uint32_t *d = dst;
-            for (size_t i = 0; i < pixels; i++) d[i] = (s ? d[i] : 0u) | (uint32_t)plane[i] << shift;
+            uint32_t *d = (uint32_t *)dst + sample * pixels;
+            for (size_t i = 0; i < pixels; i++) d[i] = (byte ? d[i] : 0u) | (uint32_t)plane[i] << shift;
         }
     }
     free(plane);

@@ -20,4 +20,11 @@
 int vxl_dicom_rle_decode(const uint8_t *frame, size_t n, uint32_t rows, uint32_t cols, uint32_t bytes_per_pixel,
                          void *dst, vxl_err *e);
 
+/* The same for `samples` (1 or 3) samples per pixel: one segment per byte of
+ * each sample, sample by sample, so dst receives the samples as planes
+ * (all of sample 0, then sample 1, ...: planar configuration 1, which is how
+ * RLE stores colour whatever the header says). */
+int vxl_dicom_rle_decode_samples(const uint8_t *frame, size_t n, uint32_t rows, uint32_t cols,
+                                 uint32_t bytes_per_sample, uint32_t samples, void *dst, vxl_err *e);
+
 #endif

@@ -33,6 +33,7 @@ struct Image {
     unsigned frame = 0;
     long file_frames = 1; // NumberOfFrames of the file
     unsigned rows = 0, cols = 0, bits_alloc = 0, bits_stored = 0, pixel_rep = 0, samples = 1;
+    unsigned planar = 0; // PlanarConfiguration of colour: 0 samples of a pixel together, 1 planes
     bool has_ipp = false, has_iop = false, has_spacing = false, encapsulated = false;
     E_TransferSyntax xs = EXS_Unknown;
     std::string xfer; // the transfer syntax's name, for messages
@@ -75,6 +76,10 @@ Parse read_header(const std::string &path, std::vector<Image> &out, std::string 
 // Sorts and checks a series, derives its geometry and plan; sets
 // s.problem when it cannot become one volume.
 void analyse(Series &s);
+
+// Three samples per pixel in a photometric interpretation the reader turns
+// into colour (RGB, YBR_FULL, YBR_FULL_422, YBR_ICT, YBR_RCT).
+bool is_colour(const Image &im);
 
 // Registers the decoders dcmtk keeps in a process-wide list: once, before
 // any thread reads, as dcmtk asks.

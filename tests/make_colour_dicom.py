@@ -1,0 +1,85 @@
+"""Writes one colour DICOM file (two frames, 8 bits a sample) with pydicom,
+a writer independent of dcmtk and of our decoders.
+
+usage: make_colour_dicom.py OUT rgb|rgb-planar|ybr|ybr422|j2k
+
+Pixel (i, j) of frame k is R = (40 i + 10 k) % 256, G = (50 j + 30) % 256,
+B = (7 i j + k) % 256 (tests/test_dicom_frames.c computes the same), stored
+as RGB (samples of a pixel together, or as planes), as full-range YCbCr
+(YBR_FULL; YBR_FULL_422 with the chroma of each two pixels averaged), or as
+JPEG 2000 frames from opj_compress, which applies its reversible colour
+transform (YBR_RCT).
+"""
+import sys
+
+import numpy as np
+from pydicom.dataset import Dataset, FileMetaDataset
+from pydicom.uid import ExplicitVRLittleEndian, generate_uid
+
+from pydicom_util import encapsulated, j2k_frame, save
+
+COLS, ROWS, FRAMES = 8, 6, 2
+
+
+def rgb_frames():
+    j, i = np.mgrid[0:ROWS, 0:COLS]
+    return [np.stack([(40 * i + 10 * k) % 256, (50 * j + 30) % 256, (7 * i * j + k) % 256], -1).astype(np.uint8)
+            for k in range(FRAMES)]
+
+
+def ycbcr(rgb):
+    """Full-range YCbCr (PS3.3 C.7.6.3.1.2), rounded to 8 bits."""
+    r, g, b = (rgb[..., c].astype(float) for c in range(3))
+    y = 0.299 * r + 0.587 * g + 0.114 * b
+    cb = -0.168736 * r - 0.331264 * g + 0.5 * b + 128
+    cr = 0.5 * r - 0.418688 * g - 0.081312 * b + 128
+    return np.clip(np.rint(np.stack([y, cb, cr], -1)), 0, 255).astype(np.uint8)
+
+
+def main(out, mode):
+    meta = FileMetaDataset()
+    meta.MediaStorageSOPClassUID = "1.2.840.10008.5.1.4.1.1.7.3"  # Multi-frame True Color Secondary Capture
+    meta.MediaStorageSOPInstanceUID = generate_uid()
+    meta.TransferSyntaxUID = ExplicitVRLittleEndian
+    ds = Dataset()
+    ds.file_meta = meta
+    ds.SOPClassUID, ds.SOPInstanceUID = meta.MediaStorageSOPClassUID, meta.MediaStorageSOPInstanceUID
+    ds.Modality = "OT"
+    ds.StudyInstanceUID, ds.SeriesInstanceUID = generate_uid(), generate_uid()
+    ds.Rows, ds.Columns, ds.NumberOfFrames = ROWS, COLS, FRAMES
+    ds.SamplesPerPixel = 3
+    ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 8, 8, 7, 0
+    ds.PixelSpacing, ds.SliceThickness = [1, 1], 2
+    ds.ImagePositionPatient, ds.ImageOrientationPatient = [0, 0, 0], [1, 0, 0, 0, 1, 0]
+    frames = rgb_frames()
+    ds.PlanarConfiguration = 0
+    if mode == "rgb":
+        ds.PhotometricInterpretation = "RGB"
+        data = b"".join(f.tobytes() for f in frames)
+    elif mode == "rgb-planar":
+        ds.PhotometricInterpretation, ds.PlanarConfiguration = "RGB", 1
+        data = b"".join(np.moveaxis(f, -1, 0).tobytes() for f in frames)
+    elif mode == "ybr":
+        ds.PhotometricInterpretation = "YBR_FULL"
+        data = b"".join(ycbcr(f).tobytes() for f in frames)
+    elif mode == "ybr422":
+        ds.PhotometricInterpretation = "YBR_FULL_422"
+        parts = []
+        for f in frames:
+            y = ycbcr(f).astype(float).reshape(ROWS, COLS // 2, 2, 3)
+            chroma = np.rint(y[..., 1:].mean(2))  # one Cb, Cr for each two pixels
+            parts.append(np.concatenate([y[..., 0], chroma], -1).astype(np.uint8).tobytes())
+        data = b"".join(parts)
+    elif mode == "j2k":
+        ds.PhotometricInterpretation = "YBR_RCT"
+        ppm = [b"P6\n%d %d\n255\n" % (COLS, ROWS) + f.tobytes() for f in frames]
+        encapsulated(ds, [j2k_frame(p) for p in ppm], "1.2.840.10008.1.2.4.90")
+    else:
+        sys.exit("make_colour_dicom: unknown mode %s" % mode)
+    if mode != "j2k":
+        ds.PixelData = data
+    save(ds, out)
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:3])

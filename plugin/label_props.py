@@ -1,8 +1,9 @@
 """Label maps on a volume object (issue 20): Object.voxlight_labels holds the
 label image, its lookup file, how labels are drawn (surface / mask / tint,
-the library's VXL_LABEL_MODE_* names) and one entry per label (id, name,
-colour with opacity as alpha, visible). Colours and visibility are
-animatable; the viewport and F12 pass them as params.labels (look_kwargs,
+the library's VXL_LABEL_MODE_* names), the boundaries (smooth or the raw
+voxels, VXL_LABEL_BOUNDARY_*) and one entry per label (id, name,
+colour with opacity as alpha, visible). Colours, visibility and the
+boundaries are animatable; the viewport and F12 pass them as params.labels (look_kwargs,
 called by params.look_kwargs), and runtime.entry_for puts the label volume
 on the renderer (core/label_runtime.py). Hiding or recolouring a label
 changes only the params, so the library re-uploads a small table."""
@@ -32,6 +33,12 @@ def _mode_items():
 
 
 LABEL_MODE_ITEMS = _mode_items()
+
+# The library's VXL_LABEL_BOUNDARY_* in order (the enum's number is the value).
+LABEL_BOUNDARY_ITEMS = [
+    ("smooth", "Smooth", "Each label's boundary smoothed (no voxel stairs), as MRIcroGL and Slicer show labels", 0),
+    ("voxels", "Voxels", "The raw voxels: each label's boundary on its voxels' faces", 1),
+]
 
 
 def tag_redraw(self=None, context=None):
@@ -71,6 +78,8 @@ class VoxlightLabelSettings(bpy.types.PropertyGroup):
                                             "ITK-SNAP, Slicer .ctbl, MRIcron .lut/.txt)")
     mode: EnumProperty(name="Label Mode", items=LABEL_MODE_ITEMS, update=tag_redraw,
                        description="How the labels are drawn")
+    boundary: EnumProperty(name="Boundaries", items=LABEL_BOUNDARY_ITEMS, default="smooth", update=tag_redraw,
+                           description="How label boundaries are drawn: smoothed, or the raw voxels' faces")
     labels: CollectionProperty(type=VoxlightLabel)
     active_index: IntProperty(name="Active Label", default=0)
     error: StringProperty(name="Error", options={"SKIP_SAVE"})
@@ -138,7 +147,7 @@ def attach(obj, label_path, lookup_path, table, mode):
 
 
 def look_kwargs(props):
-    """make_params' labels=(mode, [(id, rgba, visible), ...]) for a volume
+    """make_params' labels=(mode, [(id, rgba, visible), ...], boundary) for a volume
     object (props: Object.voxlight), or {} when it draws no labels (then
     its frames are exactly those of before issue 20)."""
     ob = getattr(props, "id_data", None)
@@ -146,7 +155,7 @@ def look_kwargs(props):
     if s is None or not s.active_path or not label_runtime.usable(s.active_path):
         return {}
     return {"labels": (s.mode, [(lab.label_id, tuple(lab.color), bool(lab.visible), label_material(lab))
-                                for lab in s.labels])}
+                                for lab in s.labels], s.boundary)}
 
 
 def own_label_ids(obj, entry):

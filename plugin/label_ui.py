@@ -1,7 +1,8 @@
 """The Labels sub-panel of a volume object (issue 20): the label image and
-lookup file, the label mode, and a list of the labels (searchable by name
+lookup file, the label mode and boundaries, and a list of the labels (searchable by name
 with the list's own filter) with colour, opacity and visibility per row,
-Show All / Hide All and how many labels are visible."""
+Show All / Hide All and how many labels are visible; the active label's id
+and own material below."""
 
 import bpy
 
@@ -9,8 +10,18 @@ from .core import label_runtime
 from .panels import _split, _VolumePanel
 
 
+# The share of the row beside the visibility icon and swatch that the name
+# gets; the opacity slider takes the rest. Five items (visibility, swatch,
+# name, opacity, id) used to share a row about evenly, which cut AAL's names
+# to "Fronta..." at the Properties editor's default width; its longest names
+# ("Frontal_Sup_Medial_L", 20 characters) need about three times what a
+# fifth of the row gave. The id, which few users need, is shown with the
+# active label below the list.
+NAME_SHARE = 0.7
+
+
 class VOXLIGHT_UL_labels(bpy.types.UIList):
-    """One row per label: visibility, colour (alpha is the opacity), name, id."""
+    """One row per label: visibility, colour (alpha is the opacity), name, opacity."""
 
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
         row = layout.row(align=True)
@@ -19,11 +30,9 @@ class VOXLIGHT_UL_labels(bpy.types.UIList):
         sub = row.row(align=True)
         sub.scale_x = 0.35
         sub.prop(item, "color", text="")
-        row.label(text=item.name)
-        sub = row.row(align=True)
-        sub.scale_x = 0.8
-        sub.prop(item, "color", index=3, text="", slider=True)  # opacity
-        row.label(text=str(item.label_id))
+        split = row.split(factor=NAME_SHARE, align=True)
+        split.label(text=item.name)
+        split.prop(item, "color", index=3, text="", slider=True)  # opacity
 
 
 def visible_count(settings):
@@ -54,6 +63,7 @@ class VOXLIGHT_PT_volume_labels(_VolumePanel, bpy.types.Panel):
         row.prop(s, "lookup_file")
         row.operator("voxlight.load_label_lookup", text="", icon="FILE_REFRESH")
         col.prop(s, "mode")
+        col.prop(s, "boundary")
         err = s.error or label_runtime.failure(s.active_path)
         if err:
             box = layout.box()
@@ -70,6 +80,7 @@ class VOXLIGHT_PT_volume_labels(_VolumePanel, bpy.types.Panel):
             lab = s.labels[s.active_index]
             box = layout.box()
             box.use_property_split = True
+            box.label(text="%s: id %d" % (lab.name or "Label", lab.label_id))
             box.prop(lab, "use_material", text="Own Material (%s)" % (lab.name or lab.label_id))
             col = box.column(align=True)
             col.active = lab.use_material

@@ -7,10 +7,12 @@ sub-panels (Transfer Function, Rendering, Lighting, and Advanced and
 Statistics collapsed), all with the property-split layout so labels fit at
 the editor's default width."""
 
+import os
+
 import bpy
 
 from . import tf
-from .core import histogram_image, import_job, runtime
+from .core import histogram_image, import_job, label_import, runtime
 from .operators import OnActiveVolume
 from .properties import FIXED_TAP_FILTERS
 
@@ -37,6 +39,17 @@ def _split(layout, decorate=True):
 
 _KIND_TEXT = {"ct": "CT (Hounsfield units)", "mr": "MR (arbitrary units)",
               "pet": "PET/NM (arbitrary units)", "other": "arbitrary units"}
+
+
+def _own_label_count(ob):
+    """How many labels the volume has when it is drawn as the label map of
+    its own file (a labels object), else None (an intensity volume)."""
+    s = getattr(ob, "voxlight_labels", None)
+    if s is None or not s.enabled or not s.filepath:
+        return None
+    if os.path.abspath(bpy.path.abspath(s.filepath)) != os.path.abspath(bpy.path.abspath(ob.voxlight.filepath)):
+        return None
+    return label_import.label_count(len(s.labels), data_max=ob.voxlight.data_max)
 
 
 class _VolumePanel(OnActiveVolume):
@@ -68,8 +81,8 @@ class VOXLIGHT_PT_volume(_VolumePanel, bpy.types.Panel):
         layout.prop(p, "filepath")
         col = layout.column(align=True)
         col.label(text="%d x %d x %d voxels" % tuple(p.dims), icon="VOLUME_DATA")
-        col.label(text="Values %.4g .. %.4g, %s" % (p.data_min, p.data_max,
-                                                   _KIND_TEXT.get(tf.kind_of(p), "")))
+        col.label(text=label_import.values_line(p.data_min, p.data_max, _KIND_TEXT.get(tf.kind_of(p), ""),
+                                                _own_label_count(context.object)))
         if p.series:
             col.label(text="DICOM series %s" % p.series)
         for line in import_job.note_lines(p.reader_notes):  # what the reader assumed at import

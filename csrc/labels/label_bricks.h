@@ -1,14 +1,16 @@
 /* label_bricks.h - the label volume's own skipping grid (issue 20,
  * docs/labels.md "Speed"). Built once per label volume on the CPU: per brick
  * of VXL_LABEL_BRICK^3 label voxels, the distinct ids in the brick and its
- * apron (the voxels the B-spline's 4^3 taps reach from a point in the brick).
+ * apron (the voxels labels.glsl reads from a point in the brick: the 8
+ * corners of its cell, and for a crossing's normal those of the cells half a
+ * voxel away).
  * Re-derived in O(bricks + listed ids) whenever the frame's table key
  * changes (hide, recolour): one 32-bit word per brick, uploaded as a small
  * R32UI texture that shaders/lib/labels.glsl leaps by:
  *   bits 0-7  Chebyshev distance in bricks to the nearest brick where a
  *             visible label can be (0: one can be here), as bricks.h's map;
  *   bit 8     UNIFORM: every voxel of the brick and its apron is one visible
- *             id, so every point of the brick is in it (filtered indicator 1);
+ *             id, so every point of the brick is in it (every corner is that id);
  *   bits 16-31 that id. */
 #ifndef VXL_LABEL_BRICKS_H
 #define VXL_LABEL_BRICKS_H
@@ -16,7 +18,8 @@
 #include <stdint.h>
 
 #define VXL_LABEL_BRICK 4   /* label voxels per brick edge (labels.glsl's LABEL_BRICK): 4 leaps closer to boundaries and finds more uniform bricks than 8 (docs/labels.md) */
-/* A point q of brick b (floor(q / BRICK) = b) reads the taps floor(q) - 1 ..
+/* A point q of brick b (floor(q / BRICK) = b) reads voxels floor(q) ..
+ * floor(q) + 1, and its normal's taps at q +- 0.5 reach floor(q) - 1 ..
  * floor(q) + 2; two voxels on each side cover them (and the rounding of q). */
 #define VXL_LABEL_APRON 2
 #define VXL_LABEL_UNIFORM 0x100u

@@ -1,7 +1,7 @@
 """How the importer treats a label image (issue 20): whether a file is a
-label map and which lookup file names its labels. Pure Python, no bpy
-(tests/python/test_label_import.py); the importer asks it before and after
-the load."""
+label map and which lookup file names its labels, and how its info line
+reads. Pure Python, no bpy (tests/python/test_label_import.py); the
+importer asks it before and after the load."""
 
 import os
 
@@ -149,3 +149,27 @@ def guess(dtype, ids, found, read_ids):
         why.append("%s (%s) names %d of its %d values, under %d%%" % (
             base, where, n, total, round(need * 100)))
     return "intensity", "", "; ".join(why)
+
+
+def values_line(data_min, data_max, kind_text, label_count=None):
+    """The volume panel's line about its values: "Values LO .. HI, KIND" for
+    an intensity volume; for a label map (label_count not None: how many
+    labels it has) its ids are names, not measurements, so "label map, N
+    labels" instead of their range and units."""
+    if label_count is not None:
+        n = int(label_count)
+        return "label map, %d label%s" % (n, "" if n == 1 else "s")
+    line = "Values %.4g .. %.4g" % (data_min, data_max)
+    return "%s, %s" % (line, kind_text) if kind_text else line
+
+
+def label_count(listed, ids=None, data_max=None):
+    """How many labels a label map has: the non-zero ids it holds (`ids`,
+    its distinct values, when known), else the entries of its lookup list
+    (`listed`, the background left out), else ids 1 .. data_max (the
+    palette the library gives a map without a table)."""
+    if ids is not None:
+        return sum(1 for i in ids if i != 0)
+    if listed:
+        return int(listed)
+    return max(0, int(round(data_max or 0)))

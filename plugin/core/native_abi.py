@@ -29,6 +29,7 @@ SHADING_MODELS = ("phong", "shadowed", "scatter")  # VXL_SHADING_*
 MODES = ("dvr", "mip", "minip", "average", "iso")  # VXL_MODE_*
 INTERPOLATIONS = ("nearest", "linear", "cubic")  # VXL_INTERP_*
 LABEL_MODES = ("surface", "mask", "tint")  # VXL_LABEL_MODE_*
+LABEL_BOUNDARIES = ("smooth", "voxels")  # VXL_LABEL_BOUNDARY_* (no name functions: two values)
 BLENDS = ("over", "add", "max")  # VXL_BLEND_*
 STREAMING_MODES = ("auto", "off", "on")  # VXL_STREAMING_*
 MAX_OVERLAYS = 3  # VXL_MAX_OVERLAYS
@@ -185,7 +186,9 @@ class LabelStyle(ctypes.Structure):
                 ("mode", ctypes.c_uint32),
                 ("entry_count", ctypes.c_uint32),
                 ("reserved", ctypes.c_uint32),
-                ("entries", ctypes.POINTER(LabelEntry))]
+                ("entries", ctypes.POINTER(LabelEntry)),
+                ("boundary", ctypes.c_uint32),   # appended: VXL_LABEL_BOUNDARY_* (0 smooth, 1 voxels)
+                ("reserved2", ctypes.c_uint32)]
 
 
 class ClipPlane(ctypes.Structure):

@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from .native_abi import (LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
+from .native_abi import (LABEL_BOUNDARIES, LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
                          RendererInfo, RendererOptions, SceneShadows, VoxlightError, matrix_from_cm, _fptr,
                          _matrix_cm, _sized)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct
@@ -46,7 +46,7 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 gradient_exp=0.0, iso_value=0.0, iso_thickness=0.0, preint_size=0,
                 shading_model=0, ambient_occlusion=0.0, occlusion_strength=0.0, anisotropy=0.0,
                 illumination_size=0, mode="dvr", matcap=None, matcap_key=0, cutaway=None,
-                scene_shadows=None, labels=None, overlays=None, lib=None):
+                scene_shadows=None, labels=None, overlays=None, minip_floor=None, lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -117,6 +117,9 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     p.gradient_exp = gradient_exp
     p.iso_value = iso_value
     p.iso_thickness = iso_thickness
+    if minip_floor is not None:  # MinIP keeps the smallest sample at or above it
+        p.minip_floor_on = 1
+        p.minip_floor = float(minip_floor)
     p.preint_size = preint_size
     p.opacity_scale = opacity_scale
     p.shading_off = 0 if shading else 1
@@ -180,8 +183,9 @@ def _set_scene_shadows(p, vertices, triangles, key=0, shadow_map_size=0):
     p.scene_shadows = ctypes.pointer(s)
 
 
-def _set_labels(p, lib, mode, entries):
-    """params.labels (issue 20) from `mode` (a label mode's name or number)
+def _set_labels(p, lib, mode, entries, boundary="smooth"):
+    """params.labels (issue 20) from `mode` (a label mode's name or number),
+    `boundary` ("smooth" or "voxels", or VXL_LABEL_BOUNDARY_*'s number)
     and entries, a sequence of (id, rgba, visible[, material]) where
     material, when given and not None, is the label's own (ambient,
     diffuse, specular, shininess); the struct and its entries live as long
@@ -203,8 +207,15 @@ def _set_labels(p, lib, mode, entries):
     s.mode = mode if isinstance(mode, int) else lib.index("label_mode", mode)
     s.entry_count = len(entries)
     s.entries = ctypes.cast(arr, ctypes.POINTER(LabelEntry))
+    if isinstance(boundary, str):
+        if boundary not in LABEL_BOUNDARIES:
+            raise ValueError("label boundary %r: one of %s" % (boundary, ", ".join(LABEL_BOUNDARIES)))
+        boundary = LABEL_BOUNDARIES.index(boundary)
+    s.boundary = int(boundary)
     p._labels, p._label_entries = s, arr
-    p._keep.append(np.frombuffer(bytes(s)[:16] + bytes(arr)[:ctypes.sizeof(LabelEntry) * len(entries)], np.uint8))
+    # the style's bytes but its pointer (which changes with every call)
+    p._keep.append(np.frombuffer(bytes(s)[:16] + bytes(s)[LabelStyle.boundary.offset:] +
+                                 bytes(arr)[:ctypes.sizeof(LabelEntry) * len(entries)], np.uint8))
     p.labels = ctypes.pointer(s)
 
 

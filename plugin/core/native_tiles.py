@@ -13,12 +13,14 @@ from .native_abi import RenderParams, _fptr, _matrix_cm, matrix_from_cm
 
 
 def _label_style_bytes(style):
-    """The label style's mode and entries (colours, visibility, ids), not
-    its pointer: a hidden label must change the digest, an equal list not."""
+    """The label style's mode, boundary and entries (colours, visibility,
+    ids), not its pointer: a hidden label must change the digest, an equal
+    list not. The style is a struct of its own behind a pointer, so each
+    field that changes the image is packed here by hand."""
     n = style.entry_count
     stride = style.entries[0].struct_size if n and style.entries else 0
     data = ctypes.string_at(ctypes.cast(style.entries, ctypes.c_void_p), n * stride) if stride else b""
-    return bytes([1]) + np.array([style.mode, n, stride], np.uint32).tobytes() + data
+    return bytes([1]) + np.array([style.mode, n, stride, style.boundary], np.uint32).tobytes() + data
 
 
 def params_digest(params, *extra):

@@ -287,4 +287,4 @@ class Layout:
     def row(self, **kw):
         return self
 
-    column = box = row
+    column = box = split = row

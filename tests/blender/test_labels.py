@@ -271,7 +271,7 @@ def _draw_panel(ob):
 def the_labels_panel_lists_them_and_show_hide_all_counts():
     scene, ob = _scene()
     drawn = _draw_panel(ob)
-    for want in ("filepath", "lookup_file", "mode", "VOXLIGHT_UL_labels", "voxlight.load_label_lookup",
+    for want in ("filepath", "lookup_file", "mode", "boundary", "VOXLIGHT_UL_labels", "voxlight.load_label_lookup",
                  "voxlight.label_visibility", "3 of 3 labels visible"):
         assert want in drawn, (want, drawn)
     layout = _Layout()
@@ -279,6 +279,14 @@ def the_labels_panel_lists_them_and_show_hide_all_counts():
                                            ob.voxlight_labels.labels[1], 0, None, "", 1)
     row = layout.drawn
     assert row.count("color") == 2 and "visible" in row and "Middle-Green" in row, row
+    # smooth boundaries by default, the raw voxels on request, passed to the library and animatable
+    s = ob.voxlight_labels
+    assert s.boundary == "smooth"
+    assert _mod("label_props").look_kwargs(ob.voxlight)["labels"][2] == "smooth"
+    s.boundary = "voxels"
+    assert _mod("label_props").look_kwargs(ob.voxlight)["labels"][2] == "voxels"
+    assert s.keyframe_insert("boundary", frame=1)
+    s.boundary = "smooth"
     assert bpy.ops.voxlight.label_visibility(visible=False) == {"FINISHED"}
     assert "0 of 3 labels visible" in _draw_panel(ob)
     assert bpy.ops.voxlight.label_visibility(visible=True) == {"FINISHED"}

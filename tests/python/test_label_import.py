@@ -112,3 +112,14 @@ def test_the_digest_sees_the_label_list_not_its_address():
     tint = native.params_digest(_with_labels(native.make_params(width=8, height=8), rows, mode=2))
     assert a == b
     assert len({base, a, hidden, faded, tint}) == 5
+
+
+def test_the_info_line_of_a_label_map_counts_its_labels():
+    assert label_import.values_line(0, 116, "MR (arbitrary units)", 116) == "label map, 116 labels"
+    assert label_import.values_line(0, 1, "MR (arbitrary units)", 1) == "label map, 1 label"
+    assert label_import.values_line(-1024, 3071, "CT (Hounsfield units)") == "Values -1024 .. 3071, CT (Hounsfield units)"
+    assert label_import.values_line(0, 1.5, "") == "Values 0 .. 1.5"
+    # AAL: 116 non-zero ids beside the background, or 116 entries listed
+    assert label_import.label_count(0, ids=list(range(117))) == 116
+    assert label_import.label_count(116) == 116
+    assert label_import.label_count(0, data_max=116) == 116

@@ -195,6 +195,12 @@ class VOXLIGHT_PT_volume_mode(_VolumeChild, bpy.types.Panel):
         layout.prop(p, "render_mode")
         if p.render_mode == "iso":
             layout.prop(p, "iso_value")
+        elif p.render_mode == "minip":
+            row = layout.row(heading="Floor")
+            row.prop(p, "use_minip_floor", text="")
+            sub = row.row()
+            sub.active = p.use_minip_floor
+            sub.prop(p, "minip_floor", text="")
         sub = layout.column()
         sub.active = p.render_mode in ("dvr", "iso")  # the projections are not shaded
         sub.prop(p, "matcap")

@@ -49,6 +49,8 @@ def switched(props, context=None):
         return
     if new == "iso" and not props.is_property_set("iso_value"):
         fit_iso(obj)  # volumes imported before the iso value was fitted
+    if new == "minip" and not props.is_property_set("minip_floor"):
+        props.minip_floor = mode_fit.minip_floor(tf.stats_of(obj))
     windows = list(props.mode_windows)
     i, j = _SLOT[old], _SLOT[new]
     windows[2 * i], windows[2 * i + 1] = props.window_low, props.window_high

@@ -55,6 +55,7 @@ def look_kwargs(props, fast=False, dragging=False):
         gradient_ref=props.gradient_ref,
         gradient_exp=props.gradient_exp,
         iso_value=props.iso_value,
+        minip_floor=props.minip_floor if props.use_minip_floor else None,
         iso_thickness=props.iso_thickness,
         **lighting.look_kwargs(props, dragging),
         **cutaway.look_kwargs(props),  # issue 19: mode, MatCap, cutaway

@@ -343,6 +343,14 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                                   description="Which render modes have a kept window")
     window_mode: StringProperty(name="Window Mode", default="dvr", options={"HIDDEN"},
                                 description="The render mode the current window belongs to")
+    use_minip_floor: BoolProperty(name="MinIP Floor", default=True, update=tag_redraw,
+                                  description="MinIP ignores values below the floor (the air "
+                                              "around the scan, which would be every ray's "
+                                              "minimum)")
+    minip_floor: FloatProperty(name="Floor", default=0.0, update=tag_redraw,
+                               description="MinIP shows the smallest value at or above this one "
+                                           "(data units); fitted to the background's level the "
+                                           "first time MinIP is picked")
     matcap: EnumProperty(name="MatCap", items=cutaway_props.matcap_items, update=tag_redraw,
                          description="Shade surfaces with one of Blender's MatCaps (a picture "
                                      "of a lit sphere, as in Solid mode) instead of the "

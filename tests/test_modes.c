@@ -5,7 +5,8 @@
  * the max, min and mean of the voxels along the axis; ISO finds an analytic
  * sphere to a tenth of a voxel; a MatCap colours each side of a sphere by
  * its half of the image; brick skipping changes no result; every storage
- * mode projects the same; bad input is refused naming the field. */
+ * mode projects the same; MinIP's floor keeps only samples at or above it;
+ * bad input is refused naming the field. */
 #include <stdio.h>
 
 #include "axis_view.h"
@@ -498,6 +499,55 @@ TEST(bad_input_is_refused_naming_the_field)
     CHECK(render(R, &base, img, NULL) == VXL_OK);
 }
 
+/* MinIP with a floor: each pixel is the smallest sample at or above the
+ * floor, so no lower than the floor and no higher than the smallest voxel at
+ * or above it (samples between two voxels interpolate them); a ray whose
+ * voxels all lie below the floor has no such sample and draws nothing.
+ * Brick skipping (which also leaps bricks wholly below the floor) changes
+ * nothing. */
+TEST(minip_floor_skips_samples_below_it)
+{
+    const int views[3] = {4, 0, 3};
+    const uint32_t dims[3] = {NX, NY, NZ};
+    static float img[NX * NY * 4 * 2], ref[NX * NY * 4 * 2];
+    const double floor_v = 0.975; /* between the noise's two top levels */
+    for (int vi = 0; vi < 3; vi++) {
+        uint32_t w, h;
+        vxl_render_params p = axis_params(NOISE, views[vi], VXL_MODE_MINIP, &w, &h);
+        p.minip_floor_on = 1;
+        p.minip_floor = (float)floor_v;
+        REQUIRE(render(R, &p, img, NULL) == VXL_OK);
+        p.no_skip = 1;
+        REQUIRE(render(R, &p, ref, NULL) == VXL_OK);
+        int axis = views[vi] / 2, bad = 0, empty = 0, drawn = 0, differ = 0;
+        for (uint32_t py = 0; py < h; py++)
+            for (uint32_t px = 0; px < w; px++) {
+                double mn = 2;
+                for (uint32_t k = 0; k < dims[axis]; k++) {
+                    int v[3];
+                    pixel_voxel(views[vi], w, h, px, py, k, dims, v);
+                    double x = VOX[v[0] + NX * (v[1] + NY * v[2])];
+                    if (x >= floor_v && x < mn) mn = x;
+                }
+                const float *px4 = img + 4 * (py * w + px), *r4 = ref + 4 * (py * w + px);
+                if (mn > 1) {
+                    empty++;
+                    if (px4[3] != 0) bad++;
+                } else {
+                    drawn++;
+                    if (fabs(px4[3] - 1) > 1e-6 || px4[0] < floor_v - 2e-3 || px4[0] > mn + 2e-3) bad++;
+                }
+                if (fabs(px4[0] - r4[0]) > 1e-6 || px4[3] != r4[3]) differ++;
+            }
+        CHECKF(empty > 0 && drawn > 0, "view %d: %d empty, %d drawn rays (the case needs both)", views[vi], empty,
+               drawn);
+        CHECKF(bad == 0, "view %d: %d pixels off", views[vi], bad);
+        CHECKF(differ == 0, "view %d: %d pixels differ with brick skipping", views[vi], differ);
+        p.minip_floor = NAN;
+        CHECK(vxl_render(R, &p, img, NULL) == VXL_ERR_INVALID_ARGUMENT);
+    }
+}
+
 int main(void)
 {
     ramp(TF, TF_N);
@@ -515,6 +565,7 @@ int main(void)
     RUN(projections_see_only_the_kept_side_of_a_clip_plane);
     RUN(a_cutter_around_the_volume_removes_all_or_nothing);
     RUN(every_storage_mode_gives_the_same_projection);
+    RUN(minip_floor_skips_samples_below_it);
     if (vxl_renderer_set_volume(R, SPHERE) != VXL_OK) {
         printf("0 passed, 1 failed\n");
         return 1;

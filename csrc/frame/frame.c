@@ -272,6 +272,13 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     {
         double span = g->tex_hi - g->tex_lo;
         f->iso_pos = (float)((p->iso_value - g->tex_lo) / (span != 0 ? span : 1));
+        if (p->minip_floor_on && p->mode == VXL_MODE_MINIP) {
+            if (!isfinite(p->minip_floor))
+                return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "minip_floor = %g is not a finite number",
+                                (double)p->minip_floor);
+            f->minip_floor_on = 1;
+            f->minip_floor_pos = (float)((p->minip_floor - g->tex_lo) / (span != 0 ? span : 1));
+        }
     }
     f->preint_size = p->preint_size ? p->preint_size : 256;
     if (f->preint_size < 16 || f->preint_size > 4096)

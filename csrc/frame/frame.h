@@ -85,6 +85,8 @@ typedef struct vxl_frame {
     /* issue 19 modes (frame_mode.c): the projection or iso-surface, and the
      * MatCap when one is given and shading reads it (DVR with shading, ISO). */
     uint32_t mode;              /* VXL_MODE_* */
+    uint32_t minip_floor_on;    /* MinIP skips samples below minip_floor_pos */
+    float minip_floor_pos;      /* normalised value */
     const float *matcap_rgba;   /* NULL: the material and lights */
     uint32_t matcap_width, matcap_height;
     uint64_t matcap_key;        /* the caller's key; 0: the GL side hashes the pixels */

@@ -425,7 +425,7 @@ VXL_API int vxl_technique_from_name(const char *name, uint32_t *out);
  * sample lies (MIP, MinIP), where the ray enters the kept volume (AVERAGE).
  *   DVR      emission-absorption ray casting (today's)
  *   MIP      the largest value along the ray inside the kept volume
- *   MINIP    the smallest
+ *   MINIP    the smallest (at or above minip_floor when minip_floor_on)
  *   AVERAGE  the mean of the samples
  *   ISO      the first crossing of iso_value (data units) along the ray,
  *            refined below the step by bisection (and a last secant step) on
@@ -708,6 +708,13 @@ typedef struct vxl_render_params {
      * level the budget allows (F12). Only streamed volumes care. */
     uint32_t progressive;
     const vxl_overlay_style *overlays;
+    /* Appended: MinIP's floor. With minip_floor_on, MinIP projects the
+     * smallest sample at or above minip_floor (data units): the air around
+     * an uncropped scan is every ray's minimum otherwise, so MinIP would
+     * show only air. A ray with no sample at or above the floor draws
+     * nothing. Other modes ignore both. */
+    uint32_t minip_floor_on;
+    float minip_floor;
 } vxl_render_params;
 
 VXL_API int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out);

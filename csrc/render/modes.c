@@ -69,5 +69,6 @@ int vxl_modes_bind(vxl_modes_state *s, const vxl_frame *f, GLuint prog)
     vxl_uniform_i(s->gpu, prog, "u_mode_skip", skip);
     vxl_uniform_i(s->gpu, prog, "u_brick_minmax", VXL_BRICK_MINMAX_UNIT);
     vxl_uniform_f(s->gpu, prog, "u_iso", f->iso_pos);
+    vxl_uniform_f(s->gpu, prog, "u_minip_floor", f->minip_floor_on ? f->minip_floor_pos : -1e30f);
     return VXL_OK;
 }

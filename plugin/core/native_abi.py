@@ -321,7 +321,9 @@ class RenderParams(ctypes.Structure):
                 ("labels", ctypes.POINTER(LabelStyle)),  # appended (issue 20)
                 ("overlay_count", ctypes.c_uint32),      # appended (issue 20)
                 ("progressive", ctypes.c_uint32),        # appended (issue 21)
-                ("overlays", ctypes.POINTER(OverlayStyle))]
+                ("overlays", ctypes.POINTER(OverlayStyle)),
+                ("minip_floor_on", ctypes.c_uint32),     # appended: MinIP's floor
+                ("minip_floor", ctypes.c_float)]
 
 
 class RenderStats(ctypes.Structure):

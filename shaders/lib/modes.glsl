@@ -11,7 +11,7 @@
 // per-brick min-max grid (the skipping grid's, apron included, so it bounds
 // every trilinear sample inside the brick) lets MIP leap over a brick whose
 // max cannot beat the running maximum, MinIP over one whose min cannot beat
-// the running minimum, and ISO over one whose range excludes the iso value.
+// the running minimum or whose max lies below MinIP's floor, and ISO over one whose range excludes the iso value.
 // AVERAGE needs every sample. The sample positions are t_start + i * step
 // whether or not bricks are skipped, so skipping changes no result.
 #include "lib/ray_box.glsl"
@@ -23,6 +23,7 @@
 uniform int u_mode_skip;             // min-max brick skipping on
 uniform sampler3D u_brick_minmax;    // RG: normalised min, max per brick of u_brick_size voxels
 uniform float u_iso;                 // ISO: the iso value, normalised
+uniform float u_minip_floor;         // MinIP: samples below it are not candidates (normalised; -1e30 off)
 
 // The brick of voxel position p and its min-max.
 vec2 brick_range(vec3 p, out ivec3 b)
@@ -55,45 +56,56 @@ vec4 project_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
     float sum = 0.0, t_first = t0; // where the kept volume begins: a cutter may remove the front
 #else
     float best = 0.0, t_best = t0;
+    bool found = false; // best holds a candidate sample
 #endif
     for (int i = 0; i < u_max_steps; i++) {
         float t = t_start + float(i) * u_step;
         if (t >= t1) break;
         CUT_SKIP_REMOVED(i, t, t_start) // lib/cut.glsl: a cutter's removed interval
         vec3 p = o + t * dir;
-#if MODE != 3
-        if (u_mode_skip != 0 && taken > 0u) {
+#if MODE == 1
+        if (u_mode_skip != 0 && found) {
             ivec3 b;
             vec2 mm = brick_range(p, b);
-#if MODE == 1
-            bool beaten = mm.y <= best;
-#else
-            bool beaten = mm.x >= best;
-#endif
-            if (beaten) {
+            if (mm.y <= best) {
+                i = brick_last_sample(b, o, dir, t_start, i);
+                continue;
+            }
+        }
+#elif MODE == 2
+        if (u_mode_skip != 0) {
+            ivec3 b;
+            vec2 mm = brick_range(p, b);
+            // a brick wholly below the floor holds no candidate either
+            if ((found && mm.x >= best) || mm.y < u_minip_floor) {
                 i = brick_last_sample(b, o, dir, t_start, i);
                 continue;
             }
         }
 #endif
         float v = sample_value(p);
+        taken++;
 #if MODE == 3
-        if (taken == 0u && i > 0) t_first = t; // only a cutter's leap makes the first sample's index > 0
+        if (taken == 1u && i > 0) t_first = t; // only a cutter's leap makes the first sample's index > 0
         sum += v;
 #else
 #if MODE == 1
-        bool better = taken == 0u || v > best;
+        bool better = !found || v > best;
 #else
-        bool better = taken == 0u || v < best;
+        bool better = v >= u_minip_floor && (!found || v < best);
 #endif
         if (better) {
             best = v;
             t_best = t;
+            found = true;
         }
 #endif
-        taken++;
     }
+#if MODE == 3
     if (taken == 0u) return vec4(0.0);
+#else
+    if (!found) return vec4(0.0);
+#endif
 #if MODE == 3
     float v = sum / float(taken);
     float t_depth = t_first;

@@ -51,6 +51,21 @@ def test_projection_windows_are_inside_the_data_and_ordered():
     assert mode_fit.window("dvr", s) is None
 
 
+def test_mip_window_ends_at_the_maximum():
+    # A window ending below the data's maximum turns every ray that meets a
+    # brighter voxel white: MIP of a head was a white silhouette.
+    s = _stats(_head_like(), 0.0, 130.0)
+    assert mode_fit.window("mip", s)[1] == 130.0
+
+
+def test_minip_floor_is_above_the_air_and_starts_the_window():
+    s = _stats(_head_like(), 0.0, 130.0)
+    floor = mode_fit.minip_floor(s)
+    assert 5.0 < floor < 51.0, floor  # between the air and the tissue
+    lo, hi = mode_fit.window("minip", s)
+    assert lo < floor < hi  # the floor itself is visible on the ramp
+
+
 def test_iso_window_puts_the_iso_value_on_the_brightest_entry():
     s = _stats(_head_like(), 0.0, 130.0)
     table = np.zeros((256, 4), np.float32)

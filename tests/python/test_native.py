@@ -371,11 +371,13 @@ def test_render_params_tail_matches_header():
     assert P.shading_model.offset + 4 == 624
     # 688 bytes up to the reserved room's end; issue 20 appended the labels'
     # pointer, then overlay_count and (issue 21) progressive before the
-    # overlays' pointer, which keeps it on its 8-byte alignment
-    assert P.labels.offset == 688 and P.overlays.offset == 704 and ctypes.sizeof(P) == 712
+    # overlays' pointer, which keeps it on its 8-byte alignment; MinIP's
+    # floor (flag and value) follows it
+    assert P.labels.offset == 688 and P.overlays.offset == 704 and P.minip_floor.offset == 716
+    assert ctypes.sizeof(P) == 720
     assert P.labels.offset == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
-    names = [n for n, _t in P._fields_][-22:-3]
+    names = [n for n, _t in P._fields_][-24:-5]
     assert names == ["preint_size", "gradient_opacity", "gradient_ref", "gradient_exp",
                      "iso_value", "iso_thickness", "shading_model", "light_shapes",
                      "ambient_occlusion", "occlusion_strength", "anisotropy", "illumination_size",

@@ -207,7 +207,7 @@ TEST(stacks_of_one_enhanced_file_are_series_of_their_own)
     CHECKF(load_dicom(path, NULL, 0) == NULL && contains(vxl_last_error(), "holds 2 DICOM series"), "%s",
            vxl_last_error());
     for (int t = 0; t < 2; t++) {
-        char ref_dir[256], name[32], index[4];
+        char ref_dir[256], name[32], index[12];
         snprintf(name, sizeof name, "stack_reference_%d", t);
         dicom_folder(g_dir, ref_dir, sizeof ref_dir, name);
         REQUIRE(write_reference(ref_dir, t) == 0);

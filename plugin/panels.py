@@ -11,7 +11,7 @@ import os
 
 import bpy
 
-from . import tf
+from . import compat, tf
 from .core import histogram_image, import_job, label_import, runtime
 from .operators import OnActiveVolume
 from .properties import FIXED_TAP_FILTERS
@@ -39,6 +39,9 @@ def _split(layout, decorate=True):
 
 _KIND_TEXT = {"ct": "CT (Hounsfield units)", "mr": "MR (arbitrary units)",
               "pet": "PET/NM (arbitrary units)", "other": "arbitrary units"}
+# characters of a reader's note a line holds beside its icon at the
+# Properties editor's default width
+_NOTE_CHARS = 26
 
 
 def _own_label_count(ob):
@@ -55,17 +58,20 @@ def _own_label_count(ob):
 class _VolumePanel(OnActiveVolume):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
-    bl_context = "object"
+    # The volume is an Empty, and an object's own kind of settings live in
+    # its Object Data tab, as a Light's, a Camera's or a Blender Volume's do.
+    # That tab holds only Blender's small "Empty" panel besides ours, so
+    # Voxlight is one click away and in view without scrolling; the Object
+    # tab would put it below Transform, Relations, Collections and the rest
+    # (Blender keeps the panel order stored in the startup file's screen).
+    bl_context = "data"
 
 
 class VOXLIGHT_PT_volume(_VolumePanel, bpy.types.Panel):
     bl_label = "Voxlight"
     bl_idname = "VOXLIGHT_PT_volume"
-    # Add-ons cannot add a Properties tab, and the volume is an object, so
-    # its settings belong in the Object tab (as a Light's or Camera's own
-    # settings are their object's data); Blender's own Object panels are
-    # order 0 and registered first, so -1 puts this one on top, in reach
-    # without scrolling past Transform, Relations and the rest.
+    # above the Empty's own display panel (order 0) where the editor has
+    # no stored order yet
     bl_order = -1
 
     def draw(self, context):
@@ -81,12 +87,17 @@ class VOXLIGHT_PT_volume(_VolumePanel, bpy.types.Panel):
         layout.prop(p, "filepath")
         col = layout.column(align=True)
         col.label(text="%d x %d x %d voxels" % tuple(p.dims), icon="VOLUME_DATA")
-        col.label(text=label_import.values_line(p.data_min, p.data_max, _KIND_TEXT.get(tf.kind_of(p), ""),
-                                                _own_label_count(context.object)))
+        # the kind on a line of its own and the notes wrapped: a label that
+        # runs past the panel's default width is cut, not wrapped
+        count = _own_label_count(context.object)
+        col.label(text=label_import.values_line(p.data_min, p.data_max, "", count))
+        if count is None and _KIND_TEXT.get(tf.kind_of(p)):
+            col.label(text=_KIND_TEXT[tf.kind_of(p)])
         if p.series:
             col.label(text="DICOM series %s" % p.series)
-        for line in import_job.note_lines(p.reader_notes):  # what the reader assumed at import
-            col.label(text=line, icon="INFO")
+        for note in import_job.note_lines(p.reader_notes):  # what the reader assumed at import
+            for i, line in enumerate(compat.wrap(note, _NOTE_CHARS)):
+                col.label(text=line, icon="INFO" if i == 0 else "BLANK1")
         if p.frame_count > 1:  # 4D: which volume frame the scene frame shows
             col = _split(layout.column(align=True), decorate=True)
             col.label(text="%d volume frames" % p.frame_count)
@@ -348,7 +359,7 @@ class VOXLIGHT_PT_scene(bpy.types.Panel):
         col.prop(s, "render_enabled", text="Composite")
         col.prop(s, "render_occlusion", text="Mesh Occlusion")
         col.prop(s, "render_separate_layer", text="Separate Layer")
-        from . import compat, scene_shadows
+        from . import scene_shadows
         if scene_shadows.note:  # how the last render applied the volume's shadows (issue 18)
             for i, line in enumerate(compat.wrap(scene_shadows.note, 40)):
                 col.label(text=line, icon="INFO" if i == 0 else "BLANK1")

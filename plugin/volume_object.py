@@ -120,7 +120,7 @@ class VOXLIGHT_PT_volume_object(bpy.types.Panel):
     bl_idname = "VOXLIGHT_PT_volume_object"
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
-    bl_context = "object"
+    bl_context = "data"  # the Volume's own settings' tab, where the Voxlight panels appear when on
     bl_order = -2  # above the Voxlight settings panel (order -1) that appears when on
 
     @classmethod

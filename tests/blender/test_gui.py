@@ -55,7 +55,7 @@ def steps():
     region = [r for r in area.regions if r.type == "WINDOW"][0]
     for a in win.screen.areas:  # the Voxlight panel (with its frame stats) is drawn too
         if a.type == "PROPERTIES":
-            a.spaces.active.context = "OBJECT"
+            a.spaces.active.context = "DATA"
     yield 0.5
 
     def grab():

@@ -126,7 +126,7 @@ def steps():
         ob = u.import_volume(u.CH2)
     props.tag_redraw()  # the Object tab exists once the editor has seen the active object
     yield 0.3
-    props.spaces.active.context = "OBJECT"
+    props.spaces.active.context = "DATA"
     v3d.tag_redraw()
     props.tag_redraw()
     yield 0.5

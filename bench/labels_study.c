@@ -6,8 +6,11 @@
  * Prints the median frame time, its ratio to the baseline (the goal is
  * <= 1.5x) and the samples a ray took (vxl_render_stats: the work, which
  * the label bricks' leaps cut, independent of the machine's load); the
- * times mean nothing on a loaded machine. Command:
- *   make -j1 build/voxlight-labelsbench && ./build/voxlight-labelsbench [--size 512] [--frames 5] */
+ * times mean nothing on a loaded machine. --boundary voxels draws the raw
+ * voxels' faces instead of the smoothed boundaries (the default); the time
+ * vxl_renderer_set_labels takes (upload and, when smooth, the margins) is
+ * printed per label count. Command:
+ *   make -j1 build/voxlight-labelsbench && ./build/voxlight-labelsbench [--size 512] [--frames 5] [--boundary smooth|voxels] */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,14 +52,16 @@ static double samples_per_ray(vxl_renderer *r)
 
 int main(int argc, char **argv)
 {
-    uint32_t size = 512;
-    int frames = 5;
+    uint32_t size = 512, boundary = VXL_LABEL_BOUNDARY_SMOOTH;
+    int frames = 5, bad = 0;
     for (int i = 1; i + 1 < argc; i += 2) {
         if (!strcmp(argv[i], "--size")) size = (uint32_t)atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--frames")) frames = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--boundary") && !strcmp(argv[i + 1], "voxels")) boundary = VXL_LABEL_BOUNDARY_VOXELS;
+        else if (strcmp(argv[i], "--boundary") || strcmp(argv[i + 1], "smooth")) bad = 1;
     }
-    if (size < 16 || size > 4096 || frames < 1 || frames > 64) {
-        fprintf(stderr, "usage: voxlight-labelsbench [--size 16..4096] [--frames 1..64]\n");
+    if (bad || size < 16 || size > 4096 || frames < 1 || frames > 64) {
+        fprintf(stderr, "usage: voxlight-labelsbench [--size 16..4096] [--frames 1..64] [--boundary smooth|voxels]\n");
         return 2;
     }
     vxl_renderer_options o = {.struct_size = sizeof o};
@@ -79,10 +84,12 @@ int main(int argc, char **argv)
     int rc = base < 0;
     for (int c = 0; c < 3 && !rc; c++) {
         vxl_volume *lab = label_volume(vol, counts[c]);
+        const double t0 = now_ms();
         if (!lab || vxl_renderer_set_labels(r, lab)) {
             rc = 1;
             break;
         }
+        fprintf(stderr, "%u labels: vxl_renderer_set_labels %.1f ms\n", counts[c], now_ms() - t0);
         vxl_volume_destroy(lab);
         for (uint32_t k = 0; k < counts[c]; k++) {
             e[k] = (vxl_label_entry){.struct_size = sizeof e[k], .id = (int32_t)k + 1, .visible = 1};
@@ -92,7 +99,8 @@ int main(int argc, char **argv)
             e[k].color[3] = 1;
         }
         for (uint32_t m = 0; m < VXL_LABEL_MODE_COUNT && !rc; m++) {
-            vxl_label_style s = {.struct_size = sizeof s, .mode = m, .entry_count = counts[c], .entries = e};
+            vxl_label_style s = {.struct_size = sizeof s, .mode = m, .entry_count = counts[c], .entries = e,
+                                 .boundary = boundary};
             p.labels = &s;
             double t = median_ms(r, &p, img, frames);
             p.labels = NULL;

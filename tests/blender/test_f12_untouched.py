@@ -80,7 +80,8 @@ def factory_scene_volume_inside_the_cube_renders_the_lit_cube():
     assert {"Cube", "Camera", "Light"} <= set(bpy.data.objects.keys()), list(bpy.data.objects.keys())
     _small_and_quick(scene)
     _forget_images()
-    vol = u.import_volume(u.CH2 if os.path.isfile(u.CH2) else u.ball_file())
+    # kept where it is: the import would hide the untouched startup Cube
+    vol = u.import_volume(u.CH2 if os.path.isfile(u.CH2) else u.ball_file(), hide_startup_cube=False)
     cube = bpy.data.objects["Cube"]
     for engine in ENGINES:
         scene.render.engine = engine

@@ -184,9 +184,9 @@ def _set_scene_shadows(p, vertices, triangles, key=0, shadow_map_size=0):
 
 
 def _set_labels(p, lib, mode, entries, boundary="smooth"):
-    """params.labels (issue 20) from `mode` (a label mode's name or number),
-    `boundary` ("smooth" or "voxels", or VXL_LABEL_BOUNDARY_*'s number)
-    and entries, a sequence of (id, rgba, visible[, material]) where
+    """params.labels (each label's colour, visibility and material) from
+    `mode` (a label mode's name or number), `boundary` ("smooth" or
+    "voxels", or VXL_LABEL_BOUNDARY_*'s number) and entries, a sequence of (id, rgba, visible[, material]) where
     material, when given and not None, is the label's own (ambient,
     diffuse, specular, shininess); the struct and its entries live as long
     as p, and _keep holds their bytes for the digest."""

@@ -11,7 +11,7 @@ def _stats(values, lo, hi, bins=1024):
 
 
 def _head_like(seed=0):
-    """Air (zeros) around a head: tissue 51..130, as in ch2better."""
+    """Air (zeros) around a head: tissue from 51 to 130, as in ch2better."""
     rng = np.random.default_rng(seed)
     air = np.zeros(600000)
     tissue = np.clip(rng.normal(95, 15, 400000), 51, 130)

@@ -41,15 +41,6 @@ namespace {
 constexpr double kSamePosition = 0.01; // mm: images closer than this share a position
 constexpr double kOnGrid = 1e-3;       // a blend weight this close to 0 or 1 takes the image as is
 
-void cross(const double a[3], const double b[3], double o[3])
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
 // What makes images stackable: size, pixel format and orientation (to 1e-3).
 using Kind = std::tuple<unsigned, unsigned, unsigned, long, long, long, long, long, long>;
 Kind kind_of(const Image &s)

@@ -13,7 +13,6 @@ namespace vxl_dicom {
 
 namespace {
 
-constexpr Uint32 kHeaderReadLength = 4096; // larger element values stay on disk
 constexpr long kMaxFrames = 1L << 20;      // more frames than this is a damaged header
 
 // "DICM" at byte 128: a Part 10 file.
@@ -116,8 +115,8 @@ void stack_classic_frames(DcmDataset *ds, std::vector<Image> &out)
     bool grid = get_doubles(ds, DCM_GridFrameOffsetVector, offsets.data(), int(n));
     double step = f.between > 0 ? f.between : f.thickness > 0 ? f.thickness : 1;
     std::string how = grid ? "" : f.between > 0 ? "SpacingBetweenSlices" : f.thickness > 0 ? "SliceThickness" : "";
-    double normal[3] = {f.iop[1] * f.iop[5] - f.iop[2] * f.iop[4], f.iop[2] * f.iop[3] - f.iop[0] * f.iop[5],
-                        f.iop[0] * f.iop[4] - f.iop[1] * f.iop[3]};
+    double normal[3];
+    cross(f.iop, f.iop + 3, normal);
     // a first offset other than 0 makes the offsets z coordinates (PS3.3 C.8.8.3.2)
     const bool absolute = grid && offsets[0] != 0;
     for (size_t i = 0; i < n; i++) {

@@ -35,8 +35,6 @@ namespace vxl_dicom {
 
 namespace {
 
-constexpr Uint32 kHeaderReadLength = 4096; // PixelData stays on disk until a frame is read
-
 enum class Codec { native, rle, jpeg_lossless, j2k, dcmtk, none };
 
 Codec codec_of(const Image &im)
@@ -85,6 +83,11 @@ void unpack_frame(const Image &s, const void *src, size_t n, void *dst)
 // together, planes (all of the first sample, then ...), or uncompressed
 // YBR_FULL_422's Y0 Y1 Cb Cr for every two pixels of a row.
 enum class Layout { interleaved, planar, ybr422 };
+
+// Full-range YCbCr, which must be turned into RGB: YBR_FULL and
+// YBR_FULL_422 (the photometric interpretation, or the colour model a
+// dcmtk codec reports it decoded into).
+bool is_ybr_full(const std::string &model) { return model.compare(0, 8, "YBR_FULL") == 0; }
 
 // Luminance (Rec. 709 weights of RGB) of a colour frame of n pixels into
 // dst, the container's type kept; ybr: the samples are full-range YCbCr
@@ -254,8 +257,7 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
 {
     const Image &s = *which[0];
     const char *p = s.path.c_str();
-    const Codec codec = codec_of(s);
-    if (codec == Codec::dcmtk) prepare_decoders(); // a no-op after load_series' call
+    const Codec codec = codec_of(s); // dcmtk's decoders: registered by prepare_decoders before any thread reads
     DcmFileFormat ff;
     OFCondition c = ff.loadFile(p, EXS_Unknown, EGL_noChange, kHeaderReadLength, ERM_autoDetect);
     if (c.bad()) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read: %s", p, c.text());
@@ -268,8 +270,11 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
     // a frame as stored uncompressed (YBR_FULL_422: two samples a pixel) and as decoded
     const size_t stored = colour ? (native_layout(s) == Layout::ybr422 ? 2 : 3) * bytes : bytes;
     const size_t decoded = colour ? 3 * bytes : bytes;
-    const bool ybr = s.photometric.compare(0, 8, "YBR_FULL") == 0; // YBR_ICT/RCT: the J2K decoder returns RGB
-    std::vector<uint8_t> raw, joined;
+    const bool ybr = is_ybr_full(s.photometric); // YBR_ICT/RCT: the J2K decoder returns RGB
+    // dcmtk's codecs want room for an even number of bytes (a 3x3 RGB frame
+    // of 27 needs 28)
+    const size_t room = (decoded + 1) & ~size_t(1);
+    std::vector<uint8_t> raw(codec == Codec::native ? 0 : room), joined;
     Fragments fr;
     if (codec == Codec::rle || codec == Codec::jpeg_lossless || codec == Codec::j2k) {
         int rc = fragments_of(s, el, fr, e);
@@ -310,22 +315,18 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
             else unpack_frame(s, frame, n, dst[i]);
             continue;
         }
-        raw.resize(decoded);
         Layout layout = Layout::interleaved;
         bool frame_ybr = ybr;
         if (codec == Codec::dcmtk) {
             OFString model; // what the codec produced: RGB, or YCbCr it left as it was
             if (f == 0 || f != previous + 1) start_fragment = 0; // 0: the codec finds the frame itself
             previous = f;
-            // dcmtk's codecs want room for an even number of bytes (a 3x3 RGB
-            // frame of 27 needs 28)
-            const Uint32 room = Uint32((decoded + 1) & ~size_t(1));
-            raw.resize(room);
-            c = static_cast<DcmPixelData *>(el)->getUncompressedFrame(ds, f, start_fragment, raw.data(), room, model);
+            c = static_cast<DcmPixelData *>(el)->getUncompressedFrame(ds, f, start_fragment, raw.data(), Uint32(room),
+                                                                      model);
             if (c.bad())
                 return vxl_fail(e, VXL_ERR_FORMAT, "'%s': frame %u: %s decoder: %s", p, f + 1, s.xfer.c_str(),
                                 c.text());
-            frame_ybr = model.compare(0, 8, "YBR_FULL") == 0;
+            frame_ybr = is_ybr_full(model.c_str());
         } else {
             int rc = frame_bytes(s, fr, f, joined, e);
             if (rc) return rc;

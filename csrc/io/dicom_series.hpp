@@ -26,6 +26,19 @@ extern "C" {
 
 namespace vxl_dicom {
 
+// Element values longer than this stay on disk when a file is parsed: a
+// folder scan reads headers only, and PixelData is read when a frame is.
+constexpr Uint32 kHeaderReadLength = 4096;
+
+inline void cross(const double a[3], const double b[3], double o[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+inline double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
 // One 2D image: frame `frame` (0-based) of the file at `path`.
 struct Image {
     std::string path, uid, modality, description, photometric;

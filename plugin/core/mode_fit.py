@@ -38,6 +38,8 @@ Why these choices:
 
 import numpy as np
 
+from .tf_fit import never_empty
+
 MODES = ("dvr", "mip", "minip", "average", "iso")
 PROJECTIONS = ("mip", "minip", "average")
 
@@ -84,12 +86,6 @@ def minip_floor(stats):
     return iso_value(stats)
 
 
-def _never_empty(lo, hi):
-    if not hi > lo:
-        hi = lo + max(abs(lo), 1.0) * 1e-3
-    return float(lo), float(hi)
-
-
 def brightest_position(table):
     """Position 0..1 of the table's brightest visible entry (largest
     luminance among entries with some opacity; the brightest of all when
@@ -108,9 +104,9 @@ def window(mode, stats, iso=None, table=None):
     ramp sampled to (n, 4) (ISO: where its brightest colour is). None for
     DVR, whose window is the preset's (tf_fit.place)."""
     if mode == "mip":
-        return _never_empty(stats.level(0.5), stats.hi)
+        return never_empty(stats.level(0.5), stats.hi)
     if mode in ("minip", "average"):
-        return _never_empty(stats.lo, stats.level(0.5))
+        return never_empty(stats.lo, stats.level(0.5))
     if mode == "iso":
         iso = iso_value(stats) if iso is None else float(iso)
         width = stats.level(0.995) - stats.level(0.0)
@@ -118,7 +114,7 @@ def window(mode, stats, iso=None, table=None):
             width = max(stats.hi - stats.lo, 1e-6)
         t = 0.75 if table is None else brightest_position(table)
         lo = iso - t * width
-        return _never_empty(lo, lo + width)
+        return never_empty(lo, lo + width)
     return None
 
 

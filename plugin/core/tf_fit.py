@@ -142,15 +142,20 @@ class DataStats:
         return self.quantile(q)
 
 
+def never_empty(lo, hi):
+    """(lo, hi) as floats, hi moved just above lo when it is not above it,
+    so a window always has a width."""
+    if not hi > lo:
+        hi = lo + max(abs(lo), 1.0) * 1e-3
+    return float(lo), float(hi)
+
+
 def fit_window(stats, low_quantile=0.0, high_quantile=0.995):
     """(low, high) spanning the foreground from one quantile to another,
     inside the data range; never empty."""
     lo = stats.level(low_quantile)
     hi = stats.level(high_quantile)
-    lo, hi = max(lo, stats.lo), min(hi, stats.hi)
-    if not hi > lo:
-        hi = lo + max(abs(lo), 1.0) * 1e-3
-    return float(lo), float(hi)
+    return never_empty(max(lo, stats.lo), min(hi, stats.hi))
 
 
 FLOOR_ENTRIES = 3  # transparent table entries kept below a preset's first rise (place)

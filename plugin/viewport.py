@@ -40,6 +40,8 @@ Per region and volume, on every redraw:
      mesh's silhouette. gl_FragDepth is the volume's hit, never behind the
      scene's own depth, so its colour (in front of that geometry, since
      the rays stopped there) always blends.
+  6. Draw the front edges of each volume's box outline again, over the
+     volume (box_outline.py says why).
 
 VOXLIGHT_PROFILE=1 in the environment prints where each draw's time goes
 (_Profile).
@@ -55,7 +57,7 @@ import gpu
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import app_handlers, gpu_quad, overlay_frames, params, scene_shadows, scene_shadows_viewport
+from . import app_handlers, box_outline, gpu_quad, overlay_frames, params, scene_shadows, scene_shadows_viewport
 from .core import depth as _depth
 from .core import upsample as _upsample
 from .core import native, resolution_policy, runtime, volume_space
@@ -262,11 +264,13 @@ void main()
     vec2 f = uv * vec2(cs) - 0.5;
     vec2 i0 = floor(f);
     vec2 fr = f - i0;
-    /* a: stopped at this pixel's depth, b: stopped nearer; weighted sum,
-       plain sum, count, nearest hit (no arrays: Mesa's llvmpipe got the
-       dynamically indexed ones wrong) */
+    /* a: stopped at this pixel's depth, b: stopped nearer, c: went past
+       it; weighted sum, plain sum, count, nearest hit (no arrays: Mesa's
+       llvmpipe got the dynamically indexed ones wrong) */
     vec4 acc_a = vec4(0.0), accu_a = vec4(0.0), acc_b = vec4(0.0), accu_b = vec4(0.0);
+    vec4 acc_c = vec4(0.0), accu_c = vec4(0.0);
     float w_a = 0.0, n_a = 0.0, hit_a = 1.0, w_b = 0.0, n_b = 0.0, hit_b = 1.0;
+    float w_c = 0.0, n_c = 0.0, hit_c = 1.0;
     for (int k = 0; k < 4; k++) {
         int ox = k - 2 * (k / 2);
         int oy = k / 2;
@@ -291,6 +295,13 @@ void main()
             n_b += 1.0;
             hit_b = min(hit_b, hs.r);
         }
+        else {
+            acc_c += wb * c;
+            accu_c += c;
+            w_c += wb;
+            n_c += 1.0;
+            hit_c = min(hit_c, hs.r);
+        }
     }
     float hit = 1.0;
     fragColor = vec4(0.0);
@@ -301,6 +312,10 @@ void main()
     else if (n_b > 0.0) {
         fragColor = w_b > 1e-4 ? acc_b / w_b : accu_b / n_b;
         hit = hit_b;
+    }
+    else if (n_c > 0.0 && hit_c <= scene) {
+        fragColor = w_c > 1e-4 ? acc_c / w_c : accu_c / n_c;
+        hit = hit_c;
     }
     gl_FragDepth = min(hit, scene);
 }
@@ -657,6 +672,7 @@ def _draw():
             if o.type in volume_space.VOLUME_TYPES and o.voxlight.is_volume and o.visible_get(viewport=space)]
     # Issue 20: an overlay is drawn inside its base's frame, not on its own.
     fused = {b.name: ovs for b, ovs in overlay_frames.fuse(objs)}
+    outlined = objs
     objs = [o for o in objs if o.name in fused]
     region_ptr = region.as_pointer()
     drawn = set()
@@ -741,6 +757,8 @@ def _draw():
             if shown is not None:
                 _profile.note("%s %dx%d scale %.3f" % (_kind(st, shown), shown.width, shown.height,
                                                        shown.scale))
+        box_outline.draw(outlined, view, rv3d.is_perspective, space, (W, H))
+        _profile.mark("outline")
 
     # Volumes of this region that were not drawn (hidden, culled, deleted)
     # must not keep a worker busy.

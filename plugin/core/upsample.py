@@ -30,8 +30,14 @@ Two filters:
     scene| <= tol, both clamped to the box's range): a ray stopped by a
     nearer mesh lacks the volume behind it, a ray that went past this
     pixel's mesh holds volume the mesh hides. When none agrees, the ones
-    stopped nearer (too little volume, never volume behind the mesh), and
-    when none of those either, nothing. Smooth where the scene depth is
+    stopped nearer (too little volume, never volume behind the mesh). When
+    none of those either, every neighbour went past this pixel's scene: a
+    feature thinner than a frame pixel, such as a wire line, that no ray of
+    the coarse frame met. Their colour is used only where their nearest
+    hit lies in front of this pixel's scene (the volume's surface is in
+    front of the line, so it covers it, as the full frame will), otherwise
+    nothing: a line in front of the volume stays whole, a line behind an
+    opaque volume is not drawn through it in dashes. Smooth where the scene depth is
     smooth (a preview looks like a soft image instead of blocks), and a
     volume pixel from behind a mesh never covers that mesh. Premultiplied
     colour is what is interpolated, so edges of the volume fade without
@@ -103,22 +109,22 @@ def composite(color, hit, stop, scene, proj, near, far, tol, mode=BILATERAL):
     x0, x1, y0, y1, tx, ty = _neighbours(h, w, H, W)
     dp = clamped_planar(scene, proj, near, far)
     ds = clamped_planar(stop, proj, near, far)
-    # per class (0: stopped at this pixel's depth, 1: stopped nearer): the
-    # bilinearly weighted colour, the plain mean (for a pixel on a frame
-    # pixel's centre line, whose only weighted neighbour may disagree), and
-    # the nearest hit
-    acc = np.zeros((2, H, W, 4))
-    wsum = np.zeros((2, H, W))
-    accu = np.zeros((2, H, W, 4))
-    cnt = np.zeros((2, H, W))
-    nhit = np.ones((2, H, W))
+    # per class (0: stopped at this pixel's depth, 1: stopped nearer, 2:
+    # went past it): the bilinearly weighted colour, the plain mean (for a
+    # pixel on a frame pixel's centre line, whose only weighted neighbour
+    # may disagree), and the nearest hit
+    acc = np.zeros((3, H, W, 4))
+    wsum = np.zeros((3, H, W))
+    accu = np.zeros((3, H, W, 4))
+    cnt = np.zeros((3, H, W))
+    nhit = np.ones((3, H, W))
     for yi, wy in ((y0, 1.0 - ty), (y1, ty)):
         for xi, wx in ((x0, 1.0 - tx), (x1, tx)):
             wb = np.outer(wy, wx)
             d = ds[yi][:, xi]
             c = color[yi][:, xi]
             hh = hit[yi][:, xi]
-            for k, m in enumerate((np.abs(d - dp) <= tol, d < dp - tol)):
+            for k, m in enumerate((np.abs(d - dp) <= tol, d < dp - tol, d > dp + tol)):
                 acc[k] += np.where(m, wb, 0.0)[..., None] * c
                 wsum[k] += np.where(m, wb, 0.0)
                 accu[k] += m[..., None] * c
@@ -127,7 +133,9 @@ def composite(color, hit, stop, scene, proj, near, far, tol, mode=BILATERAL):
     out = np.zeros((H, W, 4))
     nh = np.ones((H, W))
     done = np.zeros((H, W), bool)
-    for k in (0, 1):
+    for k in (0, 1, 2):
+        if k == 2:  # past this pixel's scene: only a hit in front of it
+            done |= nhit[2] > scene
         weighted = ~done & (wsum[k] > MIN_WEIGHT)
         plain = ~done & ~weighted & (cnt[k] > 0)
         out[weighted] = acc[k][weighted] / wsum[k][weighted][:, None]

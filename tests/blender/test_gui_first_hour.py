@@ -8,6 +8,8 @@ xvfb-run -a -s "-screen 0 1280x1024x24" blender --factory-startup \
     factory Cube, which would hide the volume, is hidden from the viewport
     and renders, and the viewport shows the volume (pixels differ from the
     Cube's grey over a good part of the view); undo brings the Cube back;
+  * the box outline's front edges are whole over the volume, in the still
+    frame and in a preview while the view turns;
   * the Object Data tab (the Empty's own) shows the Voxlight panel below the
     Empty's two-line panel, one click and no scrolling;
   * every render mode, switched to once on the fresh import, draws
@@ -23,6 +25,7 @@ import sys
 
 import bpy
 import numpy as np
+from mathutils import Euler
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import _gui  # noqa: E402
@@ -40,6 +43,34 @@ def area_of(win, kind):
 def changed_share(a, b, tol=0.06):
     """Share of pixels whose colour differs by more than tol."""
     return float((np.abs(a[..., :3] - b[..., :3]).max(-1) > tol).mean())
+
+
+def front_edges_whole(vx, area, ob, img):
+    """(whether, detail): every pixel along the middle 80% of each front
+    edge of ob's box outline (core/box_edges.py) shows the outline's theme
+    colour, in the capture img of the area's 3D view."""
+    if img is None:
+        return False, "no capture"
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    rv3d = area.spaces.active.region_3d
+    be = vx.core.box_edges
+    corners = vx.box_outline.corners(ob)
+    want = np.array(vx.box_outline.colour(ob, bpy.context)[:3])
+    pm = np.array(rv3d.perspective_matrix, np.float64)
+    h, w = img.shape[:2]
+    misses = total = 0
+    for i, j in be.front_edges(corners, np.array(rv3d.view_matrix), rv3d.is_perspective):
+        for t in np.linspace(0.1, 0.9, 40):
+            p = pm @ np.r_[corners[i] * (1 - t) + corners[j] * t, 1.0]
+            x = int((p[0] / p[3] + 1.0) * 0.5 * region.width)
+            y = int((p[1] / p[3] + 1.0) * 0.5 * region.height)
+            if not (1 <= x < w - 1 and 1 <= y < h - 1):
+                continue
+            near = img[y - 1:y + 2, x - 1:x + 2, :3].reshape(-1, 3)
+            total += 1
+            misses += np.abs(near - want).max(axis=1).min() > 0.12
+    return total > 100 and misses <= 0.02 * total, "%d of %d edge samples not the outline's colour" % (
+        misses, total)
 
 
 def steps():
@@ -95,6 +126,18 @@ def steps():
     check("volume_visible_after_import", share > 0.05,
           "%.1f%% of the view changed from the Cube's" % (100 * share))
     check("screenshot_import", view_png(after, "first_hour_import.png"))
+    # The box outline's front edges are whole over the volume, not broken
+    # where tissue lies behind them: in the still frame and in a preview
+    # while the view turns.
+    whole, detail = front_edges_whole(vx, v3d, ob, after)
+    check("box_outline_front_edges_whole_still", whole, detail)
+    v3d.spaces.active.region_3d.view_rotation.rotate(Euler((0.0, 0.0, 0.02)))
+    cap.request()
+    v3d.tag_redraw()
+    yield 0.05
+    whole, detail = front_edges_whole(vx, v3d, ob, cap.img)
+    check("box_outline_front_edges_whole_preview", whole, detail)
+    yield from cap.settled(vx, v3d)
 
     # The Object Data tab (the Empty's own): one click, Voxlight in view
     # below the Empty's two-line panel, nothing to scroll past.

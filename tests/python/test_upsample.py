@@ -122,3 +122,28 @@ def test_full_scale_equals_the_frame():
     hit = np.ones((H, W))
     rgba, _ = upsample.composite(color, hit, scene, scene, PROJ, NEAR, FAR, 0.02)
     assert np.allclose(rgba, color)
+
+
+@pytest.mark.parametrize("scale", [0.1, 0.23, 0.35, 0.5])
+@pytest.mark.parametrize("line_planar, covered", [(4.8, True), (3.05, False)])
+def test_thin_line_behind_the_volume_is_covered_and_in_front_stays(scale, line_planar, covered):
+    """A one-pixel wire (the box outline's edges) that no ray of the coarse
+    frame met: behind the volume's opaque surface (4.0) the preview covers
+    it, as the full frame does, instead of showing it through in dashes;
+    in front of that surface it stays whole."""
+    w, h = max(1, round(W * scale)), max(1, round(H * scale))
+    scene = np.ones((H, W), np.float32)
+    line = np.zeros((H, W), bool)
+    line[:, 45] = True
+    scene[line] = depth.planar_to_window(np.float32(line_planar), PROJ)
+    stop = np.ones((h, w))  # the coarse frame's samples missed the line
+    hit = np.full((h, w), depth.planar_to_window(np.float32(4.0), PROJ))
+    color = np.tile((0.6, 0.5, 0.4, 1.0), (h, w, 1))
+    tol = upsample.tolerance(0.01)
+    rgba, frag = upsample.composite(color, hit, stop, scene, PROJ, NEAR, FAR, tol)
+    if covered:
+        assert np.allclose(rgba[line], (0.6, 0.5, 0.4, 1.0))
+    else:
+        assert (rgba[line] == 0.0).all()
+    assert np.allclose(rgba[~line], (0.6, 0.5, 0.4, 1.0))
+    assert (frag <= scene + 1e-7).all()

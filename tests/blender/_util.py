@@ -140,6 +140,19 @@ def test(fn):
     return fn
 
 
+def test_oldest_and_newest(fn):
+    """A test that runs in the oldest and the newest Blender of a suite run
+    only (tools/run_blender_tests.sh sets VOXLIGHT_BLENDER_COVERAGE=api in
+    the releases between): for slow tests of what the library does
+    (memory, streaming) or of a renderer generation the two ends already
+    cover (EEVEE Legacy in 3.4, EEVEE Next in the newest), where the middle
+    releases add run time but no Blender API the ends do not call. Run by
+    hand, without the variable, it always runs."""
+    if os.environ.get("VOXLIGHT_BLENDER_COVERAGE") != "api":
+        _tests.append(fn)
+    return fn
+
+
 def run(name):
     passed = failed = 0
     for fn in _tests:

@@ -89,7 +89,7 @@ def _erode(mask, n):
     return m
 
 
-@test
+@u.test_oldest_and_newest
 def eevee_shadow_of_two_lights_is_smooth_and_matches_cycles():
     scene, ob = _scene()
     images = {}

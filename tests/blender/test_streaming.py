@@ -237,7 +237,7 @@ def _sparse_file(folder):
     return path
 
 
-@test
+@u.test_oldest_and_newest
 def larger_than_memory_renders_within_the_budget():
     folder = tempfile.mkdtemp(prefix="voxlight-sparse-")
     try:

@@ -1,14 +1,17 @@
 """Writes one colour DICOM file (two frames, 8 bits a sample) with pydicom,
 a writer independent of dcmtk and of our decoders.
 
-usage: make_colour_dicom.py OUT rgb|rgb-planar|ybr|ybr422|j2k
+usage: make_colour_dicom.py OUT rgb|rgb-planar|ybr|ybr422|j2k|palette|palette8
 
 Pixel (i, j) of frame k is R = (40 i + 10 k) % 256, G = (50 j + 30) % 256,
 B = (7 i j + k) % 256 (tests/test_dicom_frames.c computes the same), stored
 as RGB (samples of a pixel together, or as planes), as full-range YCbCr
 (YBR_FULL; YBR_FULL_422 with the chroma of each two pixels averaged), or as
 JPEG 2000 frames from opj_compress, which applies its reversible colour
-transform (YBR_RCT).
+transform (YBR_RCT), or as PALETTE COLOR: one index per pixel into red,
+green and blue tables of the pattern's distinct colours, 4096 16-bit
+entries from index 0 ("palette") or 8-bit entries packed two to a word
+from index 10 ("palette8").
 """
 import sys
 
@@ -74,6 +77,25 @@ def main(out, mode):
         ds.PhotometricInterpretation = "YBR_RCT"
         ppm = [b"P6\n%d %d\n255\n" % (COLS, ROWS) + f.tobytes() for f in frames]
         encapsulated(ds, [j2k_frame(p) for p in ppm], "1.2.840.10008.1.2.4.90")
+    elif mode in ("palette", "palette8"):
+        ds.PhotometricInterpretation, ds.SamplesPerPixel = "PALETTE COLOR", 1
+        del ds.PlanarConfiguration
+        flat = np.concatenate([f.reshape(-1, 3) for f in frames])
+        colours, index = np.unique(flat, axis=0, return_inverse=True)
+        first = 10 if mode == "palette8" else 0
+        bits = 8 if mode == "palette8" else 16
+        if bits == 16:  # tables longer than a header read (dcmtk loads them when asked)
+            colours = np.concatenate([colours, np.zeros((4096 - len(colours), 3), colours.dtype)])
+        for name, c in zip(("Red", "Green", "Blue"), range(3)):
+            setattr(ds, name + "PaletteColorLookupTableDescriptor", [len(colours), first, bits])
+            entries = colours[:, c].astype(np.uint16)
+            if bits == 8:
+                data = entries.astype(np.uint8).tobytes()
+                data += b"\0" * (len(data) % 2)
+            else:
+                data = (entries * 257).astype("<u2").tobytes()
+            setattr(ds, name + "PaletteColorLookupTableData", data)
+        data = (index.reshape(-1) + first).astype(np.uint8).tobytes()
     else:
         sys.exit("make_colour_dicom: unknown mode %s" % mode)
     if mode != "j2k":

@@ -350,7 +350,8 @@ static double colour_luminance(int i, int j, int k)
 
 /* Colour DICOM (RGB by pixel and by plane, YBR_FULL, YBR_FULL_422, JPEG
  * 2000 with its colour transform, and dcmtk's RLE, lossless JPEG, JPEG-LS
- * and Baseline of the RGB file) loads as its luminance, with a note saying
+ * and Baseline of the RGB file; PALETTE COLOR with 16-bit and packed 8-bit
+ * tables, and its RLE) loads as its luminance, with a note saying
  * so: exact where the encoding is lossless and RGB; within 1 of the
  * YCbCr the writer rounded; within 12 for YBR_FULL_422, whose two pixels
  * share one averaged chroma (measured 10 on this sharp pattern); within 24
@@ -364,7 +365,8 @@ TEST(colour_in_every_encoding_reads_as_its_luminance)
         {"rgb", NULL, 0},           {"rgb-planar", NULL, 0},     {"ybr", NULL, 1},
         {"ybr422", NULL, 12},       {"j2k", NULL, 0},            {"rgb", "dcmcrle", 0},
         {"rgb-planar", "dcmcrle", 0}, {"rgb", "dcmcjpeg", 0},    {"rgb", "dcmcjpls", 0},
-        {"rgb", "dcmcjpeg +eb", 24},
+        {"rgb", "dcmcjpeg +eb", 24}, {"palette", NULL, 0},     {"palette8", NULL, 0},
+        {"palette", "dcmcrle", 0},
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         char dir[256], path[512], cmd[1024], name[64];

@@ -96,8 +96,9 @@ std::string check_pixels(std::vector<Image> &sl, std::vector<std::string> &notes
         if (s.samples != 1 && !is_colour(s))
             return format("'%s': %u samples per pixel of '%s' is not supported (grey, RGB and YBR_FULL, _422, "
                           "_ICT, _RCT are)", p, s.samples, s.photometric.c_str());
-        if (s.photometric == "PALETTE COLOR")
-            return format("'%s': PALETTE COLOR is not supported yet (grey, RGB and YBR are)", p);
+        if (s.photometric == "PALETTE COLOR" && (!is_palette(s) || s.pixel_rep || s.bits_alloc == 32))
+            return format("'%s': PALETTE COLOR of %u sample(s) of %u %s bits is not supported (one unsigned 8- "
+                          "or 16-bit index)", p, s.samples, s.bits_alloc, s.pixel_rep ? "signed" : "unsigned");
         if (is_colour(s) && (s.bits_alloc == 32 || s.pixel_rep))
             return format("'%s': colour of %u %s bits per sample is not supported (8 or 16, unsigned)", p,
                           s.bits_alloc, s.pixel_rep ? "signed" : "unsigned");
@@ -120,7 +121,7 @@ std::string check_pixels(std::vector<Image> &sl, std::vector<std::string> &notes
             s.ps[0] = s.ps[1] = 1;
             assumed++;
         }
-    if (is_colour(f))
+    if (is_colour(f) || is_palette(f))
         notes.push_back(format("colour (%s) shown as its luminance (Rec. 709): colour volumes are not rendered yet",
                                f.photometric.c_str()));
     if (assumed)

@@ -266,6 +266,11 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
     if (ds->findAndGetElement(DCM_PixelData, el).bad() || !el)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': no PixelData", p);
     const bool colour = is_colour(s);
+    Palette palette;
+    if (is_palette(s)) {
+        int rc = read_palette(ds, s, palette, e);
+        if (rc) return rc;
+    }
     const size_t n = size_t(s.rows) * s.cols, bytes = n * (s.bits_alloc / 8);
     // a frame as stored uncompressed (YBR_FULL_422: two samples a pixel) and as decoded
     const size_t stored = colour ? (native_layout(s) == Layout::ybr422 ? 2 : 3) * bytes : bytes;
@@ -313,6 +318,7 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
             const uint8_t *frame = static_cast<const uint8_t *>(all) + size_t(f) * stored;
             if (colour) grey_of_colour(s, frame, native_layout(s), ybr, dst[i]);
             else unpack_frame(s, frame, n, dst[i]);
+            if (is_palette(s)) grey_of_palette(s, palette, dst[i]);
             continue;
         }
         Layout layout = Layout::interleaved;
@@ -351,6 +357,7 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
         }
         if (colour) grey_of_colour(s, raw.data(), layout, frame_ybr, dst[i]);
         else unpack_frame(s, raw.data(), n, dst[i]);
+        if (is_palette(s)) grey_of_palette(s, palette, dst[i]);
     }
     return VXL_OK;
 }

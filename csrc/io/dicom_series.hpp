@@ -7,6 +7,7 @@
 //                     and the resampling plan for uneven spacing
 //   dicom_pixels.cpp  one file's frames -> pixels (dcmtk for the uncompressed
 //                     and the codecs it has, our C for RLE and lossless JPEG)
+//   dicom_palette.cpp PALETTE COLOR indices -> the luminance of their colours
 //   dicom.cpp         folder scan, series choice, the parallel load
 // Only the helper process voxlight-read-dicom runs these: libvoxlight links
 // no C++.
@@ -93,6 +94,23 @@ void analyse(Series &s);
 // Three samples per pixel in a photometric interpretation the reader turns
 // into colour (RGB, YBR_FULL, YBR_FULL_422, YBR_ICT, YBR_RCT).
 bool is_colour(const Image &im);
+
+// One bits-stored index per pixel into red, green and blue lookup tables
+// (dicom_palette.cpp).
+bool is_palette(const Image &im);
+
+// A PALETTE COLOR image's tables, as 16-bit entries, and each entry's
+// Rec. 709 luminance on that scale.
+struct Palette {
+    std::vector<uint16_t> rgb[3];
+    std::vector<double> luminance;
+    long first = 0; // the stored value of entry 0
+};
+// Reads the tables of a file's dataset; VXL_OK or a vxl_fail naming the file.
+int read_palette(DcmItem *ds, const Image &im, Palette &pal, vxl_err *e);
+// A frame of indices (as read_frames unpacks grey pixels), in place, into
+// the luminance of their colours, in the frame's own type.
+void grey_of_palette(const Image &s, const Palette &pal, void *frame);
 
 // Registers the decoders dcmtk keeps in a process-wide list: once, before
 // any thread reads, as dcmtk asks.

@@ -1,7 +1,9 @@
 """Seeds for fuzz_dicom beyond make_seeds' single-frame files: enhanced
 multi-frame files (functional groups, 4D time points, JPEG 2000 frames
 behind a basic offset table), written by tests/make_enhanced_dicom.py with
-pydicom, and classic multi-frame RLE and JPEG-LS copies made by dcmtk.
+pydicom, classic multi-frame RLE and JPEG-LS copies made by dcmtk, and
+PALETTE COLOR files (16-bit and packed 8-bit tables) from
+tests/make_colour_dicom.py.
 
 usage: dicom_seeds.py OUT_DIR
 """
@@ -27,6 +29,9 @@ def main(out):
     enhanced(out / "enhanced_j2k.dcm", 1, 3, "j2k")
     for name, tool in (("enhanced_rle.dcm", ["dcmcrle"]), ("enhanced_jpls.dcm", ["dcmcjpls", "-ot"])):
         subprocess.run([*tool, str(out / "enhanced.dcm"), str(out / name)], check=True)
+    for mode in ("palette", "palette8"):
+        subprocess.run([sys.executable, str(ROOT / "tests" / "make_colour_dicom.py"), str(out / (mode + ".dcm")), mode],
+                       check=True)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,133 @@
+// dicom_palette.cpp - PALETTE COLOR images (PS3.3 C.7.6.3.1.5-6): each
+// stored value indexes three lookup tables, red, green and blue. The
+// pixels room reads the indices as it reads grey ones, and this room
+// turns them into the Rec. 709 luminance of their colours, as colour
+// images are turned (colour volumes are not rendered yet).
+//
+// A table's descriptor is (entries, first mapped value, bits per entry):
+// 0 entries means 65536; indices below the first mapped value take the
+// first entry, indices past the last take the last. 16-bit entries are one
+// word each; 8-bit entries come packed two to a word (as pydicom and
+// dcmtk's dcmimage read them) or, in files that spend a word on each, one
+// to a word: the data's length tells which. Segmented tables are refused
+// by name.
+#include "dicom_series.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+extern "C" {
+#include "error.h"
+#include "voxlight.h"
+}
+
+namespace vxl_dicom {
+
+bool is_palette(const Image &im) { return im.samples == 1 && im.photometric == "PALETTE COLOR"; }
+
+namespace {
+
+// One value of a descriptor, whose VR is US or SS (the first mapped value
+// follows the pixels' signedness).
+bool descriptor_value(DcmItem *ds, const DcmTagKey &tag, unsigned long pos, long &out)
+{
+    Uint16 u = 0;
+    if (ds->findAndGetUint16(tag, u, pos).good()) {
+        out = u;
+        return true;
+    }
+    Sint16 s = 0;
+    if (ds->findAndGetSint16(tag, s, pos).good()) {
+        out = s;
+        return true;
+    }
+    return false;
+}
+
+int read_table(DcmItem *ds, const Image &im, const DcmTagKey &desc_tag, const DcmTagKey &data_tag,
+               const DcmTagKey &segmented_tag, const char *name, std::vector<uint16_t> &out, long &first, vxl_err *e)
+{
+    const char *p = im.path.c_str();
+    if (ds->tagExists(segmented_tag))
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': a segmented PALETTE COLOR lookup table is not supported", p);
+    long entries = 0, bits = 0;
+    if (!descriptor_value(ds, desc_tag, 0, entries) || !descriptor_value(ds, desc_tag, 1, first) ||
+        !descriptor_value(ds, desc_tag, 2, bits))
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': PALETTE COLOR without a %s lookup table descriptor", p, name);
+    if (entries <= 0) entries += 65536; // 0 (or a US value read as SS) means 65536
+    if (bits != 8 && bits != 16)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the %s palette has %ld bits per entry (8 or 16)", p, name, bits);
+    // OW (or US) words in the machine's order, as dcmtk hands them over
+    DcmElement *el = nullptr;
+    Uint16 *words = nullptr;
+    if (ds->findAndGetElement(data_tag, el).bad() || !el || el->getUint16Array(words).bad() || !words)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': PALETTE COLOR without the %s lookup table data", p, name);
+    const size_t nwords = el->getLength() / 2, n = size_t(entries);
+    out.resize(n);
+    if (bits == 16 || nwords >= n) { // a word each (8-bit entries in its low byte)
+        if (nwords < n)
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the %s palette holds %zu words for %zu entries", p, name,
+                            nwords, n);
+        for (size_t i = 0; i < n; i++) out[i] = bits == 16 ? words[i] : uint16_t((words[i] & 0xffu) * 257u);
+    } else { // two 8-bit entries a word, the first in the low byte
+        if (2 * nwords < n)
+            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the %s palette holds %zu bytes for %zu 8-bit entries", p, name,
+                            2 * nwords, n);
+        for (size_t i = 0; i < n; i++) {
+            const unsigned byte = (words[i / 2] >> (8 * (i & 1))) & 0xffu;
+            out[i] = uint16_t(byte * 257u); // to 16 bits: 255 -> 65535
+        }
+    }
+    return VXL_OK;
+}
+
+} // namespace
+
+int read_palette(DcmItem *ds, const Image &im, Palette &pal, vxl_err *e)
+{
+    long first[3] = {0, 0, 0};
+    int rc = read_table(ds, im, DCM_RedPaletteColorLookupTableDescriptor, DCM_RedPaletteColorLookupTableData,
+                        DCM_SegmentedRedPaletteColorLookupTableData, "red", pal.rgb[0], first[0], e);
+    if (!rc)
+        rc = read_table(ds, im, DCM_GreenPaletteColorLookupTableDescriptor, DCM_GreenPaletteColorLookupTableData,
+                        DCM_SegmentedGreenPaletteColorLookupTableData, "green", pal.rgb[1], first[1], e);
+    if (!rc)
+        rc = read_table(ds, im, DCM_BluePaletteColorLookupTableDescriptor, DCM_BluePaletteColorLookupTableData,
+                        DCM_SegmentedBluePaletteColorLookupTableData, "blue", pal.rgb[2], first[2], e);
+    if (rc) return rc;
+    if (first[1] != first[0] || first[2] != first[0] || pal.rgb[1].size() != pal.rgb[0].size() ||
+        pal.rgb[2].size() != pal.rgb[0].size())
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the red, green and blue palettes disagree in size or first value",
+                        im.path.c_str());
+    pal.first = first[0];
+    // one luminance per entry, on the 16-bit scale of the entries
+    const size_t n = pal.rgb[0].size();
+    pal.luminance.resize(n);
+    for (size_t i = 0; i < n; i++)
+        pal.luminance[i] = 0.2126 * pal.rgb[0][i] + 0.7152 * pal.rgb[1][i] + 0.0722 * pal.rgb[2][i];
+    return VXL_OK;
+}
+
+namespace {
+
+template <typename T> void indices_to_grey(const Palette &pal, size_t n, T *px)
+{
+    // the output keeps the container's type: 8-bit indices give 8-bit luminance
+    const double scale = sizeof(T) == 1 ? 255.0 / 65535.0 : 1.0;
+    const long last = long(pal.luminance.size()) - 1;
+    for (size_t i = 0; i < n; i++) {
+        const long k = std::min(last, std::max(0L, long(px[i]) - pal.first));
+        px[i] = T(std::lround(pal.luminance[size_t(k)] * scale));
+    }
+}
+
+} // namespace
+
+void grey_of_palette(const Image &s, const Palette &pal, void *frame)
+{
+    const size_t n = size_t(s.rows) * s.cols;
+    if (s.bits_alloc == 8) indices_to_grey(pal, n, static_cast<uint8_t *>(frame));
+    else indices_to_grey(pal, n, static_cast<uint16_t *>(frame));
+}
+
+} // namespace vxl_dicom

@@ -77,7 +77,12 @@ typedef struct stress_vol {
     stress_fill fill;
     int affine;
     double slope, inter;
+    /* 0: grey; 3 or 4: a colour volume whose channel c is fill times
+     * sv_channel_gain[c] (so NaN, Inf and extremes reach every channel) */
+    uint32_t components;
 } stress_vol;
+
+static const double sv_channel_gain[4] = {1.0, 0.5, -1.0, 0.25};
 
 static inline double sv_centre(const uint32_t d[3], int a) { return (d[a] - 1) / 2.0; }
 
@@ -175,13 +180,16 @@ static inline int stress_make_volume(const stress_vol *s, const stress_env *e, v
     uint32_t d[3];
     for (int a = 0; a < 3; a++) d[a] = s->dims[a] == BIG_N ? e->big_n : s->dims[a] ? s->dims[a] : e->n;
     uint64_t n = (uint64_t)d[0] * d[1] * d[2];
-    void *raw = malloc(n * sv_dtype_size(s->dtype));
+    const uint32_t comp = s->components ? s->components : 1;
+    void *raw = malloc(n * comp * sv_dtype_size(s->dtype));
     if (!raw) return VXL_ERR_NO_MEMORY;
     for (uint32_t k = 0; k < d[2]; k++)
         for (uint32_t j = 0; j < d[1]; j++)
             for (uint32_t i = 0; i < d[0]; i++) {
                 uint64_t idx = i + (uint64_t)d[0] * (j + (uint64_t)d[1] * k);
-                sv_store(raw, s->dtype, idx, s->fill(i, j, k, d, idx));
+                const double x = s->fill(i, j, k, d, idx);
+                for (uint32_t c = 0; c < comp; c++)
+                    sv_store(raw, s->dtype, idx * comp + c, comp > 1 ? x * sv_channel_gain[c] : x);
             }
     vxl_volume_desc desc;
     memset(&desc, 0, sizeof desc);
@@ -191,6 +199,7 @@ static inline int stress_make_volume(const stress_vol *s, const stress_env *e, v
     desc.data = raw;
     desc.scl_slope = s->slope;
     desc.scl_inter = s->inter;
+    desc.components = s->components;
     double *A = desc.affine;
     desc.has_affine = 1;
     switch (s->affine) {
@@ -875,9 +884,9 @@ typedef struct stress_case {
 
 #define F32 VXL_DTYPE_F32
 #define N3 {0, 0, 0}
-#define VOL(dt, fill) {dt, N3, fill, AFF_NONE, 0, 0}
+#define VOL(dt, fill) {dt, N3, fill, AFF_NONE, 0, 0, 0}
 #define BALL VOL(F32, fill_ball)
-#define BALL_AFF(aff) {F32, N3, fill_ball, aff, 0, 0}
+#define BALL_AFF(aff) {F32, N3, fill_ball, aff, 0, 0, 0}
 #define OK VXL_OK
 #define BAD VXL_ERR_INVALID_ARGUMENT
 #define TF_SIZE_ERRORS (1u << VXL_ERR_INVALID_ARGUMENT | 1u << VXL_ERR_LIMIT)
@@ -916,6 +925,15 @@ static const stress_case stress_cases[] = {
      F_FULL_ONLY, 0},
     {"u16_full_range_ball", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_U16, fill_u16_max_ball), view_default, OK,
      F_VISIBLE, 0},
+    /* colour volumes: the voxels' colour beside the luminance scalar (docs/colour.md) */
+    {"colour_rgb_u8_const", GROUP_dtypes_and_scaling, {VXL_DTYPE_U8, N3, fill_u8_max, AFF_NONE, 0, 0, 3}, view_default,
+     OK, 0, 0},
+    {"colour_rgba_u16_ball", GROUP_dtypes_and_scaling, {VXL_DTYPE_U16, N3, fill_u16_max_ball, AFF_NONE, 0, 0, 4},
+     view_default, OK, 0, 0},
+    {"colour_rgb_f32_nan_inf_mix", GROUP_dtypes_and_scaling, {F32, N3, fill_nan_inf_mix, AFF_NONE, 0, 0, 3},
+     view_default, OK, 0, 0},
+    {"colour_rgb_f64_max_and_nan", GROUP_dtypes_and_scaling, {VXL_DTYPE_F64, N3, fill_f64_max_and_nan, AFF_ROT_SHEAR, 0, 0, 3},
+     view_default, OK, 0, 0},
     {"i32_extremes_checker", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_I32, fill_i32_checker), view_default, OK, 0, 0},
     {"u32_full_range_ball", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_U32, fill_u32_max_ball), view_default, OK,
      F_VISIBLE, 0},
@@ -923,36 +941,36 @@ static const stress_case stress_cases[] = {
     {"f64_denormal_ball", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_F64, fill_f64_denormal_ball), view_default, OK,
      F_VISIBLE, 0},
     {"f64_max_and_nan", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_F64, fill_f64_max_and_nan), view_default, OK, 0, 0},
-    {"scl_slope_zero", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_ramp, AFF_NONE, 0, 5}, view_default,
+    {"scl_slope_zero", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_ramp, AFF_NONE, 0, 5, 0}, view_default,
      OK, 0, 0},
-    {"scl_slope_negative_i16", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_ball, AFF_NONE, -1, 0},
+    {"scl_slope_negative_i16", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_ball, AFF_NONE, -1, 0, 0},
      view_default, OK, F_VISIBLE, 0},
-    {"scl_slope_negative_f32", GROUP_dtypes_and_scaling, {F32, N3, fill_ball, AFF_NONE, -3, 1}, view_default, OK,
+    {"scl_slope_negative_f32", GROUP_dtypes_and_scaling, {F32, N3, fill_ball, AFF_NONE, -3, 1, 0}, view_default, OK,
      F_VISIBLE, 0},
-    {"scl_slope_negative_huge", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_checker, AFF_NONE, -1e30, 7},
+    {"scl_slope_negative_huge", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_checker, AFF_NONE, -1e30, 7, 0},
      view_default, OK, 0, 0},
-    {"scl_slope_tiny", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_ramp, AFF_NONE, 1e-300, 0},
+    {"scl_slope_tiny", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_ramp, AFF_NONE, 1e-300, 0, 0},
      view_default, OK, 0, 0},
     {"scl_slope_overflows_double", GROUP_dtypes_and_scaling,
-     {VXL_DTYPE_I16, N3, fill_i16_checker, AFF_NONE, 1e305, 0}, view_default, OK, F_ALLOW_CREATE_ERROR, 0},
-    {"scl_slope_negative_window", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_ball, AFF_NONE, -1, 0},
+     {VXL_DTYPE_I16, N3, fill_i16_checker, AFF_NONE, 1e305, 0, 0}, view_default, OK, F_ALLOW_CREATE_ERROR, 0},
+    {"scl_slope_negative_window", GROUP_dtypes_and_scaling, {VXL_DTYPE_I16, N3, fill_i16_ball, AFF_NONE, -1, 0, 0},
      window_inverted, OK, 0, 0},
 
     /* shapes */
-    {"dims_1x1x1", GROUP_shapes, {F32, {1, 1, 1}, fill_five, AFF_NONE, 0, 0}, view_default, OK, 0, 0},
-    {"dims_1x1x1_opaque", GROUP_shapes, {F32, {1, 1, 1}, fill_five, AFF_NONE, 0, 0}, tf_opaque_white, OK,
+    {"dims_1x1x1", GROUP_shapes, {F32, {1, 1, 1}, fill_five, AFF_NONE, 0, 0, 0}, view_default, OK, 0, 0},
+    {"dims_1x1x1_opaque", GROUP_shapes, {F32, {1, 1, 1}, fill_five, AFF_NONE, 0, 0, 0}, tf_opaque_white, OK,
      F_VISIBLE, 0},
-    {"dims_1x1x1_nan", GROUP_shapes, {F32, {1, 1, 1}, fill_all_nan, AFF_NONE, 0, 0}, view_default, OK, 0, 0},
-    {"dims_2x2x2", GROUP_shapes, {F32, {2, 2, 2}, fill_index, AFF_NONE, 0, 0}, view_default, OK, 0, 0},
-    {"dims_2x2x2_i16", GROUP_shapes, {VXL_DTYPE_I16, {2, 2, 2}, fill_i16_checker, AFF_NONE, 0, 0}, view_default,
+    {"dims_1x1x1_nan", GROUP_shapes, {F32, {1, 1, 1}, fill_all_nan, AFF_NONE, 0, 0, 0}, view_default, OK, 0, 0},
+    {"dims_2x2x2", GROUP_shapes, {F32, {2, 2, 2}, fill_index, AFF_NONE, 0, 0, 0}, view_default, OK, 0, 0},
+    {"dims_2x2x2_i16", GROUP_shapes, {VXL_DTYPE_I16, {2, 2, 2}, fill_i16_checker, AFF_NONE, 0, 0, 0}, view_default,
      OK, 0, 0},
-    {"dims_1xNxN", GROUP_shapes, {F32, {1, 0, 0}, fill_ball, AFF_NONE, 0, 0}, view_ball_default, OK, F_VISIBLE, 0},
-    {"dims_Nx1xN", GROUP_shapes, {F32, {0, 1, 0}, fill_ball, AFF_NONE, 0, 0}, view_ball_default, OK, F_VISIBLE, 0},
-    {"dims_NxNx1", GROUP_shapes, {F32, {0, 0, 1}, fill_ball, AFF_NONE, 0, 0}, view_ball_default, OK, F_VISIBLE, 0},
-    {"dims_1x1xN", GROUP_shapes, {F32, {1, 1, 0}, fill_index, AFF_NONE, 0, 0}, view_default, OK, 0, 0},
-    {"dims_Nx1x1", GROUP_shapes, {F32, {0, 1, 1}, fill_index, AFF_NONE, 0, 0}, view_default, OK, 0, 0},
-    {"dims_1xNxN_edge_on", GROUP_shapes, {F32, {1, 0, 0}, fill_ball, AFF_NONE, 0, 0}, axis_ortho_minus_y, OK, 0, 0},
-    {"dims_1xNxN_face_on", GROUP_shapes, {F32, {1, 0, 0}, fill_ball, AFF_NONE, 0, 0}, axis_ortho_plus_x, OK,
+    {"dims_1xNxN", GROUP_shapes, {F32, {1, 0, 0}, fill_ball, AFF_NONE, 0, 0, 0}, view_ball_default, OK, F_VISIBLE, 0},
+    {"dims_Nx1xN", GROUP_shapes, {F32, {0, 1, 0}, fill_ball, AFF_NONE, 0, 0, 0}, view_ball_default, OK, F_VISIBLE, 0},
+    {"dims_NxNx1", GROUP_shapes, {F32, {0, 0, 1}, fill_ball, AFF_NONE, 0, 0, 0}, view_ball_default, OK, F_VISIBLE, 0},
+    {"dims_1x1xN", GROUP_shapes, {F32, {1, 1, 0}, fill_index, AFF_NONE, 0, 0, 0}, view_default, OK, 0, 0},
+    {"dims_Nx1x1", GROUP_shapes, {F32, {0, 1, 1}, fill_index, AFF_NONE, 0, 0, 0}, view_default, OK, 0, 0},
+    {"dims_1xNxN_edge_on", GROUP_shapes, {F32, {1, 0, 0}, fill_ball, AFF_NONE, 0, 0, 0}, axis_ortho_minus_y, OK, 0, 0},
+    {"dims_1xNxN_face_on", GROUP_shapes, {F32, {1, 0, 0}, fill_ball, AFF_NONE, 0, 0, 0}, axis_ortho_plus_x, OK,
      F_VISIBLE, 0},
 
     /* affines */
@@ -1054,7 +1072,7 @@ static const stress_case stress_cases[] = {
     {"step_denormal", GROUP_steps, BALL, step_denormal, OK, F_VISIBLE, 0},
     {"step_1e-4_camera_inside", GROUP_steps, BALL, step_1e_4_inside, OK, F_VISIBLE, 0},
     {"step_100_axis_rays", GROUP_steps, BALL, step_100_axis, OK, 0, 0},
-    {"step_1e-4_big_volume", GROUP_steps, {F32, {BIG_N, BIG_N, BIG_N}, fill_ball, AFF_NONE, 0, 0}, step_1e_4, OK,
+    {"step_1e-4_big_volume", GROUP_steps, {F32, {BIG_N, BIG_N, BIG_N}, fill_ball, AFF_NONE, 0, 0, 0}, step_1e_4, OK,
      F_VISIBLE, 0},
     {"sample_distance_1e-3", GROUP_steps, BALL, sample_distance_min, OK, F_VISIBLE, 0},
     {"sample_distance_64", GROUP_steps, BALL, sample_distance_max, OK, F_VISIBLE, 0},

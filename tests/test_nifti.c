@@ -817,9 +817,10 @@ TEST(bad_vox_offset_and_datatype_are_format_errors)
     h.vox_offset = -4;
     EXPECT_FAIL("voxoff.hdr", &h, g_zeros, 64, NULL, VXL_ERR_FORMAT, "vox_offset");
 
+    /* RGB24 loads as colour (test_colour.c): 3 bytes a voxel, so 64 bytes are a truncated file */
     tnw_init(&h, 1, 128, 4, 4, 4);
-    EXPECT_FAIL("rgb.nii", &h, g_zeros, 192, NULL, VXL_ERR_FORMAT, "unsupported datatype 128 (RGB24)");
-    int others[] = {0, 1, 32, 1024, 1280, 1536, 1792, 2048, 2304, 3, -1};
+    EXPECT_FAIL("rgb.nii", &h, g_zeros, 64, NULL, VXL_ERR_FORMAT, "truncated");
+    int others[] = {0, 1, 32, 1024, 1280, 1536, 1792, 2048, 3, -1};
     for (size_t i = 0; i < sizeof others / sizeof others[0]; i++) {
         char want[48];
         snprintf(want, sizeof want, "datatype %d", others[i]);

@@ -233,7 +233,7 @@ static void check_still_works(case_run *cr, int b, const char *label)
 {
     float img[4 * 24 * 24], dep[24 * 24];
     if (cr->c->flags & F_BAD_VOLUME) { /* the volume was the problem: a good one must work */
-        static const stress_vol good = {VXL_DTYPE_F32, {8, 8, 8}, fill_ball, AFF_NONE, 0, 0};
+        static const stress_vol good = {VXL_DTYPE_F32, {8, 8, 8}, fill_ball, AFF_NONE, 0, 0, 0};
         vxl_volume *v = NULL;
         int rc = stress_make_volume(&good, &ENV, &v);
         if (rc == VXL_OK) rc = vxl_renderer_set_volume(R[b], v);

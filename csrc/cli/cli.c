@@ -17,6 +17,7 @@
 #include "cli_labels.h" /* the labels command (issue 20) */
 #include "cli_labels_render.h" /* render --labels ... (issue 20) */
 #include "cli_overlays.h" /* render --overlay ... (issue 20) */
+#include "cli_colour.h" /* --color-source, --opacity-source, the components line */
 #include "cli_stream.h" /* --streaming, --cache-dir, first-open progress, Ctrl-C, budget split (issue 21) */
 #include "voxlight_dev.h" /* phantoms (phantom:NAME inputs) and --no-skip */
 
@@ -39,7 +40,9 @@ static const char usage_format[] =
     "                  [--labels LABELS [--label-lut FILE] [--label-mode surface|mask|tint] [--label-surface smooth|voxels]\n"
     "                   [--hide-labels ID,...] [--label-opacity ID:ALPHA,...]]\n"
     "                  [--overlay FILE[:PRESET][:LO:HI] [--overlay-blend over|add|max] [--overlay-opacity X]]...\n"
+    "                  [--color-source auto|data|tf] [--opacity-source luminance|alpha|channel:N]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID] [--streaming MODE] [--cache-dir DIR]\n"
+    "                  [--opacity-source luminance|alpha|channel:N]\n"
     "  voxlight labels FILE   (a label lookup table: FreeSurfer LUT, ITK-SNAP, Slicer .ctbl, MRIcron .lut/.txt)\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
@@ -51,6 +54,9 @@ static const char usage_format[] =
     "streaming: auto reads bricks on demand when the voxels exceed half of the volume's share, on always,\n"
     "         off never; a .nii.gz is streamed once into a bricked cache (beside the file, or in --cache-dir)\n"
     "         with progress on stderr; Ctrl-C during that first open cancels it (exit status 130, no cache kept)\n"
+    "colour (RGB, RGBA: NIfTI RGB24/RGBA32, vector NIfTI): rendered in the data's colour (--color-source\n"
+    "         auto or data; tf: the transfer function's), opacity from the transfer function of the\n"
+    "         --opacity-source scalar (luminance by default, alpha, or channel:N, 0 red .. 3 alpha)\n"
     "filters: %s; presets: %s\n"
     "storage: auto = one texture when it fits the texture limit and --memory-budget, else bricked;\n"
     "         sparse keeps only the bricks the transfer function can show; compressed holds every brick\n"
@@ -325,7 +331,8 @@ static int cmd_info(int argc, char **argv)
         int r = parse_input_option(argc, argv, &i, &lo);
         if (r < 0) return 1;
         if (r) continue;
-        if ((r = vxl_cli_stream_option(argc, argv, &i, &stream, serr, sizeof serr)) != 0) {
+        if ((r = vxl_cli_stream_option(argc, argv, &i, &stream, serr, sizeof serr)) != 0 ||
+            (r = vxl_cli_colour_option(argc, argv, &i, NULL, &lo, serr, sizeof serr)) != 0) {
             if (r < 0) return die("%s", serr);
             continue;
         }
@@ -362,6 +369,7 @@ static int cmd_info(int argc, char **argv)
     const char *dtype = vxl_dtype_name(in.dtype);
     printf("data type:   %s (stored as %u-bit %s)\n", dtype ? dtype : "?", in.texture_bits,
            in.texture_bits == 32 ? "float" : "normalised");
+    vxl_cli_colour_print_info(&in, stdout);
     printf("value range: %g .. %g\n", in.value_min, in.value_max);
     printf("nan voxels:  %llu\n", (unsigned long long)in.nan_count);
     printf("inf voxels:  %llu\n", (unsigned long long)in.inf_count);
@@ -486,6 +494,8 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (r < 0) return die("%s", err); /* issue 20 overlays */
         } else if ((r = vxl_cli_stream_option(argc, argv, &i, &a->stream, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err); /* issue 21 */
+        } else if ((r = vxl_cli_colour_option(argc, argv, &i, p, &a->lo, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err); /* colour volumes */
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);

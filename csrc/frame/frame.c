@@ -261,6 +261,11 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown technique %u (0 raycast, 1 slices2d, 2 slices3d)",
                         p->technique);
     f->technique = p->technique;
+    if (p->color_source >= VXL_COLOR_SOURCE_COUNT)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown color_source %u (0 auto, 1 data, 2 tf)", p->color_source);
+    if (p->reserved2)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "render params reserved2 is %u: it must be 0", p->reserved2);
+    f->color_source = p->color_source;
     rc = vxl_frame_resolve_mode(f, p, e); /* issue 19: mode, iso_value, MatCap */
     if (rc) return rc;
     f->gradient_ref = p->gradient_ref == 0 ? 0.05f : p->gradient_ref;

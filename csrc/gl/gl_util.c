@@ -90,6 +90,8 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
                  ((flags >> 2) & 3) == VXL_CLASSIFY_PRE      ? "#define CLASSIFY_PRE 1\n"
                  : ((flags >> 2) & 3) == VXL_CLASSIFY_PREINT ? "#define CLASSIFY_PREINT 1\n"
                                                              : "");
+        if (flags & VXL_FLAG_DATA_COLOUR) /* a colour volume's own colour (colour/colour.c) */
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define DATA_COLOUR 1\n");
         if ((flags >> 8) & 3) /* issue 17: shadowed / scatter; PHONG compiles as before */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define SHADING_MODEL %u\n",
                      (flags >> 8) & 3);
@@ -151,8 +153,9 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
                      (flags >> VXL_FLAG_LABELS_SHIFT) & 3, (flags & VXL_FLAG_LABEL_VOXELS) ? "#define LABEL_VOXELS 1\n" : "");
         rc = compile(g, GL_COMPUTE_SHADER, "compute/illumination.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
-    case VXL_PROG_SLICE_PLANE: /* slice_plane.c: flags & 3 the interpolation (VXL_INTERP_*), plus the sample flags */
-        snprintf(defines, sizeof defines, "%s%s#define INTERP %u\n", paged, fdef, flags & 3);
+    case VXL_PROG_SLICE_PLANE: /* slice_plane.c: flags & 3 the interpolation (VXL_INTERP_*), plus the sample flags and DATA_COLOUR */
+        snprintf(defines, sizeof defines, "%s%s#define INTERP %u\n%s", paged, fdef, flags & 3,
+                 (flags & VXL_FLAG_DATA_COLOUR) ? "#define DATA_COLOUR 1\n" : "");
         rc = compile(g, GL_COMPUTE_SHADER, "compute/slice_plane.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
     case VXL_PROG_SHADOW_MAP: /* issue 18: depth only */

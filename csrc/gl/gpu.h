@@ -57,6 +57,9 @@
 #define VXL_FLAG_OVERLAYS_SHIFT 18u
 /* With the LABELS bits: label boundaries as the voxels' faces (LABEL_VOXELS), not smooth. */
 #define VXL_FLAG_LABEL_VOXELS (1u << 21)
+/* Ray caster and slicing program flag (colour/colour.c): the samples' colour comes from a colour volume's
+ * own colour texture (DATA_COLOUR), opacity still from the transfer function. */
+#define VXL_FLAG_DATA_COLOUR (1u << 22)
 
 typedef struct vxl_program_entry {
     uint64_t key; /* kind | filter << 5 | flags << 12 (gl_util.c): every flag bit fits */

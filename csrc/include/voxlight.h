@@ -197,7 +197,29 @@ typedef struct vxl_load_options {
      * from the calling thread only. */
     int (*progress)(void *user, double fraction, const char *stage);
     void *progress_user;
+    /* Appended (colour volumes); read only when struct_size covers them. A
+     * colour volume (RGB or RGBA: NIfTI RGB24/RGBA32 and vector NIfTI, or
+     * vxl_volume_desc.components 3/4) is one scalar volume that goes through
+     * the whole pipeline (filters, classification, skipping, gradients,
+     * storage, cutaways, shading) plus the voxels' own colour, which replaces
+     * the transfer function's colour (vxl_render_params.color_source). The
+     * scalar is the opacity source: its transfer function gives opacity, its
+     * gradient the normals. Choosing it at load time (not per frame) is what
+     * keeps every derived volume a derived volume of one scalar.
+     *   LUMINANCE (0)  Rec. 709 luminance 0.2126 R + 0.7152 G + 0.0722 B
+     *   CHANNEL        channel opacity_channel (0 R, 1 G, 2 B, 3 A)
+     *   ALPHA          the alpha channel (RGBA only)
+     * Grey volumes ignore both. docs/colour.md. */
+    uint32_t opacity_source;      /* VXL_OPACITY_SOURCE_* */
+    uint32_t opacity_channel;     /* CHANNEL: 0..components-1 */
 } vxl_load_options;
+
+#define VXL_OPACITY_SOURCE_LUMINANCE 0
+#define VXL_OPACITY_SOURCE_CHANNEL 1
+#define VXL_OPACITY_SOURCE_ALPHA 2
+#define VXL_OPACITY_SOURCE_COUNT 3
+VXL_API const char *vxl_opacity_source_name(uint32_t source); /* "luminance", "channel", "alpha" */
+VXL_API int vxl_opacity_source_from_name(const char *name, uint32_t *out);
 
 #define VXL_STREAMING_AUTO 0
 #define VXL_STREAMING_OFF 1
@@ -218,6 +240,12 @@ typedef struct vxl_volume_desc {
     double affine[16];     /* voxel -> world, column-major */
     double scl_slope;      /* value = raw*slope + inter; slope 0 = no scaling */
     double scl_inter;
+    /* Appended (colour volumes); read only when struct_size covers them.
+     * 0 or 1: grey; 3 (RGB) or 4 (RGBA): `components` values per voxel,
+     * interleaved (index = c + components * voxel), of dtype each; the
+     * scalar is chosen by vxl_load_options.opacity_source. */
+    uint32_t components;
+    uint32_t reserved;     /* must be 0 */
 } vxl_volume_desc;
 
 #define VXL_NOTES_MAX 512 /* vxl_volume_info.notes, its NUL included */
@@ -251,6 +279,10 @@ typedef struct vxl_volume_info {
      * full; "" when it decided nothing. Written only when struct_size covers
      * all of it. */
     char notes[VXL_NOTES_MAX];
+    /* Appended (colour volumes): written only when struct_size covers them. */
+    uint32_t components;        /* 1 grey, 3 RGB, 4 RGBA: what the source holds */
+    uint32_t opacity_source;    /* VXL_OPACITY_SOURCE_* the scalar came from (colour volumes; 0 grey) */
+    uint64_t color_bytes;       /* bytes of the voxels' own colour (RGB8, 3 a voxel; 0 grey) */
 } vxl_volume_info;
 
 VXL_API int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **out);
@@ -715,7 +747,22 @@ typedef struct vxl_render_params {
      * nothing. Other modes ignore both. */
     uint32_t minip_floor_on;
     float minip_floor;
+    /* Appended (colour volumes): where a sample's colour comes from,
+     * VXL_COLOR_SOURCE_*. AUTO: the voxels' colour when the volume has one
+     * (RGB, RGBA), else the transfer function's; DATA: the voxels' colour (a
+     * grey volume is VXL_ERR_STATE); TF: the transfer function's, as for a
+     * grey volume (the colour volume then renders as its opacity source).
+     * Opacity always comes from the transfer function of the scalar. */
+    uint32_t color_source;
+    uint32_t reserved2;         /* must be 0 */
 } vxl_render_params;
+
+#define VXL_COLOR_SOURCE_AUTO 0
+#define VXL_COLOR_SOURCE_DATA 1
+#define VXL_COLOR_SOURCE_TF 2
+#define VXL_COLOR_SOURCE_COUNT 3
+VXL_API const char *vxl_color_source_name(uint32_t source); /* "auto", "data", "tf" */
+VXL_API int vxl_color_source_from_name(const char *name, uint32_t *out);
 
 VXL_API int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out);
 VXL_API void vxl_renderer_destroy(vxl_renderer *r);
@@ -817,10 +864,11 @@ typedef struct vxl_slice_params {
 
 /* Resamples the volume on the slice: p gives the output size (width,
  * height), the volume's placement (has_model / model), the window and the
- * colour map (preset or tf_rgba); its camera, shading and mode are not
- * used. rgba (width*height*4 floats, premultiplied): the transfer
- * function's colour at the value with alpha 1 inside the volume's box, 0
- * outside it. plane_to_world must be finite and affine (last row 0 0 0 1)
+ * colour map (preset or tf_rgba) and color_source; its camera, shading
+ * and mode are not used. rgba (width*height*4 floats, premultiplied): the
+ * transfer function's colour at the value (a colour volume's own colour,
+ * nearest or trilinear, as color_source says) with alpha 1 inside the
+ * volume's box, 0 outside it. plane_to_world must be finite and affine (last row 0 0 0 1)
  * with x and y axes that span an area (its z axis is not used);
  * VXL_ERR_INVALID_ARGUMENT otherwise. Compressed storage has no cubic
  * coefficients (as VXL_FILTER_CUBIC): a cubic slice of it is

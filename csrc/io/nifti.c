@@ -16,6 +16,7 @@
 #include "loaders.h"
 #include "stream_load.h"
 #include "gz_reader.h"
+#include "colour_volume.h"
 
 #include <errno.h>
 #include <math.h>
@@ -53,6 +54,7 @@ typedef struct nii_header {
     double vox_offset;  /* float in NIfTI-1, so kept as double until checked */
     double scl_slope, scl_inter;
     int qform_code, sform_code;
+    int intent_code;
     double quatern[3];  /* b, c, d */
     double qoffset[3];
     mat34 srow;
@@ -227,6 +229,7 @@ static void parse_nifti1(const unsigned char *b, int sw, nii_header *h)
     h->scl_inter = get_f32(b, 116, sw);
     h->qform_code = (int)get_i16(b, 252, sw);
     h->sform_code = (int)get_i16(b, 254, sw);
+    h->intent_code = (int)get_i16(b, 68, sw);
     for (int i = 0; i < 3; i++) {
         h->quatern[i] = get_f32(b, 256 + 4 * (size_t)i, sw);
         h->qoffset[i] = get_f32(b, 268 + 4 * (size_t)i, sw);
@@ -249,6 +252,7 @@ static void parse_nifti2(const unsigned char *b, int sw, nii_header *h)
     h->scl_inter = get_f64(b, 184, sw);
     h->qform_code = (int)get_i32(b, 344, sw);
     h->sform_code = (int)get_i32(b, 348, sw);
+    h->intent_code = (int)get_i32(b, 504, sw);
     for (int i = 0; i < 3; i++) {
         h->quatern[i] = get_f64(b, 352 + 8 * (size_t)i, sw);
         h->qoffset[i] = get_f64(b, 376 + 8 * (size_t)i, sw);
@@ -616,20 +620,71 @@ static int open_files(nii_load *L, nii_header *h, vxl_gz **data, const char **da
     return VXL_OK;
 }
 
+/* NIfTI's intent codes of a vector per voxel (nifti1.h). */
+#define NII_INTENT_VECTOR 1007
+#define NII_INTENT_RGB_VECTOR 2003
+#define NII_INTENT_RGBA_VECTOR 2004
+
+/* How a colour file holds its channels: RGB24 and RGBA32 interleave 8-bit
+ * channels per voxel; a vector file (dim[0] 5, dim[5] 3 or 4, a vector
+ * intent) stores each channel as a whole volume after the other, in any
+ * datatype. components 0: a grey file (as before). */
+typedef struct nii_colour {
+    uint32_t components;
+    int planar;
+    const char *what; /* for the note */
+} nii_colour;
+
+static nii_colour colour_of(const nii_header *h)
+{
+    nii_colour c = {0, 0, NULL};
+    if (h->datatype == 128) c = (nii_colour){3, 0, "NIfTI RGB24"};
+    else if (h->datatype == 2304) c = (nii_colour){4, 0, "NIfTI RGBA32"};
+    else if (h->dim[0] == 5 && h->dim[4] == 1 && (h->dim[5] == 3 || h->dim[5] == 4) &&
+             (h->intent_code == NII_INTENT_VECTOR || h->intent_code == NII_INTENT_RGB_VECTOR ||
+              h->intent_code == NII_INTENT_RGBA_VECTOR))
+        c = (nii_colour){(uint32_t)h->dim[5], 1, h->dim[5] == 3 ? "NIfTI RGB vector" : "NIfTI RGBA vector"};
+    return c;
+}
+
+/* A colour file is read whole (its colour has no brick source: only the
+ * scalar could stream): the budget takes the raw channels and the scalar's
+ * texture with the colour, whichever is larger, before anything is read. */
+static int plan_colour(const nii_colour *c, const char *path, const uint32_t dims[3], uint32_t dtype,
+                       const vxl_load_options *opt, uint64_t *nbytes, vxl_err *e)
+{
+    const uint32_t size = vxl_dtype_size(dtype);
+    const uint32_t raw = size * c->components, texture = vxl_texture_bits_for(dtype) / 8 + 3;
+    vxl_err inner = {0};
+    if (vxl_volume_check_limits(dims, raw > texture ? raw : texture, opt, &inner)) {
+        if (inner.code == VXL_ERR_LIMIT)
+            return vxl_fail(e, VXL_ERR_LIMIT, "'%s': %s (colour volumes are read whole: streaming is not available for them)",
+                            path, inner.msg);
+        return vxl_fail_in(e, path, &inner);
+    }
+    *nbytes = (uint64_t)dims[0] * dims[1] * dims[2] * raw;
+    return VXL_OK;
+}
+
 /* Validates the header and works out what to read: whole (today's checks
  * against the budget, before anything is allocated) or streamed (issue 21:
  * *stream = 1, stream_load.h). */
-static int plan_read(const nii_header *h, const char *path, const vxl_load_options *opt, uint32_t dims[3],
-                     uint32_t *dtype, uint64_t *offset, uint64_t *nbytes, int *stream, vxl_err *e)
+static int plan_read(const nii_header *h, const nii_colour *colour, const char *path, const vxl_load_options *opt,
+                     uint32_t dims[3], uint32_t *dtype, uint64_t *offset, uint64_t *nbytes, int *stream, vxl_err *e)
 {
     int rc = check_dims(h, dims, path, e);
     if (rc) return rc;
-    *dtype = vxl_dtype_from_nifti(h->datatype);
+    if (colour->components && !colour->planar) *dtype = VXL_DTYPE_U8; /* RGB24, RGBA32: 8-bit channels */
+    else *dtype = vxl_dtype_from_nifti(h->datatype);
     if (!*dtype)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': unsupported datatype %d (%s)", path, h->datatype,
                         datatype_name(h->datatype));
     rc = check_vox_offset(h, offset, path, e);
     if (rc) return rc;
+    if (colour->components) {
+        *stream = 0;
+        return plan_colour(colour, path, dims, *dtype, opt, nbytes, e);
+    }
     /* The budget check vxl_volume_build makes, but before we allocate the
      * raw buffer; it also guarantees the voxel count below cannot overflow.
      * The raw buffer is at most 2x the texture (f64 -> float texture), so
@@ -720,8 +775,13 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     uint64_t offset = 0, nbytes = 0;
     int stream = 0;
     int rc = open_files(&L, &h, &data, &data_path, e);
-    if (!rc) rc = plan_read(&h, L.hdr_path, opt, dims, &dtype, &offset, &nbytes, &stream, e);
-    if (!rc) rc = select_frame(&h, L.hdr_path, opt, nbytes, &offset, &frame_count, &frame, e);
+    const nii_colour colour = colour_of(&h);
+    if (!rc) rc = plan_read(&h, &colour, L.hdr_path, opt, dims, &dtype, &offset, &nbytes, &stream, e);
+    if (!rc && colour.planar && vxl_load_frame(opt) != 0) /* dim[4] is 1: one volume of channels */
+        rc = vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %u requested, the vector file has one volume",
+                      L.hdr_path, vxl_load_frame(opt));
+    else if (!rc && !colour.planar)
+        rc = select_frame(&h, L.hdr_path, opt, nbytes, &offset, &frame_count, &frame, e);
     if (!rc && stream && !vxl_stream_file_holds(data_path, offset, vxl_file_is_gzip(data_path), nbytes, opt)) {
         stream = 0; /* AUTO and a file too short to stream: today's whole-read checks say why */
         rc = vxl_plan_voxels(L.hdr_path, dims, dtype, opt, &nbytes, e);
@@ -753,13 +813,19 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     scaling_from(&h, &slope, &inter);
 
     vxl_err inner = {0};
-    rc = vxl_volume_build(L.raw, dtype, dims, sp, A, slope, inter, opt, out, &inner);
+    if (colour.components)
+        rc = vxl_volume_build_colour(L.raw, dtype, colour.components, colour.planar, dims, sp, A, slope, inter, opt,
+                                     colour.what, out, &inner);
+    else
+        rc = vxl_volume_build(L.raw, dtype, dims, sp, A, slope, inter, opt, out, &inner);
     if (rc) rc = fail_with_path(e, L.hdr_path, &inner);
     else {
         (*out)->nifti_version = (uint32_t)h.version;
         (*out)->affine_source = source;
         (*out)->frame_count = frame_count;
         (*out)->frame = frame;
+        if (colour.components && vxl_load_streaming(opt) == VXL_STREAMING_ON)
+            vxl_volume_note(*out, "read whole: a colour volume does not stream");
     }
     load_cleanup(&L);
     return rc;

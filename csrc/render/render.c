@@ -168,8 +168,12 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     flags |= vxl_cut_flags(f);         /* issue 19: clip planes, crop box, cutters */
     flags |= vxl_labels_flags(f);      /* issue 20: the label mode */
     flags |= vxl_overlays_flags(f);    /* issue 20: the overlay count */
+    uint32_t colour_flags;
+    int rc = vxl_colour_flags(&r->colour, f, &colour_flags); /* a colour volume's own colour */
+    if (rc) return rc;
+    flags |= colour_flags;
     uint32_t filter = vxl_frame_filter(f);
-    int rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
+    rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
     if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);
     if (!rc) rc = vxl_program_get(&r->gpu, f->technique ? VXL_PROG_SLICES : VXL_PROG_RAYCAST, filter, flags, &prog);
     if (!rc) rc = ensure_framebuffer(r, f->width, f->height);
@@ -188,6 +192,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     set_frame_uniforms(r, prog, f);
     vxl_illumination_bind(&r->illumination, prog, f);
     vxl_cut_bind(&r->cut, prog, f); /* issue 19 */
+    vxl_colour_bind(&r->colour, flags, prog);
     if ((rc = vxl_labels_prepare(&r->labels, f, prog, r->storage.geom.affine))) return rc; /* issue 20 */
     if ((rc = vxl_overlays_prepare(&r->overlays, f, prog))) return rc; /* issue 20 */
     if ((rc = vxl_modes_bind(&r->modes, f, prog)) || (rc = vxl_matcap_prepare(&r->matcap, f, prog))) return rc; /* issue 19 */

@@ -68,6 +68,7 @@ static void release_volume(vxl_renderer *r)
     vxl_classification_release(&r->classification);
     vxl_illumination_release(&r->illumination);
     vxl_modes_release(&r->modes);
+    vxl_colour_release(&r->colour);
     if (r->storage.ops) r->storage.ops->release(&r->storage);
     r->storage.ops = NULL;
     r->storage.mode = 0;
@@ -124,6 +125,7 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     r->illumination.bind_labels = bind_labels_for_shadows; /* hidden labels cast no shadow */
     r->illumination.labels_ctx = r;
     vxl_overlays_init(&r->overlays, &r->gpu); /* issue 20 overlays */
+    vxl_colour_init(&r->colour, &r->gpu); /* colour volumes */
     r->gpu.budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
     if (opt && opt->struct_size >= offsetof(vxl_renderer_options, page_brick) + sizeof opt->page_brick) {
         if (opt->storage >= VXL_STORAGE_COUNT) {
@@ -217,14 +219,20 @@ static int job_set_volume(void *p)
     const vxl_volume *v = j->v;
     const uint32_t asked = vxl_storage_choose(&r->storage, v);
     vxl_storage_plan plan;
-    /* refuse before anything is released: a failed set_volume loses nothing */
-    int rc = vxl_storage_ops_for_volume(v, asked)->plan(&r->storage, v, asked, &plan);
+    /* refuse before anything is released: a failed set_volume loses nothing.
+     * A colour volume's colour is charged with the texture dense storage
+     * would take (the paged modes ask for their pools themselves). */
+    const int dense = !v->source && (asked == VXL_STORAGE_DENSE || asked == VXL_STORAGE_AUTO);
+    int rc = vxl_colour_plan(&r->colour, v, dense ? v->storage_bytes : 0);
+    if (rc) return rc;
+    rc = vxl_storage_ops_for_volume(v, asked)->plan(&r->storage, v, asked, &plan);
     if (rc) return rc;
     const vxl_storage_ops *ops = vxl_storage_ops_for_volume(v, plan.mode);
     release_volume(r); /* the data changed */
     r->storage.has_volume = 0;
     r->storage.ops = ops;
     rc = ops->install(&r->storage, v, &plan);
+    if (!rc) rc = vxl_colour_set(&r->colour, v);
     if (rc) {
         vxl_bricks_free(&plan.bricks);
         ops->release(&r->storage);

@@ -42,7 +42,8 @@ static int slice_frame(vxl_frame *f, const vxl_render_params *in, const vxl_volu
                            .tf_rgba = p.tf_rgba,
                            .has_window = p.has_window,
                            .window_low = p.window_low,
-                           .window_high = p.window_high};
+                           .window_high = p.window_high,
+                           .color_source = p.color_source};
     memcpy(q.model, p.model, sizeof q.model);
     return vxl_frame_resolve(f, &q, g, e);
 }
@@ -95,11 +96,13 @@ static int resample(vxl_renderer *r, const vxl_frame *f, uint32_t interp, const 
     vxl_gl *gl = &r->gpu.gl;
     const uint32_t filter = interp == VXL_INTERP_CUBIC ? VXL_FILTER_CUBIC : VXL_FILTER_CENTRAL;
     GLuint prog;
-    int rc = r->storage.ops->check_filter(&r->storage, filter, VXL_CLASSIFY_POST);
+    uint32_t colour_flags; /* a colour volume's own colour, as the ray caster shows it */
+    int rc = vxl_colour_flags(&r->colour, f, &colour_flags);
+    if (!rc) rc = r->storage.ops->check_filter(&r->storage, filter, VXL_CLASSIFY_POST);
     if (!rc) rc = r->storage.ops->prepare(&r->storage, NULL); /* every brick: a plane may cross any */
     if (!rc)
-        rc = vxl_program_get(&r->gpu, VXL_PROG_SLICE_PLANE, filter, interp | r->storage.ops->sample_flags(&r->storage),
-                             &prog);
+        rc = vxl_program_get(&r->gpu, VXL_PROG_SLICE_PLANE, filter,
+                             interp | r->storage.ops->sample_flags(&r->storage) | colour_flags, &prog);
     if (rc) return rc;
     gl->GetError();
     rc = vxl_bind_volume_textures(r, prog, filter, VXL_GRADIENT_STORE_8BIT);
@@ -113,6 +116,7 @@ static int resample(vxl_renderer *r, const vxl_frame *f, uint32_t interp, const 
     vxl_uniform_i(&r->gpu, prog, "u_tf", VXL_TF_UNIT);
     vxl_uniform_i(&r->gpu, prog, "u_tf_size", (int)f->tf_size);
     gl->Uniform2f(gl->GetUniformLocation(prog, "u_window"), f->window_offset, f->window_scale);
+    vxl_colour_bind(&r->colour, colour_flags, prog);
     gl->DispatchCompute((f->width + 7) / 8, (f->height + 7) / 8, 1);
     gl->MemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
     gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);

@@ -4,6 +4,7 @@
  * against what it serves. */
 #include "brick_levels.h"
 #include "brick_source.h"
+#include "colour_volume.h"
 #include "volume.h"
 #include "voxlight_dev.h"
 
@@ -92,8 +93,17 @@ int vxl_volume_stream_copy(const vxl_volume *whole, uint32_t n_levels, vxl_volum
     *v = *whole;
     v->texels = NULL;
     v->source = NULL;
+    v->colour = NULL;
+    /* a colour volume streams its scalar; its colour stays whole in memory */
+    const size_t colour_bytes = whole->colour ? (size_t)vxl_volume_colour_bytes(whole) : 0;
+    if (colour_bytes && !(v->colour = malloc(colour_bytes))) {
+        free(v);
+        return vxl_fail(NULL, VXL_ERR_NO_MEMORY, "out of memory for the colour of a stream copy");
+    }
+    if (colour_bytes) memcpy(v->colour, whole->colour, colour_bytes);
     int rc = vxl_brick_source_from_volume(whole, n_levels, &v->source, NULL);
     if (rc) {
+        free(v->colour);
         free(v);
         return rc;
     }

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "colour_volume.h"
 #include "voxlight_dev.h" /* vxl_volume_add_note */
 
 uint32_t vxl_dtype_size(uint32_t dtype)
@@ -274,6 +275,20 @@ void vxl_volume_set_values(vxl_volume *v, const vxl_texel_map *m)
 int vxl_volume_create(const vxl_volume_desc *d, const vxl_load_options *opt, vxl_volume **out)
 {
     if (!d) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "volume description is NULL");
+    uint32_t components = 1;
+    if (d->struct_size == 0 || d->struct_size >= offsetof(vxl_volume_desc, reserved) + sizeof d->reserved) {
+        if (d->reserved) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "desc.reserved is %u: it must be 0", d->reserved);
+        components = d->components ? d->components : 1;
+    }
+    if (components != 1) {
+        if (out) *out = NULL;
+        if (components != 3 && components != 4)
+            return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "desc.components is %u: 1 (grey), 3 (RGB) or 4 (RGBA)",
+                            components);
+        return vxl_volume_build_colour(d->data, d->dtype, components, 0, d->dims, d->spacing,
+                                       d->has_affine ? d->affine : NULL, d->scl_slope, d->scl_inter, opt,
+                                       components == 3 ? "RGB" : "RGBA", out, NULL);
+    }
     return vxl_volume_build(d->data, d->dtype, d->dims, d->spacing, d->has_affine ? d->affine : NULL,
                             d->scl_slope, d->scl_inter, opt, out, NULL);
 }
@@ -288,8 +303,8 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
     const size_t v1 = offsetof(vxl_volume_info, frame_count), s = out->struct_size;
     size_t have = s >= v1 && s < sizeof *out ? s : sizeof *out;
     /* a struct that ends inside notes would get an unterminated piece */
-    const size_t notes_at = offsetof(vxl_volume_info, notes);
-    if (have > notes_at && have < sizeof *out) have = notes_at;
+    const size_t notes_at = offsetof(vxl_volume_info, notes), notes_end = notes_at + sizeof out->notes;
+    if (have > notes_at && have < notes_end) have = notes_at;
     vxl_volume_info info, *o = &info;
     memset(o, 0, sizeof *o);
     o->struct_size = (uint32_t)have;
@@ -317,6 +332,11 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
         o->resident_bytes = v->storage_bytes;
     }
     memcpy(o->notes, v->notes, sizeof o->notes);
+    o->components = v->components ? v->components : 1;
+    if (v->colour) {
+        o->opacity_source = v->opacity_source;
+        o->color_bytes = vxl_volume_colour_bytes(v);
+    }
     memcpy(out, o, have);
     return VXL_OK;
 }
@@ -395,6 +415,7 @@ void vxl_volume_destroy(vxl_volume *v)
 {
     if (!v) return;
     vxl_brick_source_free(v->source);
+    free(v->colour);
     free(v->texels);
     free(v);
 }

@@ -39,6 +39,13 @@ struct vxl_volume {
      * ("4 slices interpolated where a slice is missing"), joined by "; ". ""
      * when nothing was. Reported by `info`, the add-on and the statistics. */
     char notes[VXL_VOLUME_NOTES_MAX];
+    /* A colour volume (colour_volume.h): the voxels' own colour beside the
+     * scalar texels, RGB8 interleaved (3 bytes a voxel, x fastest), always in
+     * memory (a streamed colour volume streams only its scalar); NULL for a
+     * grey volume. The texels are the opacity source's scalar. */
+    uint8_t *colour;
+    uint32_t components;     /* 1 grey (0 is read as 1), 3 RGB, 4 RGBA: what the source held */
+    uint32_t opacity_source; /* VXL_OPACITY_SOURCE_* the texels came from (colour volumes) */
 };
 
 /* Appends one note (printf format) to v->notes, "; "-separated; cut with

@@ -32,6 +32,8 @@ LABEL_MODES = ("surface", "mask", "tint")  # VXL_LABEL_MODE_*
 LABEL_BOUNDARIES = ("smooth", "voxels")  # VXL_LABEL_BOUNDARY_* (no name functions: two values)
 BLENDS = ("over", "add", "max")  # VXL_BLEND_*
 STREAMING_MODES = ("auto", "off", "on")  # VXL_STREAMING_*
+OPACITY_SOURCES = ("luminance", "channel", "alpha")  # VXL_OPACITY_SOURCE_*: a colour volume's scalar
+COLOR_SOURCES = ("auto", "data", "tf")  # VXL_COLOR_SOURCE_*
 MAX_OVERLAYS = 3  # VXL_MAX_OVERLAYS
 MAX_LABEL_ID = 65535  # VXL_MAX_LABEL_ID
 NOTES_MAX = 512  # VXL_NOTES_MAX: vxl_volume_info.notes, its NUL included
@@ -41,7 +43,8 @@ ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "st
                   "gradient_store": ("8bit", "16f", "32f"), "shading_model": SHADING_MODELS,
                   "technique": ("raycast", "slices2d", "slices3d"), "mode": MODES,
                   "interpolation": INTERPOLATIONS, "label_mode": LABEL_MODES,
-                  "blend": BLENDS, "streaming": STREAMING_MODES}
+                  "blend": BLENDS, "streaming": STREAMING_MODES,
+                  "opacity_source": OPACITY_SOURCES, "color_source": COLOR_SOURCES}
 MAX_LIGHTS = 8
 RENDER_PARAMS_RESERVED = 2  # VXL_RENDER_PARAMS_RESERVED
 MAX_CLIP_PLANES = 6  # VXL_MAX_CLIP_PLANES
@@ -78,7 +81,9 @@ class LoadOptions(ctypes.Structure):
                 ("reserved1", ctypes.c_uint32),
                 ("cache_dir", ctypes.c_char_p),
                 ("progress", PROGRESS_CALLBACK),
-                ("progress_user", ctypes.c_void_p)]
+                ("progress_user", ctypes.c_void_p),
+                ("opacity_source", ctypes.c_uint32),   # appended: a colour volume's scalar
+                ("opacity_channel", ctypes.c_uint32)]
 
 
 class DicomSeries(ctypes.Structure):
@@ -103,7 +108,9 @@ class VolumeDesc(ctypes.Structure):
                 ("spacing", ctypes.c_double * 3),
                 ("affine", c_double4x4),
                 ("scl_slope", ctypes.c_double),
-                ("scl_inter", ctypes.c_double)]
+                ("scl_inter", ctypes.c_double),
+                ("components", ctypes.c_uint32),       # appended: 3 RGB, 4 RGBA, interleaved
+                ("reserved", ctypes.c_uint32)]
 
 
 class VolumeInfo(ctypes.Structure):
@@ -126,7 +133,10 @@ class VolumeInfo(ctypes.Structure):
                 ("level_count", ctypes.c_uint32),
                 ("resident_bytes", ctypes.c_uint64),
                 ("bytes_read", ctypes.c_uint64),
-                ("notes", ctypes.c_char * NOTES_MAX)]  # appended: what the reader decided
+                ("notes", ctypes.c_char * NOTES_MAX),  # appended: what the reader decided
+                ("components", ctypes.c_uint32),       # appended: 1 grey, 3 RGB, 4 RGBA
+                ("opacity_source", ctypes.c_uint32),
+                ("color_bytes", ctypes.c_uint64)]
 
 
 class PhantomDesc(ctypes.Structure):
@@ -323,7 +333,9 @@ class RenderParams(ctypes.Structure):
                 ("progressive", ctypes.c_uint32),        # appended (issue 21)
                 ("overlays", ctypes.POINTER(OverlayStyle)),
                 ("minip_floor_on", ctypes.c_uint32),     # appended: MinIP's floor
-                ("minip_floor", ctypes.c_float)]
+                ("minip_floor", ctypes.c_float),
+                ("color_source", ctypes.c_uint32),       # appended: colour volumes
+                ("reserved2", ctypes.c_uint32)]
 
 
 class RenderStats(ctypes.Structure):

@@ -7,8 +7,10 @@
 // (8 fractional bits on many GPUs, and llvmpipe's unorm8 lerps rounded to
 // 1/255) would cost the linear slice its accuracy. INTERP: 0 nearest,
 // 1 linear, 2 cubic (compiled with FILTER_CUBIC: the interpolating B-spline's
-// coefficients, as the cubic gradient filter reads them).
+// coefficients, as the cubic gradient filter reads them). DATA_COLOUR: a
+// colour volume's own colour replaces the table's (lib/colour.glsl).
 #include "lib/gradients.glsl"
+#include "lib/colour.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = VXL_IMAGE_OUT) writeonly uniform image2D u_out;
@@ -86,5 +88,16 @@ void main()
     vec2 uv = (vec2(px) + 0.5) / vec2(size) * 2.0 - 1.0;
     vec3 p = (u_plane_to_voxel * vec4(uv, 0.0, 1.0)).xyz;
     bool inside = all(greaterThanEqual(p, vec3(-0.5))) && all(lessThanEqual(p, u_dims - 0.5));
-    imageStore(u_out, px, inside ? vec4(colour_of(value_at(p)), 1.0) : vec4(0.0));
+#ifdef DATA_COLOUR
+    // the nearest voxel's colour, or the colour texture's trilinear one (its
+    // 8-bit texels need no finer weights); cubic takes the trilinear colour
+#if INTERP == 0
+    vec3 rgb = texelFetch(u_colour, clamp(ivec3(floor(p + 0.5)), ivec3(0), ivec3(u_dims) - 1), 0).rgb;
+#else
+    vec3 rgb = data_colour(p);
+#endif
+#else
+    vec3 rgb = colour_of(value_at(p));
+#endif
+    imageStore(u_out, px, inside ? vec4(rgb, 1.0) : vec4(0.0));
 }

@@ -54,6 +54,9 @@ vec4 project_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
     taken = 0u;
 #if MODE == 3
     float sum = 0.0, t_first = t0; // where the kept volume begins: a cutter may remove the front
+#ifdef DATA_COLOUR
+    vec3 colour_sum = vec3(0.0); // a colour volume's average projects its mean colour
+#endif
 #else
     float best = 0.0, t_best = t0;
     bool found = false; // best holds a candidate sample
@@ -88,6 +91,9 @@ vec4 project_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
 #if MODE == 3
         if (taken == 1u && i > 0) t_first = t; // only a cutter's leap makes the first sample's index > 0
         sum += v;
+#ifdef DATA_COLOUR
+        colour_sum += data_colour(p);
+#endif
 #else
 #if MODE == 1
         bool better = !found || v > best;
@@ -114,6 +120,13 @@ vec4 project_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
     float t_depth = t_best;
 #endif
     vec4 c = classify(v);
+#ifdef DATA_COLOUR
+#if MODE == 3
+    c.rgb = colour_sum / float(taken);
+#else
+    c.rgb = data_colour(o + t_depth * dir); // the colour where the projected sample lies
+#endif
+#endif
     if (c.a >= u_depth_threshold) depth = -(r.z0 + r.dz * t_depth);
     return vec4(c.rgb * c.a, c.a);
 }
@@ -181,6 +194,9 @@ vec4 iso_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth
     }
     if (!hit) return vec4(0.0);
     vec3 rgb = classify(u_iso).rgb;
+#ifdef DATA_COLOUR
+    rgb = data_colour(o + t_hit * dir); // a colour volume's colour at the hit
+#endif
 #ifdef SHADING
     vec3 p = o + t_hit * dir;
     vec3 g = gradient_at(p, u_iso);

@@ -188,6 +188,9 @@ vec4 overlay_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
 #else
                 cb = classify(vb);
 #endif
+#ifdef DATA_COLOUR
+                if (cb.a > 0.0) cb = with_data_colour(cb, p); // a colour volume's own colour
+#endif
 #if defined(LABELS) && LABELS > 1
                 if (cb.a > 0.0) cb = label_mask(lr, p, cb); // issue 20: only inside visible labels
 #endif

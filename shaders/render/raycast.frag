@@ -2,9 +2,11 @@
 // Variants by define: FILTER_* (lib/gradients.glsl), SHADING, REUSE_GRADIENTS,
 // CLASSIFY_PRE / CLASSIFY_PREINT (lib/classify.glsl; post-classification otherwise),
 // GOPACITY 1 (boundary) / 2 (iso-surface): Levoy's gradient-magnitude opacity,
+// DATA_COLOUR: a colour volume's colour replaces the table's (lib/colour.glsl),
 // SHADING_MODEL 1 (shadowed) / 2 (scatter): lib/shading.glsl's shade_lit.
 #include "lib/gradients.glsl"
 #include "lib/classify.glsl"
+#include "lib/colour.glsl" // DATA_COLOUR: a colour volume's own colour
 #include "lib/shading.glsl"
 #include "lib/cut.glsl" // issue 19 cutaways: CUT_CONVEX, CUT_CUTTERS
 #include "lib/matcap.glsl"
@@ -241,6 +243,13 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
             c = pre_classified(p);
 #else
             c = classify(v);
+#endif
+#ifdef DATA_COLOUR
+#ifdef CLASSIFY_PREINT
+            if (c.a > 0.0) c.rgb = data_colour(p) * c.a; // the segment is premultiplied
+#else
+            if (c.a > 0.0) c = with_data_colour(c, p);
+#endif
 #endif
 #if defined(LABELS) && LABELS > 1
             if (c.a > 0.0) c = label_mask(lr, p, c); // issue 20: only inside visible labels

@@ -7,6 +7,7 @@
 // refused), GOPACITY 1 / 2. REUSE_GRADIENTS has nothing to reuse here.
 #include "lib/gradients.glsl"
 #include "lib/classify.glsl"
+#include "lib/colour.glsl" // DATA_COLOUR: a colour volume's own colour
 #include "lib/shading.glsl"
 
 #ifndef GOPACITY
@@ -62,6 +63,11 @@ void main()
     vec4 c = classify(v);
 #endif
     if (c.a <= 0.0) return;
+#endif
+#ifdef DATA_COLOUR
+    c = with_data_colour(c, p); // a colour volume's own colour
+#endif
+#if GOPACITY != 2
     float a = correct_opacity(c.a, seg);
 #endif
     vec3 rgb = c.rgb;

@@ -13,9 +13,20 @@ import bpy
 import numpy as np
 from bpy.props import IntProperty, StringProperty
 
-from . import params
+from . import compat, params
 from .core import budget_split, lighting, native, runtime, vdb_export
 from .operators import OnActiveVolume
+
+
+def cell_shift():
+    """Index space as this Blender draws it -> OpenVDB's (and
+    vxl_grid_info.index_to_world's), where cell i is centred at i: before
+    5.0 Blender centres it at i + 0.5 (compat.volume_cell_offset), so the
+    file's transform starts that much back and each value lands where
+    Voxlight samples it."""
+    m = np.eye(4)
+    m[:3, 3] = -compat.volume_cell_offset()
+    return m
 
 
 def default_path(obj, volume_frame):
@@ -148,7 +159,7 @@ class VOXLIGHT_OT_convert_to_blender_volume(OnActiveVolume, bpy.types.Operator):
             info, density, rgb = vol.classified_grid(p, dims)
         finally:
             vol.close()
-        index_to_local = np.linalg.inv(np.array(src.matrix_world, np.float64)) @ info["index_to_world"]
+        index_to_local = np.linalg.inv(np.array(src.matrix_world, np.float64)) @ info["index_to_world"] @ cell_shift()
         forget_cached_grids(path)
         size = vdb_export.write(writer, path, info["dims"], index_to_local, density, rgb)
         ob = add_volume_object(context, src, path)

@@ -95,6 +95,26 @@ TEST(clip_plane_baked_into_density)
     vxl_volume_destroy(v);
 }
 
+TEST(slices_filled_by_every_worker)
+{
+    /* one column of 9 slices: the slabs the processors share, each value its own */
+    const uint8_t data[9] = {0, 30, 60, 90, 120, 150, 180, 210, 240};
+    vxl_volume_desc d = {.struct_size = sizeof d, .dtype = VXL_DTYPE_U8, .dims = {1, 1, 9}, .data = data};
+    vxl_volume *v = NULL;
+    REQUIRE(vxl_volume_create(&d, NULL, &v) == VXL_OK);
+    vxl_render_params p = params();
+    vxl_grid_info info = {0};
+    float dens[9], rgb[27];
+    REQUIRE(vxl_classified_grid(v, &p, NULL, &info, dens, rgb) == VXL_OK);
+    for (int z = 0; z < 9; z++) {
+        double x = data[z] / 255.0;
+        CHECKF(near(dens[z], -log(1 - 0.5 * x)), "slice %d: %g", z, dens[z]);
+        CHECK(near(rgb[3 * z + 2], linear(x)));
+    }
+    CHECK(near(info.max_density, -log(1 - 0.5 * 240 / 255.0)));
+    vxl_volume_destroy(v);
+}
+
 TEST(refusals)
 {
     const uint8_t data[2] = {0, 255};
@@ -122,6 +142,7 @@ int main(void)
     RUN(density_and_colour_at_voxel_centres);
     RUN(coarser_grid_interpolates_between_voxels);
     RUN(clip_plane_baked_into_density);
+    RUN(slices_filled_by_every_worker);
     RUN(refusals);
     return TEST_SUMMARY();
 }

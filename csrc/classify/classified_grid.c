@@ -11,6 +11,7 @@
 #include "error.h"
 #include "frame.h"
 #include "mat4.h"
+#include "threads.h"
 #include "volume.h"
 #include "voxlight.h"
 
@@ -126,6 +127,71 @@ static void cell_to_voxel(const uint32_t vdims[3], const uint32_t gdims[3], doub
     m[15] = 1;
 }
 
+/* The cells of slices [z0, z1), one job of fill_cells. */
+typedef struct slab_job {
+    const vxl_volume *vol;
+    const vxl_frame *f;
+    const double *c2v;
+    const uint32_t *dims;
+    double voxel_length;
+    float *density, *rgb;
+    uint32_t z0, z1;
+    double max_density; /* out */
+} slab_job;
+
+static void *fill_slab(void *arg)
+{
+    slab_job *j = arg;
+    const uint32_t *dims = j->dims;
+    double max_sigma = -log(MIN_VOXEL_TRANSMITTANCE);
+    for (uint32_t z = j->z0; z < j->z1; z++)
+        for (uint32_t y = 0; y < dims[1]; y++)
+            for (uint32_t x = 0; x < dims[0]; x++) {
+                size_t i = ((size_t)z * dims[1] + y) * dims[0] + x;
+                double q[4] = {x, y, z, 1}, pv[4], col[4] = {0, 0, 0, 0}, sigma = 0;
+                vxl_mat4_transform(j->c2v, q, pv);
+                if (!j->f->cut.any || vxl_frame_cut_keeps(&j->f->cut, pv)) {
+                    double a = voxel_opacity(j->vol, j->f, pv, col);
+                    sigma = a <= 0 ? 0 : fmin(-log1p(-fmin(a, 1.0)), max_sigma);
+                }
+                double d = sigma / j->voxel_length;
+                if (d > j->max_density) j->max_density = d;
+                if (j->density) j->density[i] = (float)d;
+                if (j->rgb)
+                    for (int k = 0; k < 3; k++) j->rgb[3 * i + k] = (float)srgb_to_linear(col[k]);
+            }
+    return NULL;
+}
+
+/* Every cell, slabs of slices spread over the processors (each cell is
+ * independent); a worker that cannot start leaves its slab to this
+ * thread. Returns the largest density. */
+static double fill_cells(const vxl_volume *vol, const vxl_frame *f, const double c2v[16], const uint32_t dims[3],
+                         double voxel_length, float *density, float *rgb)
+{
+    enum { MAX_WORKERS = 16 };
+    unsigned n = vxl_cpu_count();
+    n = n > MAX_WORKERS ? MAX_WORKERS : n;
+    n = n > dims[2] ? dims[2] : n;
+    slab_job jobs[MAX_WORKERS];
+    vxl_thread threads[MAX_WORKERS];
+    int started[MAX_WORKERS] = {0};
+    for (unsigned k = 0; k < n; k++) {
+        jobs[k] = (slab_job){.vol = vol, .f = f, .c2v = c2v, .dims = dims, .voxel_length = voxel_length,
+                             .density = density, .rgb = rgb,
+                             .z0 = (uint32_t)((uint64_t)dims[2] * k / n),
+                             .z1 = (uint32_t)((uint64_t)dims[2] * (k + 1) / n)};
+        if (k > 0) started[k] = vxl_thread_start(&threads[k], fill_slab, &jobs[k]) == 0;
+    }
+    double max_density = 0;
+    for (unsigned k = 0; k < n; k++) {
+        if (k == 0 || !started[k]) fill_slab(&jobs[k]);
+        else vxl_thread_join(threads[k]);
+    }
+    for (unsigned k = 0; k < n; k++) max_density = fmax(max_density, jobs[k].max_density);
+    return max_density;
+}
+
 static int read_grid_params(const vxl_grid_params *g, const vxl_volume *vol, uint32_t dims[3])
 {
     vxl_grid_params q = {0};
@@ -188,24 +254,8 @@ int vxl_classified_grid(const vxl_volume *vol, const vxl_render_params *p, const
         vxl_frame_free(&f);
         return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "the model matrix has no volume (determinant %g)", det);
     }
-    double max_density = 0, max_sigma = -log(MIN_VOXEL_TRANSMITTANCE);
-    if (density || rgb)
-        for (uint32_t z = 0; z < dims[2]; z++)
-            for (uint32_t y = 0; y < dims[1]; y++)
-                for (uint32_t x = 0; x < dims[0]; x++) {
-                    size_t i = ((size_t)z * dims[1] + y) * dims[0] + x;
-                    double q[4] = {x, y, z, 1}, pv[4], col[4] = {0, 0, 0, 0}, sigma = 0;
-                    vxl_mat4_transform(c2v, q, pv);
-                    if (!f.cut.any || vxl_frame_cut_keeps(&f.cut, pv)) {
-                        double a = voxel_opacity(vol, &f, pv, col);
-                        sigma = a <= 0 ? 0 : fmin(-log1p(-fmin(a, 1.0)), max_sigma);
-                    }
-                    double d = sigma / voxel_length;
-                    if (d > max_density) max_density = d;
-                    if (density) density[i] = (float)d;
-                    if (rgb)
-                        for (int k = 0; k < 3; k++) rgb[3 * i + k] = (float)srgb_to_linear(col[k]);
-                }
+    double max_density = 0;
+    if (density || rgb) max_density = fill_cells(vol, &f, c2v, dims, voxel_length, density, rgb);
     vxl_frame_free(&f);
     vxl_grid_info out = {.struct_size = sizeof out, .voxel_length = voxel_length, .max_density = max_density};
     memcpy(out.dims, dims, sizeof out.dims);

@@ -4,7 +4,8 @@ ball), rendered by Voxlight's F12 and, after Convert to Blender Volume, by
 Cycles from the same camera at several sample counts. Prints a markdown
 table: Cycles' samples and time, RMSE and PSNR (linear RGB, 0..1, before the
 view transform, whole image) against Voxlight, and against Cycles' own
-render at the most samples (its noise alone).
+render at the most samples (its noise alone); then the mean values, with the
+library's own image before the add-on's F12 decodes it from sRGB.
 
   --shading off      pure emission-absorption (the exact case)
   --shading scatter  one sun, Voxlight's scatter model with no surface term
@@ -64,7 +65,7 @@ def _psnr(rmse):
 
 def main():
     a = _args()
-    u.install_addon()
+    vx = u.install_addon()
     scene = u.black_cycles_scene(a.size)
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.image_settings.color_depth = "32"
@@ -87,6 +88,8 @@ def main():
         sun.data.energy = 1.0  # Voxlight: L = 1
         scene.cycles.max_bounces = scene.cycles.volume_bounces = 1
     ours, t_ours = _render(scene, a.size, "voxlight")
+    # the library's own image, display-referred, before the F12 decodes it from sRGB
+    library = vx.render_volume(ob)[..., :3]
     vo = bpy.ops.voxlight.convert_to_blender_volume(resolution=a.resolution)
     vo = bpy.context.view_layer.objects.active
     ob.hide_render = True
@@ -108,7 +111,9 @@ def main():
     for s, t, img in rows:
         r = _rmse(img, ours)
         print("| %d | %.2f | %.4f | %.1f | %.4f |" % (s, t, r, _psnr(r), _rmse(img, best)))
-    print("mean linear value: Voxlight %.4f, Cycles %d samples %.4f" % (ours.mean(), counts[-1], best.mean()))
+    print("mean value: Voxlight F12 (linear) %.4f, the library's own image (display-referred) %.4f, Cycles %d "
+          "samples %.4f; RMSE of the library's image against it %.4f"
+          % (ours.mean(), library.mean(), counts[-1], best.mean(), _rmse(library, best)))
 
 
 main()

@@ -72,7 +72,7 @@ OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_
 PLATFORM := dynlib dynlib_posix threads_posix files files_posix process_posix clock_posix os_posix
 HELPER_CORE_NAMES := helper_main volume colour_volume brick_source error loader_util zlib_api
 HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,$(HELPER_CORE_NAMES) helper_self_posix $(PLATFORM))
-HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr
+HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr $(BUILD)/voxlight-write-vdb
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
 STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlight-slicingbench $(BUILD)/voxlight-modesbench \
@@ -137,6 +137,15 @@ $(BUILD)/voxlight: $(CLI_C) $(wildcard csrc/cli/*.h) $(BUILD)/libvoxlight.so $(P
 # objects they use and their library; started by libvoxlight.so.
 $(BUILD)/voxlight-read-oiio: $(BUILD)/obj/helper_oiio.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(OIIO_CXX))) $(HELPER_CORE)
 	$(CXX) $(OPT) -o $@ $^ $(OIIO_LIBS) -lz -lm
+
+# The OpenVDB writer (csrc/io/vdb_write.h): classified grids in on standard
+# input, a .vdb file out; the add-on starts it to make a Blender Volume.
+# libopenvdb (Debian's libopenvdb-dev) is linked here alone.
+# OpenVDB's grid registry is template statics shared with libopenvdb: its
+# types must keep default visibility here (hidden, initialize() crashes).
+$(BUILD)/obj/vdb_write.o: CXXFLAGS += -fvisibility=default
+$(BUILD)/voxlight-write-vdb: $(BUILD)/obj/helper_write_vdb.o $(BUILD)/obj/vdb_write.o
+	$(CXX) $(OPT) -o $@ $^ -lopenvdb -ltbb $(shell pkg-config --libs Imath 2>/dev/null) -lm
 
 # The Zarr helper is our C alone (its codecs are opened at run time), so it
 # is built as the library is, for glibc 2.28.

@@ -42,7 +42,7 @@ if UNSUPPORTED is None:
     # extension's own folder where Blender gives one; set before any module
     # loads the library.
     native.CACHE_DIR = compat.private_data_dir(__package__)
-    from . import (api, compositor, importer, offline, operators, panels, params,  # noqa: E402
+    from . import (api, blender_volume, compositor, importer, offline, operators, panels, params,  # noqa: E402
                    preferences, properties, render_hooks, render_setup, scene_shadows, tf,
                    viewport, volume_object)
     from . import cutaway_ui, slice_planes  # noqa: E402  (issue 19)
@@ -53,7 +53,8 @@ if UNSUPPORTED is None:
     from .api import render_volume  # noqa: E402,F401
 
     # Registration order: properties before the UI that shows them; handlers last.
-    _modules = (preferences, properties, label_props, overlay_props, tf, operators, importer, volume_object,
+    _modules = (preferences, properties, label_props, overlay_props, tf, operators, blender_volume, importer,
+                volume_object,
                 panels, slice_planes, cutaway_ui, label_ui, overlay_ui, render_setup, render_hooks, scene_shadows,
                 viewport)
 else:

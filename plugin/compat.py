@@ -54,6 +54,13 @@ def _bpy():
     return bpy
 
 
+def volume_cell_offset():
+    """Where Blender draws a Volume grid's cell i, in index space: 3.4 to
+    4.5 over the cube [i, i + 1] (centred at i + 0.5), 5.0 on at i as
+    OpenVDB defines it (measured by tests/blender/test_blender_volume.py)."""
+    return 0.5 if _bpy().app.version < (5, 0, 0) else 0.0
+
+
 def has_compositing_node_group(scene):
     return hasattr(scene, "compositing_node_group")  # Blender 5.0+
 

@@ -103,6 +103,7 @@ class VOXLIGHT_PT_volume(_VolumePanel, bpy.types.Panel):
             col.label(text="%d volume frames" % p.frame_count)
             col.prop(p, "frame_mode")
             col.prop(p, "frame_offset" if p.frame_mode == "TIMELINE" else "fixed_frame")
+        layout.operator("voxlight.convert_to_blender_volume", icon="VOLUME_DATA")
 
 
 # ------------------------------------------------------- transfer function

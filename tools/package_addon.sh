@@ -5,7 +5,9 @@
 # extension platform is one per package:
 # - BUILD_DIR/voxlight-linux-x64.zip: BUILD_DIR/libvoxlight.so and every
 #   reader helper the library starts from its own folder (BUILD_DIR/
-#   voxlight-read-*, and voxlight-vdb-read where a build still has it);
+#   voxlight-read-*, and voxlight-vdb-read where a build still has it),
+#   and the add-on's own helper voxlight-write-vdb (Convert to Blender
+#   Volume; run from the add-on's folder, not copied with the library);
 # - BUILD_DIR/voxlight-windows-x64.zip, when BUILD_DIR/windows-x64/
 #   voxlight.dll exists: voxlight.dll, every other *.dll beside it (zlib1.dll,
 #   which voxlight.dll loads from its own folder at run time) and any
@@ -84,6 +86,8 @@ if [ $# -lt 2 ]; then
     echo "package_addon: no reader helper (voxlight-read-*) in $BUILD; run make first" >&2
     exit 1
 fi
+# Without it the add-on still works; Convert to Blender Volume then says it is missing.
+[ -x "$BUILD/voxlight-write-vdb" ] && set -- "$@" "$BUILD/voxlight-write-vdb"
 package linux-x64 "$@"
 
 # Windows x64: only where the Windows build ran (make windows).

@@ -41,7 +41,8 @@ FOLDERS = {
     "io": """volume_load.c loaders.h nifti.c nifti.h nrrd.c metaimage.c loader_util.c loader_util.h
              dicom_detect.c reader_stream.h reader_spawn.c reader_spawn.h remote_readers.c
              helper_main.c helper_main.h image_stack.cpp vdb.cpp dicom.cpp image_write.c image_write.h
-             json.c json.h zarr.h zarr_store.c zarr_chunk.c zarr_read.c zarr_detect.c""",
+             json.c json.h zarr.h zarr_store.c zarr_chunk.c zarr_read.c zarr_detect.c
+             vdb_write.cpp vdb_write.h""",
     # the GL context and its backends, the function table, the GL thread,
     # programs and shader source, texture units and bindings, the GL memory
     # accountant
@@ -60,7 +61,7 @@ FOLDERS = {
     "skip": """skipping.c skipping.h minmax.c minmax.h""",
     # classification: transfer functions, the classified volume,
     # pre-integration
-    "classify": """classification.c classification.h preint.c preint.h""",
+    "classify": """classification.c classification.h preint.c preint.h classified_grid.c""",
     # derived volumes for filtering: gradients, B-spline coefficients, the
     # shared kernels, the gradient probe
     "gradients": """precompute.c precompute.h paged_gradients.c gradients.h bspline.c bspline.h
@@ -75,7 +76,7 @@ FOLDERS = {
     # the command-line tool (an executable, not in the library)
     "cli": """cli.c cli_cut.c cli_cut.h""",
     # the reader helper executables' own main()s
-    "helpers": """helper_oiio.c helper_dicom.c helper_zarr.c""",
+    "helpers": """helper_oiio.c helper_dicom.c helper_zarr.c helper_write_vdb.c""",
 }
 MOVES = {name: folder for folder, names in FOLDERS.items() for name in names.split()}
 

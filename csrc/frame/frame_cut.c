@@ -190,6 +190,21 @@ int vxl_frame_cut_interval(const vxl_frame_cut *c, const double o[3], const doub
     return *t0 < *t1;
 }
 
+int vxl_frame_cut_keeps(const vxl_frame_cut *c, const double p[3])
+{
+    for (uint32_t i = 0; i < c->plane_count; i++) {
+        const double *q = c->plane[i];
+        double d = q[0] * p[0] + q[1] * p[1] + q[2] * p[2] + q[3];
+        if (!(d >= 0) || (c->thickness[i] > 0 && d > c->thickness[i])) return 0;
+    }
+    if (c->has_crop)
+        for (int r = 0; r < 3; r++) {
+            double b = c->crop[r] * p[0] + c->crop[4 + r] * p[1] + c->crop[8 + r] * p[2] + c->crop[12 + r];
+            if (!(b >= -1 && b <= 1)) return 0;
+        }
+    return 1;
+}
+
 void vxl_frame_cut_plane_floats(const vxl_frame_cut *c, float planes[VXL_MAX_CLIP_PLANES][4],
                                 float thickness[VXL_MAX_CLIP_PLANES])
 {

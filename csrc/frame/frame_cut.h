@@ -54,4 +54,9 @@ void vxl_frame_cut_plane_floats(const vxl_frame_cut *c, float planes[VXL_MAX_CLI
 int vxl_frame_cut_interval(const vxl_frame_cut *c, const double o[3], const double dir[3], double *t0, double *t1,
                            double cap[3]);
 
+/* Whether the clip planes and the crop box keep voxel-space point p (the
+ * same tests as vxl_frame_cut_interval, at a point): 1 kept, 0 cut away.
+ * Cutters are not looked at. */
+int vxl_frame_cut_keeps(const vxl_frame_cut *c, const double p[3]);
+
 #endif

@@ -881,6 +881,43 @@ VXL_API int vxl_render_slice(vxl_renderer *r, const vxl_render_params *p, const 
 VXL_API int vxl_default_camera(vxl_renderer *r, const vxl_render_params *p, float view[16],
                                float proj[16]);
 
+/* ---------------------------------------------------- classified grid */
+
+/* The classified volume as a participating medium on a regular grid, for
+ * renderers that take density and colour grids (Blender's Volume objects).
+ * docs/physical_model.md is the model: with a the transfer function's
+ * opacity per voxel of path (after opacity_scale, and the gradient-opacity
+ * factor of params.gradient_opacity), the extinction per world unit is
+ * -ln(1 - a) / voxel_length, and the albedo is the table's colour made linear. */
+typedef struct vxl_grid_params {
+    uint32_t struct_size;
+    uint32_t dims[3];            /* cells per axis, spread evenly over the volume's box; 0 = the volume's
+                                    own voxel count on that axis */
+} vxl_grid_params;
+
+typedef struct vxl_grid_info {   /* output */
+    uint32_t struct_size;
+    uint32_t dims[3];            /* the cells filled */
+    double index_to_world[16];   /* column-major: cell (i, j, k)'s centre -> world (the params' model) */
+    double voxel_length;         /* world units per voxel of path: the cube root of the model's
+                                    determinant (the edge of a cube as large as a voxel) */
+    double max_density;          /* the largest density written (0 when density and rgb are NULL) */
+} vxl_grid_info;
+
+/* Fills density (dims product floats, x fastest: extinction per world unit,
+ * 0 where the clip planes or the crop box of params.cutaway cut the volume
+ * away) and rgb (3 floats per cell: the transfer function's straight
+ * colour, which the library treats as display-referred sRGB, decoded to
+ * linear, 0..1) for vol classified as p classifies it (preset or
+ * table, window, opacity scale, gradient opacity from central differences
+ * sample_distance apart). Either buffer may be NULL; both NULL fills info
+ * only, so a caller can size its buffers. CPU only: no renderer, no GL.
+ * Each cell takes the trilinear value at its centre. Only the DVR mode is a
+ * medium; labels and cutter meshes are not baked (VXL_ERR_INVALID_ARGUMENT
+ * naming them); a streamed volume is VXL_ERR_STATE (load it whole). */
+VXL_API int vxl_classified_grid(const vxl_volume *vol, const vxl_render_params *p, const vxl_grid_params *g,
+                                vxl_grid_info *info, float *density, float *rgb);
+
 /* ------------------------------------------------------------------ misc */
 
 VXL_API uint32_t vxl_abi_version(void);

@@ -253,6 +253,19 @@ class SliceParams(ctypes.Structure):
                 ("plane_to_world", c_float4x4)]
 
 
+class GridParams(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3)]
+
+
+class GridInfo(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("dims", ctypes.c_uint32 * 3),
+                ("index_to_world", c_double4x4),
+                ("voxel_length", ctypes.c_double),
+                ("max_density", ctypes.c_double)]
+
+
 class OverlayStyle(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("slot", ctypes.c_uint32),

@@ -11,7 +11,7 @@ import numpy as np
 
 from .native_abi import (ABI_VERSION, ENUM_FALLBACKS, FILTERS, DicomSeries, LabelEntry,
                          LibraryUnavailable, LoadOptions, PhantomDesc, RendererInfo, RendererOptions, RenderParams,
-                         RenderStats, SliceParams, VolumeDesc, VolumeInfo, VoxlightError, _fptr)
+                         RenderStats, SliceParams, GridInfo, GridParams, VolumeDesc, VolumeInfo, VoxlightError, _fptr)
 from . import platform_rules
 from .native_private_copy import helper_names, private_copy, restore_execute_bit
 
@@ -75,6 +75,8 @@ def _declare(lib):
         "vxl_probe_gradients": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                                ctypes.c_uint32, P(ctypes.c_float)]),
         "vxl_render_slice": (ctypes.c_int, [vp, P(RenderParams), P(SliceParams), P(ctypes.c_float)]),
+        "vxl_classified_grid": (ctypes.c_int, [vp, P(RenderParams), P(GridParams), P(GridInfo),
+                                               P(ctypes.c_float), P(ctypes.c_float)]),
         "vxl_write_image": (ctypes.c_int, [ctypes.c_char_p, P(ctypes.c_float),
                                            P(ctypes.c_float), ctypes.c_uint32,
                                            ctypes.c_uint32]),

@@ -9,8 +9,9 @@ import os
 
 import numpy as np
 
-from .native_abi import (PROGRESS_CALLBACK, DicomSeries, LabelEntry, LibraryObject, LoadOptions, PhantomDesc,
-                         VolumeDesc, VolumeInfo, VoxlightError, matrix_from_cm, _DTYPES, _sized)
+from .native_abi import (PROGRESS_CALLBACK, DicomSeries, GridInfo, GridParams, LabelEntry, LibraryObject,
+                         LoadOptions, PhantomDesc, VolumeDesc, VolumeInfo, VoxlightError, matrix_from_cm,
+                         _DTYPES, _fptr, _sized)
 from .native_library import load_library
 
 
@@ -184,6 +185,31 @@ class Volume(LibraryObject):
         counts = (ctypes.c_uint64 * bins)()
         self.lib.check(self.lib.cdll.vxl_volume_histogram(self.handle, bins, lo, hi, counts))
         return np.frombuffer(counts, np.uint64).astype(np.int64)
+
+    def classified_grid(self, params, dims=(0, 0, 0), fill=True):
+        """The volume classified as params classifies it, as a medium on a
+        grid of dims cells (0 on an axis: the volume's own count):
+        vxl_classified_grid, docs/physical_model.md. Returns (info dict,
+        density (z, y, x) float32 extinction per world unit, rgb (z, y, x, 3)
+        float32 linear colour); with fill False only the info, and None for
+        both arrays, so a caller can check the size first."""
+        g = _sized(GridParams)
+        g.dims[:] = [int(d) for d in dims]
+        info = _sized(GridInfo)
+        self.lib.check(self.lib.cdll.vxl_classified_grid(self.handle, ctypes.byref(params), ctypes.byref(g),
+                                                         ctypes.byref(info), None, None), what="classified grid")
+        shape = tuple(int(d) for d in reversed(info.dims))
+        density = rgb = None
+        if fill:
+            density = np.empty(shape, np.float32)
+            rgb = np.empty(shape + (3,), np.float32)
+            self.lib.check(self.lib.cdll.vxl_classified_grid(self.handle, ctypes.byref(params), ctypes.byref(g),
+                                                             ctypes.byref(info), _fptr(density), _fptr(rgb)),
+                           what="classified grid")
+        return {"dims": tuple(int(d) for d in info.dims),
+                "index_to_world": matrix_from_cm(info.index_to_world),
+                "voxel_length": info.voxel_length,
+                "max_density": info.max_density}, density, rgb
 
     @property
     def handle(self):

@@ -27,6 +27,10 @@ class PosixRules:
     library = "libvoxlight.so"
     helper_suffix = ""
     path = posixpath
+    # The program that writes OpenVDB files for Convert to Blender Volume,
+    # shipped beside the library (None: this platform has no OpenVDB build).
+    vdb_writer = "voxlight-write-vdb"
+    no_vdb_writer = ""
 
     def is_helper(self, name, prefix):
         """A helper program of this platform: no extension (a .exe is
@@ -94,6 +98,9 @@ class WindowsRules:
     library = "voxlight.dll"
     helper_suffix = ".exe"
     path = ntpath
+    vdb_writer = None
+    no_vdb_writer = ("Convert to Blender Volume needs OpenVDB, which the Windows build of Voxlight "
+                     "does not include yet: convert on Linux, where the add-on ships voxlight-write-vdb")
 
     def __init__(self, remove=os.remove, open_file=open):
         # Windows' own behaviour, injectable so Linux tests can emulate it:

@@ -40,6 +40,8 @@ BINDINGS = {
     "vxl_matcap": native.Matcap,
     "vxl_scene_shadows": native.SceneShadows,
     "vxl_slice_params": native.SliceParams,
+    "vxl_grid_params": native.GridParams,
+    "vxl_grid_info": native.GridInfo,
     "vxl_render_stats": native.RenderStats,
     "vxl_phantom_desc": native.PhantomDesc,
 }

@@ -378,7 +378,8 @@ def test_render_params_tail_matches_header():
     assert ctypes.sizeof(P) == 728
     assert P.labels.offset == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
-    names = [n for n, _t in P._fields_][-24:-5]
+    names = [n for n, _t in P._fields_]
+    names = names[names.index("preint_size"):names.index("labels") + 1]
     assert names == ["preint_size", "gradient_opacity", "gradient_ref", "gradient_exp",
                      "iso_value", "iso_thickness", "shading_model", "light_shapes",
                      "ambient_occlusion", "occlusion_strength", "anisotropy", "illumination_size",

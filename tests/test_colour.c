@@ -5,7 +5,8 @@
  * exactly that colour at the centre (the other two channels exactly 0: no
  * luminance mixing) in every storage mode, classification and render mode;
  * colour source tf renders bit for bit what the luminance alone renders;
- * NIfTI RGB24, RGBA32 and vector files load as colour with their notes; the
+ * NIfTI RGB24, RGBA32 and vector files and an RGB NRRD load as colour with
+ * their notes; the
  * opacity source picks the scalar; the colour is charged to the budget. */
 #include <dirent.h>
 #include <errno.h>
@@ -366,7 +367,7 @@ static int write_cube_nifti(const char *path, int kind)
     return tnw_write(path, &h, bytes, (size_t)comp * N * N * N);
 }
 
-TEST(nifti_colour_files_load_as_colour_with_a_note)
+TEST(nifti_and_nrrd_colour_files_load_as_colour_with_a_note)
 {
     char path[256];
     vxl_renderer *r = make_stored_renderer(VXL_STORAGE_DENSE, 0, 0, 0);
@@ -395,6 +396,28 @@ TEST(nifti_colour_files_load_as_colour_with_a_note)
         /* the 8-bit files are the same voxels as the volume made in memory */
         if (kind < 2) CHECKF(!memcmp(IMG, REF, sizeof IMG), "%s renders differently from the same voxels in memory", names[kind]);
         vxl_volume_destroy(v);
+    }
+    /* NRRD: the fastest axis RGB-color, the same voxels */
+    {
+        static uint8_t body[3 * N * N * N];
+        for (int i = 0; i < N * N * N; i++)
+            for (int c = 0; c < 3; c++) body[3 * i + c] = CUBE[4 * i + c];
+        char hdr[256];
+        int n = snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uint8\ndimension: 4\nsizes: 3 %d %d %d\n"
+                                          "kinds: RGB-color domain domain domain\nencoding: raw\n\n", N, N, N);
+        FILE *f = fopen(tmp(path, sizeof path, "rgb.nrrd"), "wb");
+        REQUIRE(f);
+        CHECK(fwrite(hdr, 1, (size_t)n, f) == (size_t)n && fwrite(body, 1, sizeof body, f) == sizeof body);
+        fclose(f);
+        vxl_volume *v = NULL;
+        CHECKF(vxl_volume_load(path, NULL, &v) == VXL_OK, "rgb.nrrd: %s", vxl_last_error());
+        if (v) {
+            vxl_volume_info in = {.struct_size = sizeof in};
+            vxl_volume_get_info(v, &in);
+            CHECK(in.components == 3 && strstr(in.notes, "NRRD RGB: colour from the data"));
+            CHECK(render(r, v, &p, IMG) == VXL_OK && !memcmp(IMG, REF, sizeof IMG));
+            vxl_volume_destroy(v);
+        }
     }
     /* streaming on: still read whole, and the note says so */
     vxl_load_options on = {.struct_size = sizeof on, .streaming = VXL_STREAMING_ON};
@@ -427,7 +450,7 @@ int main(void)
     RUN(opacity_source_picks_the_scalar);
     RUN(slice_planes_show_the_data_colour);
     RUN(colour_is_charged_to_the_budget);
-    RUN(nifti_colour_files_load_as_colour_with_a_note);
+    RUN(nifti_and_nrrd_colour_files_load_as_colour_with_a_note);
     remove_tmp_dir();
     return TEST_SUMMARY();
 }

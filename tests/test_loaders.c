@@ -227,10 +227,17 @@ TEST(nrrd_4d_reads_the_first_volume_and_2d_is_one_slice)
     if (v) CHECK(v->dims[0] == 4 && v->dims[1] == 3 && v->dims[2] == 1);
     vxl_volume_destroy(v);
 
-    /* RGB as the fastest axis is not a scalar volume */
+    /* RGB as the fastest axis is a colour volume (test_colour.c); as another axis it is refused */
     snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 3 2 2\nkinds: RGB-color domain domain\n"
              "encoding: raw\n\n");
     REQUIRE(tw_write(tmp(p, sizeof p, "rgb.nrrd"), hdr, strlen(hdr), buf, 12) == 0);
+    v = NULL;
+    CHECKF(load(p, NULL, &v) == VXL_OK, "%s", vxl_last_error());
+    if (v) CHECK(v->components == 3 && v->dims[0] == 2 && v->dims[1] == 2 && v->dims[2] == 1);
+    vxl_volume_destroy(v);
+    snprintf(hdr, sizeof hdr, "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 3 2\nkinds: domain RGB-color domain\n"
+             "encoding: raw\n\n");
+    REQUIRE(tw_write(tmp(p, sizeof p, "rgb_middle.nrrd"), hdr, strlen(hdr), buf, 12) == 0);
     CHECK(load(p, NULL, &v) == VXL_ERR_FORMAT && strstr(vxl_last_error(), "not spatial"));
 }
 

@@ -69,6 +69,14 @@ uint64_t vxl_load_budget(const vxl_load_options *opt);
 int vxl_plan_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, const vxl_load_options *opt,
                     uint64_t *nbytes, vxl_err *e);
 
+/* vxl_plan_voxels for a colour file of `components` (3, 4) interleaved or
+ * planar channels of dtype, read whole (its colour has no brick source):
+ * the budget takes the raw channels or the scalar's texture with its RGB8
+ * colour, whichever is larger; over it the error says streaming is not
+ * available for colour. *nbytes: the raw channels' bytes. */
+int vxl_plan_colour_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, uint32_t components,
+                           const vxl_load_options *opt, uint64_t *nbytes, vxl_err *e);
+
 /* Wraps an error from a helper with the file name, keeping its code. */
 int vxl_fail_in(vxl_err *e, const char *path, const vxl_err *inner);
 

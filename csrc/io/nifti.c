@@ -647,25 +647,6 @@ static nii_colour colour_of(const nii_header *h)
     return c;
 }
 
-/* A colour file is read whole (its colour has no brick source: only the
- * scalar could stream): the budget takes the raw channels and the scalar's
- * texture with the colour, whichever is larger, before anything is read. */
-static int plan_colour(const nii_colour *c, const char *path, const uint32_t dims[3], uint32_t dtype,
-                       const vxl_load_options *opt, uint64_t *nbytes, vxl_err *e)
-{
-    const uint32_t size = vxl_dtype_size(dtype);
-    const uint32_t raw = size * c->components, texture = vxl_texture_bits_for(dtype) / 8 + 3;
-    vxl_err inner = {0};
-    if (vxl_volume_check_limits(dims, raw > texture ? raw : texture, opt, &inner)) {
-        if (inner.code == VXL_ERR_LIMIT)
-            return vxl_fail(e, VXL_ERR_LIMIT, "'%s': %s (colour volumes are read whole: streaming is not available for them)",
-                            path, inner.msg);
-        return vxl_fail_in(e, path, &inner);
-    }
-    *nbytes = (uint64_t)dims[0] * dims[1] * dims[2] * raw;
-    return VXL_OK;
-}
-
 /* Validates the header and works out what to read: whole (today's checks
  * against the budget, before anything is allocated) or streamed (issue 21:
  * *stream = 1, stream_load.h). */
@@ -683,7 +664,7 @@ static int plan_read(const nii_header *h, const nii_colour *colour, const char *
     if (rc) return rc;
     if (colour->components) {
         *stream = 0;
-        return plan_colour(colour, path, dims, *dtype, opt, nbytes, e);
+        return vxl_plan_colour_voxels(path, dims, *dtype, colour->components, opt, nbytes, e);
     }
     /* The budget check vxl_volume_build makes, but before we allocate the
      * raw buffer; it also guarantees the voxel count below cannot overflow.

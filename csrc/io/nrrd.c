@@ -26,6 +26,7 @@
 #include "loader_util.h"
 #include "loaders.h"
 #include "stream_load.h"
+#include "colour_volume.h"
 
 #define NRRD_MAX_DIM 16
 #define ENC_RAW 0
@@ -328,20 +329,27 @@ static int parse_header(char *text, size_t len, uint64_t file_size, int detached
 
 /* Picks the (up to 3) spatial axes. A non-spatial axis of size > 1 (time,
  * vector components) is only allowed as the slowest axis; then the first
- * volume is read. */
+ * volume is read. A non-spatial fastest axis of 3 or 4 (RGB-color,
+ * RGBA-color, 3-vector: each sample's channels, interleaved) makes a colour
+ * volume of that many *components (1 otherwise). */
 static int choose_axes(const nrrd_hdr *h, int axes[3], int *nax, uint32_t dims[3], uint64_t *block_count,
-                       const char *path, vxl_err *e)
+                       uint32_t *components, const char *path, vxl_err *e)
 {
     int ns = 0;
+    *components = 1;
     for (int i = 0; i < h->dimension; i++) {
         int nonspatial = (h->nkinds && h->component_kind[i]) || (h->ndirs && h->dir_none[i]);
         int last = i == h->dimension - 1;
         if (nonspatial && h->sizes[i] == 1) continue;
+        if (nonspatial && i == 0 && !last && (h->sizes[0] == 3 || h->sizes[0] == 4)) {
+            *components = (uint32_t)h->sizes[0];
+            continue;
+        }
         if (nonspatial || ns == 3) {
             if (last) continue; /* only its first index is read */
             return vxl_fail(e, VXL_ERR_FORMAT,
-                            nonspatial ? "'%s': NRRD axis %d is not spatial (size %llu; vector or colour "
-                                         "components are not supported)"
+                            nonspatial ? "'%s': NRRD axis %d is not spatial (size %llu; only a fastest axis of 3 or "
+                                         "4 colour components is supported)"
                                        : "'%s': NRRD axis %d: more than 3 spatial axes (size %llu)",
                             path, i, (unsigned long long)h->sizes[i]);
         }
@@ -444,9 +452,12 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
     uint64_t block = 0, nbytes = 0, offset = 0, skip_after = 0;
     const char *dpath = path;
     int stream = 0;
-    if (!rc) rc = choose_axes(&h, axes, &nax, dims, &block, path, e);
-    /* gzip data, attached or detached, streams through a bricked cache that inflates from its start */
-    if (!rc) rc = vxl_stream_plan(path, dims, h.dtype, opt, NULL, &stream, &nbytes, e);
+    uint32_t components = 1;
+    if (!rc) rc = choose_axes(&h, axes, &nax, dims, &block, &components, path, e);
+    /* gzip data, attached or detached, streams through a bricked cache that inflates from its start;
+     * colour is read whole (colour_volume.h) */
+    if (!rc && components > 1) rc = vxl_plan_colour_voxels(path, dims, h.dtype, components, opt, &nbytes, e);
+    else if (!rc) rc = vxl_stream_plan(path, dims, h.dtype, opt, NULL, &stream, &nbytes, e);
     if (!rc && h.data_file) {
         data_path = vxl_sibling_path(path, h.data_file);
         if (!data_path) rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", path);
@@ -511,9 +522,15 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
         rc = geometry(&h, axes, nax, sp, A, path, e);
         if (!rc) {
             vxl_err inner = {0};
-            rc = vxl_volume_build(raw, h.dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner);
+            if (components > 1)
+                rc = vxl_volume_build_colour(raw, h.dtype, components, 0, dims, sp, A, 0.0, 0.0, opt,
+                                             components == 3 ? "NRRD RGB" : "NRRD RGBA", out, &inner);
+            else
+                rc = vxl_volume_build(raw, h.dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner);
             if (rc) rc = vxl_fail_in(e, path, &inner);
             else (*out)->affine_source = h.ndirs ? 2 : 0;
+            if (!rc && components > 1 && vxl_load_streaming(opt) == VXL_STREAMING_ON)
+                vxl_volume_note(*out, "read whole: a colour volume does not stream");
         }
     }
     free(raw);

@@ -168,6 +168,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     flags |= vxl_cut_flags(f);         /* issue 19: clip planes, crop box, cutters */
     flags |= vxl_labels_flags(f);      /* issue 20: the label mode */
     flags |= vxl_overlays_flags(f);    /* issue 20: the overlay count */
+    if (f->shading && f->env.on) flags |= VXL_FLAG_ENVIRONMENT; /* the World's light */
     uint32_t filter = vxl_frame_filter(f);
     int rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
     if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);

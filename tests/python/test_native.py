@@ -372,12 +372,12 @@ def test_render_params_tail_matches_header():
     # 688 bytes up to the reserved room's end; issue 20 appended the labels'
     # pointer, then overlay_count and (issue 21) progressive before the
     # overlays' pointer, which keeps it on its 8-byte alignment; MinIP's
-    # floor (flag and value) follows it
+    # floor (flag and value) follows it, then the World's light (a pointer on its alignment)
     assert P.labels.offset == 688 and P.overlays.offset == 704 and P.minip_floor.offset == 716
-    assert ctypes.sizeof(P) == 720
+    assert P.environment.offset == 720 and ctypes.sizeof(P) == 728
     assert P.labels.offset == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
-    names = [n for n, _t in P._fields_][-24:-5]
+    names = [n for n, _t in P._fields_][-25:-6]
     assert names == ["preint_size", "gradient_opacity", "gradient_ref", "gradient_exp",
                      "iso_value", "iso_thickness", "shading_model", "light_shapes",
                      "ambient_occlusion", "occlusion_strength", "anisotropy", "illumination_size",

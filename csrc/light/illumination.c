@@ -23,8 +23,16 @@
 #define MIN_SIZE 8u
 
 enum { PASS_EXTINCTION, PASS_SWEEP, PASS_OCCLUSION, PASS_SCENE_SHADOWS, PASS_ENVIRONMENT = VXL_FLAG_ENVIRONMENT };
-/* The environment's RGBA16F volume weighs as much as this many R16F blocks. */
-#define ENV_BLOCKS 4u
+/* The environment's irradiance is a mean over the whole sphere, smoother
+ * than any lamp's shadow: it is kept on a grid half as fine as the lamps'
+ * per axis, an eighth of the cells and of the pass's cost. Its RGBA16F
+ * texture then weighs at most as much as one R16F block. */
+#define ENV_BLOCKS 1u
+
+static void env_grid(const uint32_t cells[3], uint32_t out[3])
+{
+    for (int a = 0; a < 3; a++) out[a] = (cells[a] + 1) / 2;
+}
 
 void vxl_illumination_release(vxl_illumination_state *s)
 {
@@ -152,18 +160,21 @@ static int allocate(vxl_illumination_state *s, const uint32_t ext_cells[3], cons
         memset(s->light_key, 0, sizeof s->light_key);
         s->occlusion_key = 0;
     }
-    if (s->env_tex && (!env || memcmp(s->env_cells, cells, sizeof s->env_cells))) {
+    uint32_t ec[3];
+    env_grid(cells, ec);
+    if (s->env_tex && (!env || memcmp(s->env_cells, ec, sizeof s->env_cells))) {
         gl->DeleteTextures(1, &s->env_tex);
         s->env_tex = 0;
     }
     if (env && !s->env_tex) {
         s->env_tex = vxl_texture_new(s->gpu, GL_TEXTURE_3D, GL_LINEAR);
-        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16F, (GLsizei)cells[0], (GLsizei)cells[1], (GLsizei)cells[2], 0, GL_RGBA,
-                       GL_FLOAT, NULL);
-        memcpy(s->env_cells, cells, sizeof s->env_cells);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16F, (GLsizei)ec[0], (GLsizei)ec[1], (GLsizei)ec[2], 0, GL_RGBA, GL_FLOAT,
+                       NULL);
+        memcpy(s->env_cells, ec, sizeof s->env_cells);
         s->env_key = 0;
     }
-    s->bytes = extinction_bytes(s->extinction_cells) + light_bytes(s->cells, s->blocks + (s->env_tex ? ENV_BLOCKS : 0));
+    s->bytes = extinction_bytes(s->extinction_cells) + light_bytes(s->cells, s->blocks) +
+               (s->env_tex ? (uint64_t)s->env_cells[0] * s->env_cells[1] * s->env_cells[2] * 8 : 0);
     int rc = vxl_gl_check(s->gpu, "allocating the illumination volumes");
     if (rc) {
         uint32_t builds = s->builds;
@@ -419,7 +430,7 @@ static int build_environment(vxl_illumination_state *s, const float dirs[VXL_ENV
 {
     vxl_gl *gl = &s->gpu->gl;
     GLuint prog;
-    int rc = pass_program(s, PASS_ENVIRONMENT, 0, s->cells, &prog);
+    int rc = pass_program(s, PASS_ENVIRONMENT, 0, s->env_cells, &prog);
     if (rc) return rc;
     float radiance[VXL_ENV_CELLS][3], start = 0;
     for (int k = 0; k < VXL_ENV_CELLS; k++)
@@ -427,14 +438,14 @@ static int build_environment(vxl_illumination_state *s, const float dirs[VXL_ENV
     /* half a cell out, as the lights' reads move half a cell towards the
      * light: a surface half fills its own cell and would occlude itself */
     for (int a = 0; a < 3; a++) {
-        float cell = (float)s->storage->geom.dims[a] / (float)s->cells[a];
+        float cell = (float)s->storage->geom.dims[a] / (float)s->env_cells[a];
         start = cell > start ? cell : start;
     }
     gl->Uniform3fv(gl->GetUniformLocation(prog, "u_env_dir"), VXL_ENV_CELLS, &dirs[0][0]);
     gl->Uniform3fv(gl->GetUniformLocation(prog, "u_env_radiance"), VXL_ENV_CELLS, &radiance[0][0]);
     vxl_uniform_f(s->gpu, prog, "u_env_start", 0.5f * start);
     gl->BindImageTexture(VXL_IMAGE_OUT, s->env_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
-    dispatch_cells(s, s->cells);
+    dispatch_cells(s, s->env_cells);
     return vxl_gl_check(s->gpu, "building the environment's irradiance volume");
 }
 
@@ -572,6 +583,14 @@ void vxl_illumination_bind(vxl_illumination_state *s, GLuint prog, const vxl_fra
     gl->Uniform1i(LOC("u_illum_ao_block"), f->ao_radius > 0 ? f->light_count : -1);
     gl->Uniform4fv(LOC("u_light_voxel"), VXL_MAX_LIGHTS, &lv[0][0]);
     gl->Uniform1f(LOC("u_illum_bias"), bias);
+    if (f->env.on && s->env_tex) { /* half the environment's own (coarser) cell */
+        float env_bias = 0;
+        for (int a = 0; a < 3; a++) {
+            float cell = (float)s->storage->geom.dims[a] / (float)s->env_cells[a];
+            env_bias = cell > env_bias ? cell : env_bias;
+        }
+        gl->Uniform1f(LOC("u_env_bias"), 0.5f * env_bias);
+    }
     gl->Uniform3fv(LOC("u_spot_dir"), VXL_MAX_LIGHTS, &f->light_spot_dir[0][0]);
     float shape[VXL_MAX_LIGHTS][4] = {{0}};
     for (int i = 0; i < VXL_MAX_LIGHTS; i++) {

@@ -51,8 +51,9 @@ typedef struct vxl_illumination_state {
     uint64_t extinction_key, occlusion_key;
     /* The World's light (environment_map.h): its map reduced to direction
      * cells (keyed by the frame's env.key), and the irradiance volume E(x)
-     * on the lights' cells, RGBA16F, keyed by the extinction, the grid, the
-     * map and its voxel-space directions. Freed by a frame without one. */
+     * on env_cells (half the lights' grid per axis), RGBA16F, keyed by the
+     * extinction, the grid, the map and its voxel-space directions. Freed by
+     * a frame without one. */
     GLuint env_tex;
     uint32_t env_cells[3];
     uint64_t env_key, env_map_key;

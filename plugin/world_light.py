@@ -14,7 +14,9 @@ _images = {}  # image name -> its downsampled map
 
 
 def _cached_rgb(image):
-    key = (image.name_full, tuple(image.size), image.filepath_raw)
+    # A reload or a paint stroke is an image update (the handler below drops
+    # the cache); is_dirty catches a script's first pixel edit too.
+    key = (image.name_full, tuple(image.size), image.filepath_raw, image.is_dirty)
     hit = _images.get(image.name_full)
     if hit is not None and hit[0] == key:
         return hit[1]

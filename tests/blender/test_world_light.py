@@ -132,4 +132,30 @@ def a_black_world_gives_no_light_and_world_light_off_brings_the_headlight_back()
     assert min(head) > 0.3, head
 
 
+@test
+def the_light_follows_the_world_and_its_image():
+    """What the viewport and F12 pass is read from the World as it is now:
+    its strength, the Mapping rotation, and another image's pixels."""
+    scene, ob = _scene()
+    img = _sky()
+    world = _world(scene, img, strength=2.0)
+    dg = bpy.context.evaluated_depsgraph_get()
+    env = vx.params.scene_lights(scene, dg).environment
+    assert env is not None and env.strength == 2.0 and env.rgb.shape == (32, 64, 3), env
+    bright = float(env.rgb.max())
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.5
+    world.node_tree.nodes["Mapping"].inputs["Rotation"].default_value[2] = math.radians(30.0)
+    bpy.context.view_layer.update()
+    env = vx.params.scene_lights(scene, dg).environment
+    assert env.strength == 0.5 and abs(env.rotation_deg - 30.0) < 1e-4, env[1:]
+    grey = bpy.data.images.new("VoxlightTestGrey", 16, 8, float_buffer=True)
+    grey.pixels.foreach_set(np.full(16 * 8 * 4, 0.25, np.float32))
+    world.node_tree.nodes["Environment Texture"].image = grey  # another image: another map
+    bpy.context.view_layer.update()
+    env = vx.params.scene_lights(scene, bpy.context.evaluated_depsgraph_get()).environment
+    assert abs(float(env.rgb.max()) - 0.25) < 1e-6 and bright > 1.0, (env.rgb.max(), bright)
+    scene.voxlight.use_scene_lights = False  # the World follows Scene Lights
+    assert vx.params.scene_lights(scene, dg).environment is None
+
+
 u.run("world_light")

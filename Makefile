@@ -80,7 +80,7 @@ STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlig
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
-all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/tests/render_scene $(BUILD)/tests/child_program $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(BUILD)/voxlight-sceneshadowbench $(STUDIES) $(TESTS)
+all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/tests/render_scene $(BUILD)/tests/child_program $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(BUILD)/voxlight-sceneshadowbench $(BUILD)/voxlight-envbench $(STUDIES) $(TESTS)
 
 # Objects are rebuilt when LIB_CC changes (the stamp holds the last one).
 LIB_CC_STAMP := $(BUILD)/obj/lib_cc.txt
@@ -194,6 +194,10 @@ $(BUILD)/voxlight-overlaysbench: bench/overlays_study.c bench/bench_util.h $(BUI
 $(BUILD)/voxlight-modesbench: bench/modes_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
+# the World's light: its cost over a cached shadowed frame (docs/lighting.md)
+$(BUILD)/voxlight-envbench: bench/environment_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
 $(BUILD)/voxlight-sceneshadowbench: bench/scene_shadow_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
@@ -205,6 +209,14 @@ BRICK_CACHE_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,brick_cache brick_cache_re
 $(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wildcard tests/*.h) $(BRICK_CACHE_TEST_OBJ) \
 		$(BUILD)/libvoxlight.so | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Itests $< $(BRICK_CACHE_TEST_OBJ) -o $@ -L$(BUILD) -lvoxlight -lz -lm -lpthread -Wl,-rpath,'$$ORIGIN/..'
+
+# test_environment checks the World map's reduction and the Radiance reader
+# (internals) beside rendering through the library.
+ENVIRONMENT_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,environment_map hdr_read error)
+$(BUILD)/tests/test_environment: tests/test_environment.c tests/harness.h $(wildcard tests/*.h) $(ENVIRONMENT_TEST_OBJ) \
+		$(BUILD)/libvoxlight.so $(PLATFORM:%=$(BUILD)/obj/%.o) | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Itests $< $(ENVIRONMENT_TEST_OBJ) $(PLATFORM:%=$(BUILD)/obj/%.o) -o $@ -L$(BUILD) -lvoxlight -lm \
+		-ldl -lpthread -Wl,-rpath,'$$ORIGIN/..'
 
 # test_gl_thread checks the GL thread's shared lock (internal), so it links
 # the thread and context objects; the backends come with context.o.
@@ -377,9 +389,9 @@ FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc
 FUZZ_LIB_C := volume.c colour_volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
 	reader_spawn.c remote_readers.c label_table.c zarr_detect.c $(notdir $(ZARR_C)) zarr_source.c brick_source.c
 # the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
-# fuzz_brick_cache and fuzz_tiff_layout
+# fuzz_brick_cache and fuzz_tiff_layout; the Radiance reader of World maps, read by fuzz_hdr
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
-	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c \
+	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c hdr_read.c \
 	$(DICOM_CODECS:%=%.c) $(PLATFORM:%=%.c))
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp $(notdir $(DICOM_CXX))
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
@@ -401,8 +413,9 @@ $(FUZZ_BUILD)/obj/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h csrc/in
 $(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/fuzz_%.o $(FUZZ_OBJ)
 	clang++ $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@ $(LIBS) $(OIIO_LIBS) $(DCMTK_LIBS)
 
-$(FUZZ_BUILD)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/writers.h tests/fuzz/dicom_writer.h tests/nifti_writer.h | $(FUZZ_BUILD)/obj
-	$(CC) -std=c11 -D_GNU_SOURCE $(WARN) -O1 -Itests $< -o $@ -lz
+$(FUZZ_BUILD)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/writers.h tests/fuzz/dicom_writer.h tests/nifti_writer.h \
+		tests/hdr_writer.h | $(FUZZ_BUILD)/obj
+	$(CC) -std=c11 -D_GNU_SOURCE $(WARN) -O1 -Itests $< -o $@ -lz -lm
 
 $(FUZZ_BUILD)/obj:
 	mkdir -p $@

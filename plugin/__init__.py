@@ -44,7 +44,7 @@ if UNSUPPORTED is None:
     native.CACHE_DIR = compat.private_data_dir(__package__)
     from . import (api, blender_volume, compositor, importer, offline, operators, panels, params,  # noqa: E402
                    preferences, properties, render_hooks, render_setup, scene_shadows, tf,
-                   viewport, volume_object)
+                   viewport, volume_object, world_light)
     from . import cutaway_ui, slice_planes  # noqa: E402  (issue 19)
     from . import label_props, label_ui  # noqa: E402  (issue 20)
     from . import overlay_props, overlay_ui  # noqa: E402  (issue 20 overlays)
@@ -56,7 +56,7 @@ if UNSUPPORTED is None:
     _modules = (preferences, properties, label_props, overlay_props, tf, operators, blender_volume, importer,
                 volume_object,
                 panels, slice_planes, cutaway_ui, label_ui, overlay_ui, render_setup, render_hooks, scene_shadows,
-                viewport)
+                world_light, viewport)
 else:
     _modules = ()
 

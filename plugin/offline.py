@@ -7,7 +7,7 @@ the scene's meshes in numpy (zbuffer.py) and passing that as scene_depth.
 import bpy
 import numpy as np
 
-from . import label_props, overlay_frames, params, scene_shadows
+from . import label_props, overlay_frames, params, scene_shadows, world_light
 from .core import label_runtime, native, runtime, scene_geometry, volume_space, zbuffer
 
 
@@ -86,6 +86,7 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
     named = scene_shadows.named_lights(depsgraph, for_render) \
         if scene.voxlight.use_scene_lights else []
     lights = [l for _n, _g, l in named]
+    environment = world_light.scene_environment(scene)  # the World's light, None without one
     casters = [(ob, mw) for ob, mw in vols if ob.voxlight.cast_shadows]
     if camera is not None:
         view, proj = camera_matrices(camera, depsgraph, width, height, scene)
@@ -108,7 +109,7 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
         entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
                                   scene.frame_current, **opts)
         v2l = np.array(ob.voxlight.voxel_to_local, np.float64).reshape(4, 4).T
-        return entry, dict(view=view, proj=proj, model=mw @ v2l, lights=lights,
+        return entry, dict(view=view, proj=proj, model=mw @ v2l, lights=lights, environment=environment,
                            **params.look_kwargs(ob.voxlight))
 
     if frame_info is not None:

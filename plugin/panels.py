@@ -365,6 +365,9 @@ class VOXLIGHT_PT_scene(bpy.types.Panel):
             for i, line in enumerate(compat.wrap(scene_shadows.note, 40)):
                 col.label(text=line, icon="INFO" if i == 0 else "BLANK1")
         layout.prop(s, "use_scene_lights")
+        row = layout.row()
+        row.active = s.use_scene_lights  # the World follows Scene Lights
+        row.prop(s, "use_world_light")
         layout.prop(s, "backend")
         layout.prop(s, "storage")
         layout.prop(s, "memory_budget_mib", text="Budget (MiB)")

@@ -11,6 +11,7 @@ from . import cutaway
 from . import label_props
 from . import mode_start
 from . import tf as _tf
+from . import world_light
 
 
 def model_matrix(obj):
@@ -69,15 +70,18 @@ def look_key(props, fast=False):
                         for k, v in look_kwargs(props, fast).items()))
 
 
-def scene_lights(scene, depsgraph, for_render=False):
-    if not scene.voxlight.use_scene_lights:
-        return []
-    return _lights.collect(depsgraph, for_render)
-
-
 class _Lights(list):
-    """Scene lights, marked while one of them is being dragged."""
+    """Scene lights, marked while one of them is being dragged, with the
+    World's light that goes with them (world_light.scene_environment; None:
+    none): make_params' `environment`."""
     dragged = False
+    environment = None
+
+
+def scene_lights(scene, depsgraph, for_render=False):
+    out = _Lights(_lights.collect(depsgraph, for_render) if scene.voxlight.use_scene_lights else [])
+    out.environment = world_light.scene_environment(scene)
+    return out
 
 
 _light_watch = lighting.LightWatch()
@@ -91,6 +95,7 @@ def while_lights_move(lights, now, settle_time):
     left = _light_watch.update(lights, now, settle_time)
     out = _Lights(lights)
     out.dragged = left is not None
+    out.environment = getattr(lights, "environment", None)
     return out, left
 
 
@@ -100,6 +105,7 @@ def build(obj, width, height, view, proj, scene_depth=None, lights=(), fast=Fals
     the volume (issue 18), or None. overlays: make_params' overlay dicts
     (issue 20, overlay_frames.prepare), or None."""
     kw = look_kwargs(obj.voxlight, fast, dragging=getattr(lights, "dragged", False))
+    kw["environment"] = getattr(lights, "environment", None)
     if overlays:
         kw["overlays"] = overlays
     if scene_shadows is not None:

@@ -385,6 +385,12 @@ class VoxlightSceneProperties(bpy.types.PropertyGroup):
     use_scene_lights: BoolProperty(name="Scene Lights", default=True,
                                    description="Light volumes with the scene's lights "
                                                "(off: headlight)", update=tag_redraw)
+    use_world_light: BoolProperty(name="World Light", default=True,
+                                  description="Light volumes with the World too: its colour or "
+                                              "Environment Texture, strength and Mapping rotation, "
+                                              "in place of the material's ambient term (with no "
+                                              "lights it replaces the headlight)",
+                                  update=tag_redraw)
     render_enabled: BoolProperty(name="Composite in Renders", default=True,
                                  description="Render volumes in F12/animation renders and "
                                              "composite them over the render")

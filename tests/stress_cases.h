@@ -791,6 +791,37 @@ VIEW(material_zero)
     p->has_material = 1; /* all zero; shininess 0 */
 }
 
+/* The World's light at its extremes: radiance and strength at their
+ * largest (every cell saturates), a rotation of many turns, no lamps, each
+ * model that reads it; a uniform World with occlusion and a lamp. */
+VIEW(environment_extreme)
+{
+    (void)vc;
+    sv_ball_tf(p);
+    static const float sky[4 * 2 * 3] = {0, 0, 0, 3.4e38f, 1e-38f, 0, 1e30f, 1e30f, 1e30f, 1, 2, 3,
+                                          0, 1e6f, 0, 5, 5, 5, 3.4e38f, 3.4e38f, 3.4e38f, 0.5f, 0, 0};
+    static vxl_environment env;
+    env = (vxl_environment){.struct_size = sizeof env, .width = 4, .height = 2, .rgb = sky, .strength = 1e6f,
+                            .rotation_deg = 1e30f};
+    p->environment = &env;
+    p->light_count = 0;
+    p->shading_model = VXL_SHADING_SCATTER;
+    p->anisotropy = 0.99f;
+}
+VIEW(environment_uniform_shadowed)
+{
+    (void)vc;
+    sv_ball_tf(p);
+    static const float grey[3] = {0.5f, 0.5f, 0.5f};
+    static vxl_environment env;
+    env = (vxl_environment){.struct_size = sizeof env, .width = 1, .height = 1, .rgb = grey, .strength = 1};
+    p->environment = &env;
+    p->shading_model = VXL_SHADING_SHADOWED;
+    p->ambient_occlusion = 4;
+    p->light_count = 1;
+    p->lights[0].position[2] = 1;
+}
+
 /* deliberately invalid inputs: each must give its error code with a message */
 VIEW(bad_tf_size_zero) { sv_tf_table(p, vc, 256, 3); p->tf_size = 0; }
 VIEW(bad_tf_size_one) { sv_tf_table(p, vc, 2, 3); p->tf_size = 1; }
@@ -841,6 +872,14 @@ VIEW(bad_iso_thickness) { UNUSED_VIEW_ARGS; p->gradient_opacity = VXL_GOPACITY_I
 VIEW(bad_preint_size_small) { UNUSED_VIEW_ARGS; p->preint_size = 15; }
 VIEW(bad_preint_size_large) { UNUSED_VIEW_ARGS; p->preint_size = 4097; }
 VIEW(bad_preset) { UNUSED_VIEW_ARGS; p->preset = VXL_PRESET_COUNT + 3; }
+VIEW(bad_environment_pixel)
+{
+    UNUSED_VIEW_ARGS;
+    static const float px[6] = {1, 1, 1, 1, NAN, 1};
+    static vxl_environment env;
+    env = (vxl_environment){.struct_size = sizeof env, .width = 2, .height = 1, .rgb = px, .strength = 1};
+    p->environment = &env;
+}
 
 /* ------------------------------------------------------------------ cases */
 
@@ -1089,6 +1128,8 @@ static const stress_case stress_cases[] = {
     {"light_direction_1e-38", GROUP_lighting, BALL, light_tiny_direction, OK, F_VISIBLE, 0},
     {"material_extreme", GROUP_lighting, BALL, material_extreme, OK, F_VISIBLE, 0},
     {"material_zero", GROUP_lighting, BALL, material_zero, OK, 0, 0},
+    {"environment_extreme", GROUP_lighting, BALL, environment_extreme, OK, F_VISIBLE, 0},
+    {"environment_uniform_shadowed", GROUP_lighting, BALL, environment_uniform_shadowed, OK, F_VISIBLE, 0},
 
     /* deliberately invalid inputs */
     {"invalid_tf_size_zero", GROUP_invalid_inputs, BALL, bad_tf_size_zero, BAD, 0, 0},
@@ -1132,6 +1173,7 @@ static const stress_case stress_cases[] = {
     {"invalid_preint_size_15", GROUP_invalid_inputs, BALL, bad_preint_size_small, BAD, 0, 0},
     {"invalid_preint_size_4097", GROUP_invalid_inputs, BALL, bad_preint_size_large, BAD, 0, 0},
     {"invalid_preset", GROUP_invalid_inputs, BALL, bad_preset, BAD, 0, 0},
+    {"invalid_environment_pixel", GROUP_invalid_inputs, BALL, bad_environment_pixel, BAD, 0, 0},
 };
 
 #define STRESS_CASE_COUNT (sizeof stress_cases / sizeof stress_cases[0])

@@ -13,6 +13,7 @@
 #include "os.h"
 
 #include "cli_cut.h"   /* --clip-plane, --crop, --no-caps (issue 19) */
+#include "cli_environment.h" /* --environment, --environment-rotation: the World's light */
 #include "cli_modes.h" /* --mode, --iso-value, --matcap, --ortho, --view (issue 19) */
 #include "cli_labels.h" /* the labels command (issue 20) */
 #include "cli_labels_render.h" /* render --labels ... (issue 20) */
@@ -34,6 +35,7 @@ static const char usage_format[] =
     "                  [--storage %s] [--page-brick 8|16|32|64] [--renderer %s]\n"
     "                  [--light dir:X,Y,Z[,INTENSITY] | point:X,Y,Z[,INTENSITY]]... [--shading %s]\n"
     "                  [--ambient-occlusion RADIUS] [--anisotropy G]\n"
+    "                  [--environment FILE.hdr|R,G,B[,STRENGTH]] [--environment-rotation DEG]\n"
     "                  [--mode %s] [--iso-value V] [--matcap FILE.png] [--ortho]\n"
     "                  [--view x|-x|y|-y|z|-z] [--streaming %s] [--cache-dir DIR]\n"
     "                  [--clip-plane A,B,C,D[,T]]... [--crop X0:X1,Y0:Y1,Z0:Z1] [--no-caps]\n"
@@ -67,6 +69,10 @@ static const char usage_format[] =
     "         directional light, point: a point light's world position; INTENSITY > 0, default 1.\n"
     "         --shading phong: local lighting; shadowed: with shadows and --ambient-occlusion (voxels,\n"
     "         0 = off); scatter: also single scattering, forward for --anisotropy G > 0 (-0.99..0.99)\n"
+    "environment: --environment lights the volume from every side, as Blender's World: a Radiance .hdr\n"
+    "         latitude-longitude map (Blender's equirectangular mapping) or a uniform linear colour, times\n"
+    "         STRENGTH (default 1), turned by --environment-rotation DEG about world +Z (a Mapping node's Z\n"
+    "         rotation); with no --light it replaces the headlight (docs/lighting.md)\n"
     "cutaways: --clip-plane (repeatable, up to 6) keeps A x + B y + C z + D >= 0 (world mm), only the slab\n"
     "         up to T mm from the plane when T > 0; --crop keeps voxels X0..X1, Y0..Y1, Z0..Z1 (indices from 0,\n"
     "         inclusive); cut faces are shaded as surfaces (caps) unless --no-caps (docs/cutaways.md)\n"
@@ -392,6 +398,7 @@ typedef struct render_args {
     vxl_cli_labels labels; /* issue 20 label maps */
     vxl_cli_overlays overlays; /* issue 20 overlays */
     vxl_cli_stream stream; /* issue 21 streaming */
+    vxl_cli_environment environment; /* the World's light */
 } render_args;
 
 static int parse_render(int argc, char **argv, render_args *a)
@@ -496,6 +503,8 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (r < 0) return die("%s", err); /* issue 21 */
         } else if ((r = vxl_cli_colour_option(argc, argv, &i, p, &a->lo, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err); /* colour volumes */
+        } else if ((r = vxl_cli_environment_option(argc, argv, &i, &a->environment, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err);
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);
@@ -518,6 +527,7 @@ static int cmd_render(int argc, char **argv)
     vxl_cli_labels_init(&a.labels);
     vxl_cli_overlays_init(&a.overlays);
     vxl_cli_stream_init(&a.stream);
+    vxl_cli_environment_init(&a.environment);
     if (parse_render(argc, argv, &a)) return 1;
     uint32_t w = a.p.width ? a.p.width : 512, h = a.p.height ? a.p.height : 512;
     vxl_volume *v = NULL;
@@ -542,6 +552,7 @@ static int cmd_render(int argc, char **argv)
     if (vxl_cli_cut_apply(&a.cut, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_labels_apply(&a.labels, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; } /* issue 20 */
     if (vxl_cli_overlays_apply(&a.overlays, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
+    if (vxl_cli_environment_apply(&a.environment, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     vxl_volume_destroy(v);
     v = NULL;
     rgba = malloc((size_t)w * h * 4 * sizeof *rgba);
@@ -578,6 +589,7 @@ done:
     free(depth);
     vxl_cli_modes_free(&a.modes);
     vxl_cli_labels_free(&a.labels);
+    vxl_cli_environment_free(&a.environment);
     vxl_renderer_destroy(r);
     vxl_volume_destroy(v);
     return status;

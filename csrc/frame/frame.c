@@ -140,6 +140,7 @@ static int resolve_lights(vxl_frame *f, const vxl_render_params *p, vxl_err *e)
     }
     if (p->light_count > VXL_MAX_LIGHTS)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "light_count %u exceeds %d", p->light_count, VXL_MAX_LIGHTS);
+    if (p->light_count == 0 && f->env.on) return VXL_OK; /* the World lights it alone: no lamps */
     if (p->light_count == 0) { /* headlight: from the eye, in view space */
         f->light_count = 1;
         f->light_pos[0][2] = 1;
@@ -318,6 +319,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     if (rc) return rc;
     f->scene_depth = p->scene_depth;
     rc = resolve_matrices(f, p, g, e);
+    if (!rc) rc = vxl_frame_resolve_environment(f, p, e);
     if (!rc) rc = resolve_lights(f, p, e);
     if (!rc) rc = vxl_frame_resolve_lighting(f, p, e);
     if (!rc) rc = vxl_frame_resolve_scene_shadows(f, p, e); /* issue 18 */

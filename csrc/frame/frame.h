@@ -103,6 +103,14 @@ typedef struct vxl_frame {
         uint32_t count, stride;         /* entries and their stride in bytes */
         uint64_t key;                   /* hash of the table (ids, colours, visibility) */
     } labels;
+    /* The World's light (frame_environment.c): on is 0 without params.environment. */
+    struct {
+        int on;
+        const float *rgb;           /* the caller's, checked: width*height*3 finite, >= 0 */
+        uint32_t width, height;
+        float strength, rotation_deg; /* rotation in (-360, 360) */
+        uint64_t key;               /* the map, its size, strength and rotation; never 0 when on */
+    } env;
     /* issue 20 overlays (frame_overlays.c): count is 0 without params.overlays. */
     struct {
         uint32_t count;
@@ -153,6 +161,11 @@ void vxl_frame_free(vxl_frame *f);
  * ambient_occlusion, occlusion_strength, anisotropy, illumination_size) into
  * f; needs f->view and the lights resolved. Part of vxl_frame_resolve. */
 int vxl_frame_resolve_lighting(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+
+/* Validates p->environment (size, pixels, strength, rotation) into
+ * f->env. Before the lights: an environment with light_count 0 means no
+ * lamps, not the headlight. Part of vxl_frame_resolve (frame_environment.c). */
+int vxl_frame_resolve_environment(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
 
 /* Whether mode (VXL_MODE_*) shades: DVR and ISO do, the projections have no surface. */
 static inline int vxl_mode_shades(uint32_t mode) { return mode == VXL_MODE_DVR || mode == VXL_MODE_ISO; }

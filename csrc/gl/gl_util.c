@@ -95,6 +95,8 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         if ((flags >> 8) & 3) /* issue 17: shadowed / scatter; PHONG compiles as before */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define SHADING_MODEL %u\n",
                      (flags >> 8) & 3);
+        if (flags & VXL_FLAG_ENVIRONMENT) /* the World's light replaces the ambient term */
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define ENVIRONMENT 1\n");
         if (kind == VXL_PROG_RAYCAST) /* issue 19: the mode, the MatCap and the cutaways */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define MODE %u\n%s%s%s",
                      (flags >> VXL_FLAG_MODE_SHIFT) & 7, (flags & VXL_FLAG_MATCAP) ? "#define MATCAP 1\n" : "",
@@ -145,8 +147,9 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         snprintf(defines, sizeof defines, "#define CACHE_FORMAT %s\n", cache_formats[flags & 3]);
         rc = compile(g, GL_COMPUTE_SHADER, "compute/decode_bricks.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
-    case VXL_PROG_ILLUMINATION: /* illumination.c: flags & 3 the pass, bits 2-3 the gradient-opacity mode, plus the storage's sample flags; the extinction's cut (CUT_CONVEX) and label mode (LABELS bits) */
-        snprintf(defines, sizeof defines, "%s#define PASS %u\n#define GOPACITY %u\n%s", paged, flags & 3, (flags >> 2) & 3,
+    case VXL_PROG_ILLUMINATION: /* illumination.c: flags & 3 the pass (ENVIRONMENT: pass 4), bits 2-3 the gradient-opacity mode, plus the storage's sample flags; the extinction's cut (CUT_CONVEX) and label mode (LABELS bits) */
+        snprintf(defines, sizeof defines, "%s#define PASS %u\n#define GOPACITY %u\n#define ENV_CELLS %u\n%s", paged,
+                 (flags & VXL_FLAG_ENVIRONMENT) ? 4u : flags & 3, (flags >> 2) & 3, VXL_ENV_CELLS,
                  (flags & VXL_FLAG_CUT_CONVEX) ? "#define CUT_KEEPS 1\n" : "");
         if ((flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* the extinction leaves hidden labels out: label mode + 1 */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABEL_SHADOWS %u\n%s",

@@ -61,6 +61,13 @@
  * own colour texture (DATA_COLOUR), opacity still from the transfer function. */
 #define VXL_FLAG_DATA_COLOUR (1u << 22)
 
+/* The World's light: the ray caster's shading adds it (ENVIRONMENT), and
+ * the illumination program with it is the environment pass (PASS 4). */
+#define VXL_FLAG_ENVIRONMENT (1u << 22)
+/* Direction cells the World's map is reduced to (light/environment_map.h);
+ * the environment pass's ENV_CELLS. */
+#define VXL_ENV_CELLS 32
+
 typedef struct vxl_program_entry {
     uint64_t key; /* kind | filter << 5 | flags << 12 (gl_util.c): every flag bit fits */
     GLuint program;

@@ -649,6 +649,51 @@ typedef struct vxl_overlay_style {
     uint32_t reserved;          /* must be 0 */
 } vxl_overlay_style;
 
+/* The World's light, params.environment: a linear-RGB latitude-longitude
+ * map (equirectangular, as Blender's Environment Texture), times strength,
+ * turned about world +Z by rotation_deg, lighting every sample from every
+ * direction with the volume's own occlusion of it (docs/lighting.md).
+ * Pixel (i, j), row j = 0 at the bottom (the nadir), is the radiance
+ * arriving from map direction m with azimuth atan2(m.y, m.x) = pi (1 - 2 u)
+ * and elevation asin(m.z) = pi (v - 1/2), u = (i + 0.5) / width,
+ * v = (j + 0.5) / height: the centre column looks along +X, a quarter to
+ * its left along +Y (Cycles' equirectangular mapping). World direction d
+ * sees map direction m = Rz(rotation_deg) d, as a Mapping node (type Point)
+ * with that Z rotation in front of the texture: rotating by +90 degrees
+ * brings what the map shows along +X to world -Y. A 1x1 map is a uniform
+ * colour (Blender's Background colour).
+ *   SHADOWED, SCATTER  the ambient term is replaced by diffuse * colour *
+ *             E(x), E(x) the environment's radiance averaged over the
+ *             sphere with each direction's transmittance through the
+ *             volume to the box (isotropic: neither the normal nor the
+ *             anisotropy weighs it); E = the map's mean radiance where
+ *             nothing occludes.
+ *   PHONG     the ambient term is replaced by diffuse * colour * the map's
+ *             mean radiance (no occlusion).
+ * With an environment and light_count 0 there are no lamps: the headlight
+ * stands in only when nothing else lights the volume. */
+typedef struct vxl_environment {
+    uint32_t struct_size;
+    uint32_t width, height;     /* >= 1 each; width * height <= 2^26 */
+    uint32_t reserved;          /* must be 0 */
+    const float *rgb;           /* width*height*3 floats, linear radiance, finite and >= 0 */
+    float strength;             /* multiplies rgb; >= 0 (0 = dark: no light from the World) */
+    float rotation_deg;         /* about world +Z, see above; finite */
+    uint64_t key;               /* nonzero: the caller's name for these pixels (the same key is not
+                                   reduced again); 0: the library hashes them */
+} vxl_environment;
+
+/* Reads a World map file for vxl_environment: Radiance RGBE (.hdr, .pic;
+ * flat or run-length-encoded scanlines, "-Y H +X W" or "+Y H +X W") into
+ * linear RGB floats, row 0 at the bottom. *width and *height receive its
+ * size; rgb NULL (max_pixels ignored) reads the header only, so a caller
+ * can size the buffer: rgb then holds width*height*3 floats, and a map of
+ * more than max_pixels pixels is VXL_ERR_LIMIT. A corrupt or truncated file
+ * is VXL_ERR_FORMAT saying what is wrong; OpenEXR (.exr) is VXL_ERR_FORMAT
+ * saying how to convert it. */
+VXL_API int vxl_environment_image_load(const char *path, float *rgb, uint64_t max_pixels, uint32_t *width,
+                                       uint32_t *height);
+
 /* 2 words of room: the struct then ends on its 8-byte alignment, with no padding. */
 #define VXL_RENDER_PARAMS_RESERVED 2
 
@@ -755,6 +800,10 @@ typedef struct vxl_render_params {
      * Opacity always comes from the transfer function of the scalar. */
     uint32_t color_source;
     uint32_t reserved2;         /* must be 0 */
+    /* Appended: the World's light (vxl_environment); read only when
+     * struct_size covers it. NULL: no environment (the lamps and the
+     * ambient term only, as before). */
+    const vxl_environment *environment;
 } vxl_render_params;
 
 #define VXL_COLOR_SOURCE_AUTO 0

@@ -9,6 +9,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "environment_map.h"
 #include "hash.h"
 #include "holdings.h"
 #include "mat4.h"
@@ -21,12 +22,23 @@
 #define AUTO_SIZE 64u
 #define MIN_SIZE 8u
 
-enum { PASS_EXTINCTION, PASS_SWEEP, PASS_OCCLUSION, PASS_SCENE_SHADOWS };
+enum { PASS_EXTINCTION, PASS_SWEEP, PASS_OCCLUSION, PASS_SCENE_SHADOWS, PASS_ENVIRONMENT = VXL_FLAG_ENVIRONMENT };
+/* The environment's irradiance is a mean over the whole sphere, smoother
+ * than any lamp's shadow: it is kept on a grid half as fine as the lamps'
+ * per axis, an eighth of the cells and of the pass's cost. Its RGBA16F
+ * texture then weighs at most as much as one R16F block. */
+#define ENV_BLOCKS 1u
+
+static void env_grid(const uint32_t cells[3], uint32_t out[3])
+{
+    for (int a = 0; a < 3; a++) out[a] = (cells[a] + 1) / 2;
+}
 
 void vxl_illumination_release(vxl_illumination_state *s)
 {
     if (s->extinction_tex) s->gpu->gl.DeleteTextures(1, &s->extinction_tex);
     if (s->tex) s->gpu->gl.DeleteTextures(1, &s->tex);
+    if (s->env_tex) s->gpu->gl.DeleteTextures(1, &s->env_tex);
     if (s->scene_depth_tex) s->gpu->gl.DeleteTextures(1, &s->scene_depth_tex);
     if (s->transmittance_tex) s->gpu->gl.DeleteTextures(1, &s->transmittance_tex);
     vxl_shadow_maps_release(&s->shadows);
@@ -123,9 +135,11 @@ static int keeps_extinction(vxl_illumination_state *s, uint64_t key, const uint3
                            extinction_bytes(s->extinction_cells) + light_bytes(cells, blocks));
 }
 
-/* The extinction texture on ext_cells and the lights' on cells x blocks;
- * a texture already of its size is kept with what it holds. */
-static int allocate(vxl_illumination_state *s, const uint32_t ext_cells[3], const uint32_t cells[3], uint32_t blocks)
+/* The extinction texture on ext_cells, the lights' on cells x blocks and
+ * (env) the environment's on cells; a texture already of its size is kept
+ * with what it holds. */
+static int allocate(vxl_illumination_state *s, const uint32_t ext_cells[3], const uint32_t cells[3], uint32_t blocks,
+                    int env)
 {
     vxl_gl *gl = &s->gpu->gl;
     if (!s->extinction_tex || memcmp(s->extinction_cells, ext_cells, sizeof s->extinction_cells)) {
@@ -146,7 +160,21 @@ static int allocate(vxl_illumination_state *s, const uint32_t ext_cells[3], cons
         memset(s->light_key, 0, sizeof s->light_key);
         s->occlusion_key = 0;
     }
-    s->bytes = extinction_bytes(s->extinction_cells) + light_bytes(s->cells, s->blocks);
+    uint32_t ec[3];
+    env_grid(cells, ec);
+    if (s->env_tex && (!env || memcmp(s->env_cells, ec, sizeof s->env_cells))) {
+        gl->DeleteTextures(1, &s->env_tex);
+        s->env_tex = 0;
+    }
+    if (env && !s->env_tex) {
+        s->env_tex = vxl_texture_new(s->gpu, GL_TEXTURE_3D, GL_LINEAR);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16F, (GLsizei)ec[0], (GLsizei)ec[1], (GLsizei)ec[2], 0, GL_RGBA, GL_FLOAT,
+                       NULL);
+        memcpy(s->env_cells, ec, sizeof s->env_cells);
+        s->env_key = 0;
+    }
+    s->bytes = extinction_bytes(s->extinction_cells) + light_bytes(s->cells, s->blocks) +
+               (s->env_tex ? (uint64_t)s->env_cells[0] * s->env_cells[1] * s->env_cells[2] * 8 : 0);
     int rc = vxl_gl_check(s->gpu, "allocating the illumination volumes");
     if (rc) {
         uint32_t builds = s->builds;
@@ -380,16 +408,73 @@ static int apply_scene_shadows(vxl_illumination_state *s, const vxl_frame *f, in
     return vxl_gl_check(s->gpu, "cutting a light's illumination volume by the scene's shadows");
 }
 
+/* The environment's irradiance E(x) per cell: each direction cell's
+ * radiance times its transmittance to the box, weighed by its solid angle
+ * (1 / cells of the sphere: a uniform map that nothing occludes gives E =
+ * its radiance). The directions go into voxel space as the lights' do. */
+static void environment_voxel_dirs(const vxl_frame *f, float dirs[VXL_ENV_CELLS][3])
+{
+    double inv[16];
+    if (!vxl_mat4_invert(inv, f->model)) vxl_mat4_identity(inv); /* frame.c refuses a singular model */
+    for (int k = 0; k < VXL_ENV_CELLS; k++) {
+        double w[4] = {0, 0, 0, 0}, v[4];
+        vxl_environment_cell_direction(k, w);
+        vxl_mat4_transform(inv, w, v);
+        double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (!(n > 0)) n = 1;
+        for (int a = 0; a < 3; a++) dirs[k][a] = (float)(v[a] / n);
+    }
+}
+
+static int build_environment(vxl_illumination_state *s, const float dirs[VXL_ENV_CELLS][3])
+{
+    vxl_gl *gl = &s->gpu->gl;
+    GLuint prog;
+    int rc = pass_program(s, PASS_ENVIRONMENT, 0, s->env_cells, &prog);
+    if (rc) return rc;
+    float radiance[VXL_ENV_CELLS][3], start = 0;
+    for (int k = 0; k < VXL_ENV_CELLS; k++)
+        for (int c = 0; c < 3; c++) radiance[k][c] = s->env_radiance[k][c] / VXL_ENV_CELLS;
+    /* half a cell out, as the lights' reads move half a cell towards the
+     * light: a surface half fills its own cell and would occlude itself */
+    for (int a = 0; a < 3; a++) {
+        float cell = (float)s->storage->geom.dims[a] / (float)s->env_cells[a];
+        start = cell > start ? cell : start;
+    }
+    gl->Uniform3fv(gl->GetUniformLocation(prog, "u_env_dir"), VXL_ENV_CELLS, &dirs[0][0]);
+    gl->Uniform3fv(gl->GetUniformLocation(prog, "u_env_radiance"), VXL_ENV_CELLS, &radiance[0][0]);
+    vxl_uniform_f(s->gpu, prog, "u_env_start", 0.5f * start);
+    gl->BindImageTexture(VXL_IMAGE_OUT, s->env_tex, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+    dispatch_cells(s, s->env_cells);
+    return vxl_gl_check(s->gpu, "building the environment's irradiance volume");
+}
+
+/* The map's reduction, when its key changed: cheap next to a frame for the
+ * add-on's 128 x 64 maps, a few hundred milliseconds for a large HDRI. */
+static void reduce_environment(vxl_illumination_state *s, const vxl_frame *f)
+{
+    if (s->env_map_key == f->env.key) return;
+    vxl_environment_reduce(f->env.rgb, f->env.width, f->env.height, f->env.strength, f->env.rotation_deg,
+                           s->env_radiance);
+    double mean[3] = {0, 0, 0};
+    for (int k = 0; k < VXL_ENV_CELLS; k++)
+        for (int c = 0; c < 3; c++) mean[c] += s->env_radiance[k][c];
+    for (int c = 0; c < 3; c++) s->env_mean[c] = (float)(mean[c] / VXL_ENV_CELLS);
+    s->env_map_key = f->env.key;
+    s->env_key = 0; /* the irradiance follows the cells' radiance */
+}
+
 static int uses_illumination(const vxl_frame *f) { return f->shading && f->shading_model != VXL_SHADING_PHONG; }
 
 int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
 {
     s->rebuilt = 0;
     s->in_use = 0;
+    if (f->shading && f->env.on) reduce_environment(s, f); /* Phong reads its mean too */
     if (!uses_illumination(f)) return VXL_OK; /* kept: a Phong frame between two shadowed ones costs nothing */
-    const uint32_t blocks = (uint32_t)f->light_count + 1;
+    const uint32_t blocks = (uint32_t)f->light_count + 1, budget_blocks = blocks + (f->env.on ? ENV_BLOCKS : 0);
     uint32_t size = 0, cells[3] = {0, 0, 0};
-    int rc = choose_grid(s, f, blocks, &size, cells);
+    int rc = choose_grid(s, f, budget_blocks, &size, cells);
     if (rc) return rc;
     uint64_t key = vxl_classification_key(f);
     key = vxl_fnv(key, &s->storage->pool_generation, sizeof s->storage->pool_generation);
@@ -408,8 +493,8 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
         key = vxl_fnv(key, &f->labels.key, sizeof f->labels.key);
         key = vxl_fnv(key, &f->labels.mode, sizeof f->labels.mode);
     }
-    const int keep = keeps_extinction(s, key, cells, blocks);
-    if ((rc = allocate(s, keep ? s->extinction_cells : cells, cells, blocks))) return rc;
+    const int keep = keeps_extinction(s, key, cells, budget_blocks);
+    if ((rc = allocate(s, keep ? s->extinction_cells : cells, cells, blocks, f->env.on))) return rc;
     s->size = size;
     if (s->extinction_key != key) {
         s->extinction_key = 0;
@@ -446,6 +531,21 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
             s->builds++;
         }
     }
+    if (f->env.on) {
+        float dirs[VXL_ENV_CELLS][3];
+        environment_voxel_dirs(f, dirs);
+        uint64_t k = vxl_fnv(key, &f->env.key, sizeof f->env.key);
+        k = vxl_fnv(k, dirs, sizeof dirs);
+        if (s->env_key != k) {
+            s->env_key = 0;
+            if ((rc = build_environment(s, dirs))) return rc;
+            s->env_key = k;
+            s->rebuilt++;
+            s->builds++;
+        }
+        s->gpu->gl.ActiveTexture(GL_TEXTURE0 + VXL_ENVIRONMENT_UNIT);
+        s->gpu->gl.BindTexture(GL_TEXTURE_3D, s->env_tex);
+    }
     s->gpu->gl.ActiveTexture(GL_TEXTURE0 + VXL_ILLUMINATION_UNIT);
     s->gpu->gl.BindTexture(GL_TEXTURE_3D, s->tex);
     s->gpu->gl.UseProgram(0);
@@ -456,8 +556,12 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
 void vxl_illumination_bind(vxl_illumination_state *s, GLuint prog, const vxl_frame *f)
 {
     vxl_gl *gl = &s->gpu->gl;
-    if (!s->in_use) return;
 #define LOC(name) gl->GetUniformLocation(prog, name)
+    if (f->shading && f->env.on) { /* Phong's term; the others' volume */
+        gl->Uniform3fv(LOC("u_env_mean"), 1, s->env_mean);
+        gl->Uniform1i(LOC("u_environment"), VXL_ENVIRONMENT_UNIT);
+    }
+    if (!s->in_use) return;
     float lv[VXL_MAX_LIGHTS][4] = {{0}}, cells[3], bias = 0;
     for (int i = 0; i < f->light_count; i++) {
         float radius;
@@ -479,6 +583,14 @@ void vxl_illumination_bind(vxl_illumination_state *s, GLuint prog, const vxl_fra
     gl->Uniform1i(LOC("u_illum_ao_block"), f->ao_radius > 0 ? f->light_count : -1);
     gl->Uniform4fv(LOC("u_light_voxel"), VXL_MAX_LIGHTS, &lv[0][0]);
     gl->Uniform1f(LOC("u_illum_bias"), bias);
+    if (f->env.on && s->env_tex) { /* half the environment's own (coarser) cell */
+        float env_bias = 0;
+        for (int a = 0; a < 3; a++) {
+            float cell = (float)s->storage->geom.dims[a] / (float)s->env_cells[a];
+            env_bias = cell > env_bias ? cell : env_bias;
+        }
+        gl->Uniform1f(LOC("u_env_bias"), 0.5f * env_bias);
+    }
     gl->Uniform3fv(LOC("u_spot_dir"), VXL_MAX_LIGHTS, &f->light_spot_dir[0][0]);
     float shape[VXL_MAX_LIGHTS][4] = {{0}};
     for (int i = 0; i < VXL_MAX_LIGHTS; i++) {

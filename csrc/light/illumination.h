@@ -49,9 +49,19 @@ typedef struct vxl_illumination_state {
     uint32_t size;              /* cells along the longest side */
     uint64_t bytes;
     uint64_t extinction_key, occlusion_key;
+    /* The World's light (environment_map.h): its map reduced to direction
+     * cells (keyed by the frame's env.key), and the irradiance volume E(x)
+     * on env_cells (half the lights' grid per axis), RGBA16F, keyed by the
+     * extinction, the grid, the map and its voxel-space directions. Freed by
+     * a frame without one. */
+    GLuint env_tex;
+    uint32_t env_cells[3];
+    uint64_t env_key, env_map_key;
+    float env_radiance[VXL_ENV_CELLS][3];
+    float env_mean[3];          /* the cells' mean: the map's mean radiance (Phong's term) */
     uint64_t light_key[VXL_MAX_LIGHTS];
     int in_use;                 /* the last prepared frame reads it */
-    uint32_t rebuilt;           /* volumes the last prepare rebuilt (lights + occlusion) */
+    uint32_t rebuilt;           /* volumes the last prepare rebuilt (lights + occlusion + environment) */
     uint32_t builds;            /* every volume built since the renderer opened (tests) */
     /* Issue 18: the scene's occluders seen from each light; a light's
      * volume is multiplied by their visibility and keyed by its maps. */
@@ -73,7 +83,8 @@ typedef struct vxl_illumination_state {
 void vxl_illumination_init(vxl_illumination_state *s, vxl_gpu *g, vxl_storage_state *st);
 
 /* Builds what frame f's shading model reads (nothing for Phong or unshaded
- * frames) and binds it on VXL_ILLUMINATION_UNIT. With occluders in f
+ * frames but the environment's reduction) and binds it on
+ * VXL_ILLUMINATION_UNIT (and the environment's on VXL_ENVIRONMENT_UNIT). With occluders in f
  * (issue 18), each light's volume is cut by its shadow maps. Needs the storage prepared
  * for f and the transfer function on VXL_TF_UNIT; uses programs of its own,
  * so call it before the ray caster's program is bound. */

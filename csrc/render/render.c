@@ -172,6 +172,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     int rc = vxl_colour_flags(&r->colour, f, &colour_flags); /* a colour volume's own colour */
     if (rc) return rc;
     flags |= colour_flags;
+    if (f->shading && f->env.on) flags |= VXL_FLAG_ENVIRONMENT; /* the World's light */
     uint32_t filter = vxl_frame_filter(f);
     rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
     if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);

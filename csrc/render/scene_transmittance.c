@@ -35,6 +35,7 @@ static int job_transmittance(void *arg)
     q.shading_off = 0;
     q.ambient_occlusion = 0; /* not read here; a cached occlusion volume stays valid */
     q.matcap = NULL;         /* nor is the MatCap, whose checks follow the shading just forced on */
+    q.environment = NULL;    /* nor the World's light: light_count 0 stays the headlight here */
     vxl_frame f;
     rc = vxl_frame_resolve(&f, &q, &r->storage.geom, e);
     if (rc) return rc;

@@ -33,7 +33,7 @@ from . import (native_abi, native_cutaway, native_library, native_private_copy, 
 from .native_abi import (ABI_VERSION, BACKENDS, CLASSIFY_MODES, ENUM_FALLBACKS, FILTERS,  # noqa: F401
                          GRADIENT_OPACITY_MODES, MAX_LIGHTS, PRESETS, RENDER_PARAMS_RESERVED,
                          STORAGES, MAX_CLIP_PLANES, MAX_CUTTERS, MODES, INTERPOLATIONS, LABEL_MODES, LABEL_BOUNDARIES, MAX_LABEL_ID, BLENDS, STREAMING_MODES, MAX_OVERLAYS, PROGRESS_CALLBACK, OverlayStyle, ClipPlane,
-                         Cutaway, Cutter, LabelEntry, LabelStyle, Matcap, SceneShadows, SliceParams, GridParams, GridInfo, DicomSeries, Light, LightShape, LibraryUnavailable, LoadOptions, PhantomDesc,
+                         Cutaway, Cutter, LabelEntry, LabelStyle, Matcap, Environment, SceneShadows, SliceParams, GridParams, GridInfo, DicomSeries, Light, LightShape, LibraryUnavailable, LoadOptions, PhantomDesc,
                          RendererInfo, RendererOptions, RenderParams, RenderStats, SHADING_MODELS,
                          VolumeDesc, VolumeInfo, VoxlightError, c_double4x4, c_float4x4, matrix_from_cm)
 from .native_library import (LIBRARY_NAME, Library, candidate_paths, filter_names,  # noqa: F401

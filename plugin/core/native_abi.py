@@ -237,6 +237,18 @@ class Matcap(ctypes.Structure):
                 ("key", ctypes.c_uint64)]
 
 
+class Environment(ctypes.Structure):
+    """vxl_environment: the World's light (a lat-long map, strength, Z rotation)."""
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("width", ctypes.c_uint32),
+                ("height", ctypes.c_uint32),
+                ("reserved", ctypes.c_uint32),
+                ("rgb", ctypes.POINTER(ctypes.c_float)),
+                ("strength", ctypes.c_float),
+                ("rotation_deg", ctypes.c_float),
+                ("key", ctypes.c_uint64)]
+
+
 class SceneShadows(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("occluder_vertex_count", ctypes.c_uint32),
@@ -348,7 +360,8 @@ class RenderParams(ctypes.Structure):
                 ("minip_floor_on", ctypes.c_uint32),     # appended: MinIP's floor
                 ("minip_floor", ctypes.c_float),
                 ("color_source", ctypes.c_uint32),       # appended: colour volumes
-                ("reserved2", ctypes.c_uint32)]
+                ("reserved2", ctypes.c_uint32),
+                ("environment", ctypes.POINTER(Environment))]  # appended: the World's light
 
 
 class RenderStats(ctypes.Structure):

@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from .native_abi import (LABEL_BOUNDARIES, LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
+from .native_abi import (LABEL_BOUNDARIES, Environment, LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
                          RendererInfo, RendererOptions, SceneShadows, VoxlightError, matrix_from_cm, _fptr,
                          _matrix_cm, _sized)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct
@@ -46,7 +46,8 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 gradient_exp=0.0, iso_value=0.0, iso_thickness=0.0, preint_size=0,
                 shading_model=0, ambient_occlusion=0.0, occlusion_strength=0.0, anisotropy=0.0,
                 illumination_size=0, mode="dvr", matcap=None, matcap_key=0, cutaway=None,
-                scene_shadows=None, labels=None, overlays=None, minip_floor=None, lib=None):
+                scene_shadows=None, labels=None, overlays=None, minip_floor=None, environment=None,
+                lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -68,7 +69,10 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     shadow the volume; key 0 lets the library hash the arrays, a nonzero key
     names this version of them (the same key: no shadow map is rebuilt).
     Issue 20: `overlays` is a list of dicts or OverlayStyles
-    (native_overlays.py), each naming a slot filled by Renderer.set_overlay."""
+    (native_overlays.py), each naming a slot filled by Renderer.set_overlay.
+    `environment` is the World's light, (rgb (h, w, 3) linear, row 0 at the
+    bottom; strength; rotation_deg about world +Z) as world_light.Environment
+    gives it, or None."""
     lib = lib or load_library()
     p = _sized(RenderParams)
     p.width, p.height = int(width), int(height)
@@ -160,7 +164,26 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
         p.overlays = ctypes.cast(p._overlays, ctypes.POINTER(OverlayStyle))
     if scene_shadows is not None:
         _set_scene_shadows(p, *scene_shadows)
+    if environment is not None:
+        _set_environment(p, *environment)
     return p
+
+
+def _set_environment(p, rgb, strength, rotation_deg):
+    """params.environment from an (h, w, 3) map; the map and the struct live
+    as long as p, and _keep holds them for the digest."""
+    m = np.ascontiguousarray(rgb, dtype=np.float32)
+    if m.ndim != 3 or m.shape[2] != 3:
+        raise ValueError("environment map must be (height, width, 3), not %r" % (m.shape,))
+    e = _sized(Environment)
+    e.height, e.width = m.shape[:2]
+    e.rgb = _fptr(m)
+    e.strength = float(strength)
+    e.rotation_deg = float(rotation_deg)
+    p._environment = e
+    p._env_map = m
+    p._keep.extend((m, np.array([e.strength, e.rotation_deg], np.float32)))
+    p.environment = ctypes.pointer(e)
 
 
 def _set_scene_shadows(p, vertices, triangles, key=0, shadow_map_size=0):

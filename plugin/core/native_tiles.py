@@ -40,6 +40,7 @@ def params_digest(params, *extra):
     labels = _label_style_bytes(c.labels.contents) if c.labels else b""
     c.labels = None
     c.overlays = None  # issue 20: their contents are in _keep
+    c.environment = None  # the World's map and numbers are in _keep
     h = hashlib.blake2b(bytes(c), digest_size=16)
     h.update(labels)
     for a in getattr(params, "_keep", ()):
@@ -86,7 +87,8 @@ def tile_params(params, x0, y0, x1, y1):
     if shapes is not None:  # the same light shapes
         t._keep.append(shapes)
         t._shapes = shapes
-    for name in ("_cutaway", "_matcap", "_scene_shadows", "_occluders", "_overlays", "_overlay_tables"):  # the copy points at the same structs (holding their arrays)
+    for name in ("_cutaway", "_matcap", "_scene_shadows", "_occluders", "_overlays", "_overlay_tables",
+                 "_environment", "_env_map"):  # the copy points at the same structs (holding their arrays)
         if hasattr(params, name):
             setattr(t, name, getattr(params, name))
     t.width, t.height = x1 - x0, y1 - y0

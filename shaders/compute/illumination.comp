@@ -22,7 +22,11 @@
 //     visibility of each cell's centre through the scene's occluders
 //     (lib/shadow_maps.glsl), in place. The product is the cell's direct
 //     transmittance: the volume's and the meshes' attenuate the same path.
-// The results go to u_dst at z offset u_block * u_cells.z: the lights and the
+//  4  environment: per cell, the World's irradiance E = sum over the
+//     ENV_CELLS direction cells of radiance_k / ENV_CELLS times the
+//     transmittance along direction k to the box (from half a cell out, so a
+//     surface does not occlude itself), RGB into its own texture.
+// Passes 1-3 write u_dst at z offset u_block * u_cells.z: the lights and the
 // occlusion share one texture (lib/illumination.glsl reads it).
 #include "lib/common.glsl"
 #if PASS == 0
@@ -116,7 +120,11 @@ void main()
 #elif PASS == 3
 layout(r16f, binding = VXL_IMAGE_OUT) uniform image3D u_dst; // read and written: each cell its own texel
 #else
+#if PASS == 4
+layout(rgba16f, binding = VXL_IMAGE_OUT) writeonly uniform image3D u_dst;
+#else
 layout(r16f, binding = VXL_IMAGE_OUT) writeonly uniform image3D u_dst;
+#endif
 uniform sampler3D u_extinction; // pass 0's result, trilinear
 uniform float u_ext_step;       // voxels: its smallest cell, the step its integrals take
 
@@ -246,5 +254,34 @@ void main()
     float v = shadow_visibility((u_model * vec4(cell_centre(c), 1.0)).xyz);
     ivec3 t = c + ivec3(0, 0, u_block * u_cells.z);
     if (v < 1.0) imageStore(u_dst, t, imageLoad(u_dst, t) * v);
+}
+#endif
+
+#if PASS == 4
+uniform vec3 u_env_dir[ENV_CELLS];      // voxel space, unit: towards each cell of the sky
+uniform vec3 u_env_radiance[ENV_CELLS]; // each cell's radiance / ENV_CELLS (equal solid angles)
+uniform float u_env_start;              // voxels: half a cell, where each path starts
+
+void main()
+{
+    ivec3 c = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(c, u_cells))) return;
+    vec3 p = cell_centre(c);
+    vec3 e = vec3(0.0);
+    for (int k = 0; k < ENV_CELLS; k++) {
+        vec3 d = u_env_dir[k];
+        float len = box_exit(p, d) - u_env_start; // nothing occludes beyond the box
+        float depth = 0.0;
+        if (len > 0.0) {
+            // midpoint rule at about two extinction cells a sample: 32 such
+            // paths per cell are the pass's cost, and the irradiance is a
+            // mean over them, smoother than any one light's shadow
+            int n = int(clamp(ceil(len / (2.0 * u_ext_step)), 1.0, 16.0));
+            float h = len / float(n);
+            for (int i = 0; i < n; i++) depth += h * extinction(p + d * (u_env_start + (float(i) + 0.5) * h));
+        }
+        e += u_env_radiance[k] * exp(-depth);
+    }
+    imageStore(u_dst, c, vec4(min(e, vec3(65504.0)), 1.0)); // half float's largest, never inf
 }
 #endif

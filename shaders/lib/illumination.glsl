@@ -28,3 +28,21 @@ float light_transmittance(int i, vec3 p)
 }
 
 float ambient_occlusion(vec3 p) { return u_illum_ao_block < 0 ? 1.0 : illumination_at(u_illum_ao_block, p); }
+
+#ifdef ENVIRONMENT
+// The World's irradiance at voxel position p (compute/illumination.comp's
+// pass 4): its own texture on cells twice the lights' size, one trilinear
+// fetch.
+uniform sampler3D u_environment;
+uniform float u_env_bias; // voxels: half its cell
+// g is the voxel-space gradient: the read moves half a cell against it
+// (towards lower values, out of the usual bright-is-dense material), as a
+// light's read moves towards the light, so a surface's own cell, half
+// inside it, does not darken it.
+vec3 environment_light(vec3 p, vec3 g)
+{
+    float len = length(g);
+    vec3 q = len > 1e-20 ? p - g * (u_env_bias / len) : p;
+    return textureLod(u_environment, (q + 0.5) / u_dims, 0.0).rgb;
+}
+#endif

@@ -12,6 +12,11 @@ vec4 g_label_material = vec4(-1.0);
 uniform int u_light_count;
 uniform vec4 u_light_pos[8];  // view space; w = 0 direction towards light (unit, frame.c), 1 point
 uniform vec3 u_light_color[8];// colour * intensity
+#ifdef ENVIRONMENT
+// The World's light (voxlight.h's vxl_environment) in place of the ambient
+// term: its mean radiance here (Phong), its irradiance volume in shade_lit.
+uniform vec3 u_env_mean;
+#endif
 
 // Most frames have one directional light (frame.c's headlight when none is
 // given); raycast.frag's march has a copy of the sample loop for that case
@@ -57,7 +62,11 @@ vec3 shade(vec3 rgb, vec3 g, vec3 pos, RayLighting r, bool one_directional)
     if (!(len > 1e-20)) return rgb;
     n /= len;
     if (dot(n, r.v) < 0.0) n = -n; // two-sided: a boundary faces the viewer
+#ifdef ENVIRONMENT
+    vec3 acc = SHADE_MATERIAL.y * rgb * u_env_mean;
+#else
     vec3 acc = SHADE_MATERIAL.x * rgb;
+#endif
     if (one_directional) {
         acc += light_term(0, rgb, n, r.l0, r.h0);
     } else {
@@ -141,7 +150,13 @@ vec3 shade_lit(vec3 rgb, vec3 g, vec3 pos, vec3 p, RayLighting r, bool one_direc
         n /= len;
         if (dot(n, r.v) < 0.0) n = -n;
     }
+#ifdef ENVIRONMENT
+    // isotropic: the irradiance is a mean over the sphere, the phase
+    // function's 1 / 4 pi and the cells' solid angles folded in
+    vec3 acc = SHADE_MATERIAL.y * rgb * environment_light(p, g);
+#else
     vec3 acc = SHADE_MATERIAL.x * rgb * (1.0 - u_ao_strength * (1.0 - ambient_occlusion(p)));
+#endif
     if (one_directional) {
         acc += light_transmittance(0, p) * lit_term(0, rgb, n, has_normal, w, r.l0, r.h0, r.v);
     } else {

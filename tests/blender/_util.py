@@ -193,6 +193,9 @@ def reset_scene():
     for prop in scene.voxlight.bl_rna.properties:
         if prop.identifier != "rna_type":
             scene.voxlight.property_unset(prop.identifier)
+    # The suite's scenes are lit by their lamps and the headlight, with the
+    # material's ambient term; the tests of the World's light turn it on.
+    scene.voxlight.use_world_light = False
     scene.render.pixel_aspect_x = scene.render.pixel_aspect_y = 1.0
     scene.render.resolution_percentage = 100
     return scene

@@ -13,6 +13,7 @@
 #include "fuzz/dicom_writer.h"
 #include "fuzz/label_table_samples.h"
 #include "fuzz/writers.h"
+#include "hdr_writer.h"
 #include "nifti_writer.h"
 
 static char g_out[512];
@@ -161,6 +162,29 @@ int main(int argc, char **argv)
                                     2, 0x34, 0xff, 0};
     ok(tw_write(path("dicom_codecs", "seed_rle_8bit"), rle8, sizeof rle8, NULL, 0), "dicom rle 8-bit");
     ok(tw_write(path("dicom_codecs", "seed_rle_16bit"), rle16, sizeof rle16, NULL, 0), "dicom rle 16-bit");
+
+    /* Radiance World maps: run-length and flat scanlines, both row orders,
+     * a width under the run-length minimum, runs and literals of every kind */
+    {
+        float map[40 * 6 * 3];
+        for (int i = 0; i < 40 * 6; i++) {
+            map[3 * i] = i % 40 < 20 ? 0.5f : 4.0f;
+            map[3 * i + 1] = (float)(i / 40) * 0.1f + (float)(i % 3) * 0.01f;
+            map[3 * i + 2] = i < 40 ? 1000.0f : 0.0f;
+        }
+        const struct {
+            const char *name;
+            uint32_t w, h;
+            int rle, top;
+        } maps[] = {{"seed_rle_top", 40, 6, 1, 1}, {"seed_rle_bottom", 40, 6, 1, 0}, {"seed_flat", 40, 6, 0, 1},
+                    {"seed_narrow", 5, 3, 1, 1}, {"seed_1x1", 1, 1, 0, 1}};
+        for (size_t k = 0; k < sizeof maps / sizeof maps[0]; k++) {
+            size_t n = 0;
+            uint8_t *b = hdr_encode(map, maps[k].w, maps[k].h, maps[k].rle, maps[k].top, &n);
+            ok(b ? tw_write(path("hdr", maps[k].name), b, n, NULL, 0) : 1, "hdr");
+            free(b);
+        }
+    }
 
     return failures ? 1 : 0;
 }

@@ -38,6 +38,7 @@ BINDINGS = {
     "vxl_cutter": native.Cutter,
     "vxl_cutaway": native.Cutaway,
     "vxl_matcap": native.Matcap,
+    "vxl_environment": native.Environment,
     "vxl_scene_shadows": native.SceneShadows,
     "vxl_slice_params": native.SliceParams,
     "vxl_grid_params": native.GridParams,

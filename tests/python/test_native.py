@@ -372,10 +372,11 @@ def test_render_params_tail_matches_header():
     # 688 bytes up to the reserved room's end; issue 20 appended the labels'
     # pointer, then overlay_count and (issue 21) progressive before the
     # overlays' pointer, which keeps it on its 8-byte alignment; MinIP's
-    # floor (flag and value) follows it, then colour volumes' colour source
+    # floor (flag and value) follows it, then colour volumes' colour source (and a reserved word)
     assert P.labels.offset == 688 and P.overlays.offset == 704 and P.minip_floor.offset == 716
-    assert P.color_source.offset == 720
-    assert ctypes.sizeof(P) == 728
+    # and the World's light (a pointer on its alignment)
+    assert P.color_source.offset == 720 and P.environment.offset == 728
+    assert ctypes.sizeof(P) == 736
     assert P.labels.offset == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
     names = [n for n, _t in P._fields_]

@@ -226,13 +226,7 @@ int vxl_classified_grid(const vxl_volume *vol, const vxl_render_params *p, const
     uint32_t dims[3];
     int rc = read_grid_params(g, vol, dims);
     if (rc) return rc;
-    vxl_volume_geom geom;
-    memcpy(geom.dims, vol->dims, sizeof geom.dims);
-    memcpy(geom.affine, vol->affine, sizeof geom.affine);
-    geom.tex_lo = vol->tex_lo;
-    geom.tex_hi = vol->tex_hi;
-    geom.value_min = vol->value_min;
-    geom.value_max = vol->value_max;
+    vxl_volume_geom geom = vxl_volume_geom_of(vol);
     vxl_frame f;
     rc = vxl_frame_resolve(&f, p, &geom, NULL);
     if (rc) return rc;

@@ -8,6 +8,7 @@
 
 #include "hash.h"
 #include "mat4.h"
+#include "volume.h"
 
 #define DEFAULT_STEP 0.5f
 #define DEFAULT_SAMPLE_DISTANCE 1.0f
@@ -16,6 +17,18 @@
 #define MAX_TF_SIZE 4096
 
 static const float default_material[4] = {0.3f, 0.7f, 0.3f, 24.0f};
+
+vxl_volume_geom vxl_volume_geom_of(const vxl_volume *v)
+{
+    vxl_volume_geom g;
+    memcpy(g.dims, v->dims, sizeof g.dims);
+    memcpy(g.affine, v->affine, sizeof g.affine);
+    g.tex_lo = v->tex_lo;
+    g.tex_hi = v->tex_hi;
+    g.value_min = v->value_min;
+    g.value_max = v->value_max;
+    return g;
+}
 
 static void world_bounds(const vxl_volume_geom *g, double center[3], double *radius)
 {

@@ -20,6 +20,10 @@ typedef struct vxl_volume_geom {
     double value_min, value_max;
 } vxl_volume_geom;
 
+struct vxl_volume;
+/* The geometry and value mapping a frame needs of a CPU volume. */
+vxl_volume_geom vxl_volume_geom_of(const struct vxl_volume *v);
+
 /* One overlay of a frame (issue 20), resolved against its volume's geometry. */
 typedef struct vxl_frame_overlay {
     uint32_t slot, blend, interpolation; /* VXL_BLEND_*, VXL_INTERP_* */

@@ -107,12 +107,7 @@ int vxl_overlays_set(vxl_overlays_state *s, uint32_t slot, const vxl_volume *v)
     release_slot(g, sl);
     sl->tex = tex;
     sl->bricks = grid;
-    memcpy(sl->geom.dims, v->dims, sizeof sl->geom.dims);
-    memcpy(sl->geom.affine, v->affine, sizeof sl->geom.affine);
-    sl->geom.tex_lo = v->tex_lo;
-    sl->geom.tex_hi = v->tex_hi;
-    sl->geom.value_min = v->value_min;
-    sl->geom.value_max = v->value_max;
+    sl->geom = vxl_volume_geom_of(v);
     sl->volume_bytes = bytes;
     recount(s);
     s->volume_uploads++;

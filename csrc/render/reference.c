@@ -196,13 +196,7 @@ int vxl_reference_render(const vxl_phantom_desc *d, const vxl_volume *vol, const
     double probe_v, probe_g[3], origin[3] = {0, 0, 0};
     int rc = vxl_phantom_eval(d, origin, &probe_v, probe_g);
     if (rc) return rc;
-    vxl_volume_geom g;
-    memcpy(g.dims, vol->dims, sizeof g.dims);
-    memcpy(g.affine, vol->affine, sizeof g.affine);
-    g.tex_lo = vol->tex_lo;
-    g.tex_hi = vol->tex_hi;
-    g.value_min = vol->value_min;
-    g.value_max = vol->value_max;
+    vxl_volume_geom g = vxl_volume_geom_of(vol);
     vxl_frame f;
     rc = vxl_frame_resolve(&f, p, &g, NULL);
     if (rc) return rc;

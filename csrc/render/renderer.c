@@ -241,12 +241,7 @@ static int job_set_volume(void *p)
         return rc;
     }
     vxl_skipping_adopt(&r->skipping, &plan.bricks, v->texture_bits); /* the min-max grid the plan computed, if any */
-    memcpy(r->storage.geom.dims, v->dims, sizeof r->storage.geom.dims);
-    r->storage.geom.tex_lo = v->tex_lo;
-    r->storage.geom.tex_hi = v->tex_hi;
-    r->storage.geom.value_min = v->value_min;
-    r->storage.geom.value_max = v->value_max;
-    memcpy(r->storage.geom.affine, v->affine, sizeof r->storage.geom.affine);
+    r->storage.geom = vxl_volume_geom_of(v);
     r->storage.has_volume = 1;
     return VXL_OK;
 }

@@ -28,7 +28,7 @@
 #define VXL_MATCAP_UNIT 16        /* raycast: the MatCap image (issue 19, render/matcap.c) */
 #define VXL_LABELS_UNIT 18        /* raycast: the label volume (R16UI, issue 20, labels/labels.c) */
 #define VXL_LABEL_TABLE_UNIT 19   /* raycast: the per-label colour table (issue 20) */
-#define VXL_ENVIRONMENT_UNIT 21   /* raycast: the World's irradiance volume (RGBA16F, light/illumination.c) */
+#define VXL_ENVIRONMENT_UNIT 22   /* raycast: the World's irradiance volume (RGBA16F, light/illumination.c) */
 #define VXL_LABEL_MARGIN_UNIT 20  /* raycast: per label voxel, its margin inside its own label (R8, labels/label_margin.c) */
 #define VXL_COLOUR_UNIT 21        /* raycast, slices, slice_plane.comp: a colour volume's own colour (RGB8, colour/colour.c) */
 #define VXL_LABEL_BRICKS_UNIT 23  /* raycast: per label brick, the visible-label distance map and uniform id (issue 20, labels/label_bricks.c) */

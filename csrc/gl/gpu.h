@@ -63,7 +63,7 @@
 
 /* The World's light: the ray caster's shading adds it (ENVIRONMENT), and
  * the illumination program with it is the environment pass (PASS 4). */
-#define VXL_FLAG_ENVIRONMENT (1u << 22)
+#define VXL_FLAG_ENVIRONMENT (1u << 23)
 /* Direction cells the World's map is reduced to (light/environment_map.h);
  * the environment pass's ENV_CELLS. */
 #define VXL_ENV_CELLS 32

@@ -39,6 +39,32 @@
 #define VXL_OVERLAY_DISTANCE_UNIT 38 /* raycast: overlay k's brick distance map (empty-space skipping) on unit 38 + k */
 #define VXL_BRICK_MINMAX_UNIT 17  /* raycast: the brick min-max grid the modes skip by (issue 19, render/mode_bricks.c) */
 
+/* The ray caster reads every unit above at once, so no two may share a
+ * number: with distinct units the sum of their bits equals their union
+ * (two rooms added on separate branches once took the same unit). */
+#define VXL_UNIT_BIT_(u) (1ull << (u))
+#define VXL_UNITS_SUM_                                                                                               \
+    (VXL_UNIT_BIT_(VXL_VOLUME_UNIT) + VXL_UNIT_BIT_(VXL_DERIVED_UNIT) + VXL_UNIT_BIT_(VXL_TF_UNIT) +                  \
+     VXL_UNIT_BIT_(VXL_SCENE_DEPTH_UNIT) + VXL_UNIT_BIT_(VXL_DISTANCE_UNIT) + VXL_UNIT_BIT_(VXL_CLASSIFIED_UNIT) +    \
+     VXL_UNIT_BIT_(VXL_PREINT_UNIT) + VXL_UNIT_BIT_(VXL_SCRATCH_UNIT) + VXL_UNIT_BIT_(VXL_PAGE_UNIT) +                \
+     VXL_UNIT_BIT_(VXL_GPAGE_UNIT) + VXL_UNIT_BIT_(VXL_CODE_UNIT) + VXL_UNIT_BIT_(VXL_PALETTE_UNIT) +                 \
+     VXL_UNIT_BIT_(VXL_CPAGE_UNIT) + VXL_UNIT_BIT_(VXL_ILLUMINATION_UNIT) + VXL_UNIT_BIT_(VXL_EXTINCTION_UNIT) +      \
+     VXL_UNIT_BIT_(VXL_SHADOW_MAP_UNIT) + VXL_UNIT_BIT_(VXL_MATCAP_UNIT) + VXL_UNIT_BIT_(VXL_LABELS_UNIT) +           \
+     VXL_UNIT_BIT_(VXL_LABEL_TABLE_UNIT) + VXL_UNIT_BIT_(VXL_ENVIRONMENT_UNIT) + VXL_UNIT_BIT_(VXL_LABEL_MARGIN_UNIT) + \
+     VXL_UNIT_BIT_(VXL_COLOUR_UNIT) + VXL_UNIT_BIT_(VXL_LABEL_BRICKS_UNIT) + VXL_UNIT_BIT_(VXL_BRICK_MINMAX_UNIT) +    \
+     (7ull << VXL_OVERLAY_VOLUME_UNIT) + (7ull << VXL_OVERLAY_TF_UNIT) + (7ull << VXL_OVERLAY_DISTANCE_UNIT))
+#define VXL_UNITS_UNION_                                                                                             \
+    (VXL_UNIT_BIT_(VXL_VOLUME_UNIT) | VXL_UNIT_BIT_(VXL_DERIVED_UNIT) | VXL_UNIT_BIT_(VXL_TF_UNIT) |                  \
+     VXL_UNIT_BIT_(VXL_SCENE_DEPTH_UNIT) | VXL_UNIT_BIT_(VXL_DISTANCE_UNIT) | VXL_UNIT_BIT_(VXL_CLASSIFIED_UNIT) |    \
+     VXL_UNIT_BIT_(VXL_PREINT_UNIT) | VXL_UNIT_BIT_(VXL_SCRATCH_UNIT) | VXL_UNIT_BIT_(VXL_PAGE_UNIT) |                \
+     VXL_UNIT_BIT_(VXL_GPAGE_UNIT) | VXL_UNIT_BIT_(VXL_CODE_UNIT) | VXL_UNIT_BIT_(VXL_PALETTE_UNIT) |                 \
+     VXL_UNIT_BIT_(VXL_CPAGE_UNIT) | VXL_UNIT_BIT_(VXL_ILLUMINATION_UNIT) | VXL_UNIT_BIT_(VXL_EXTINCTION_UNIT) |      \
+     VXL_UNIT_BIT_(VXL_SHADOW_MAP_UNIT) | VXL_UNIT_BIT_(VXL_MATCAP_UNIT) | VXL_UNIT_BIT_(VXL_LABELS_UNIT) |           \
+     VXL_UNIT_BIT_(VXL_LABEL_TABLE_UNIT) | VXL_UNIT_BIT_(VXL_ENVIRONMENT_UNIT) | VXL_UNIT_BIT_(VXL_LABEL_MARGIN_UNIT) | \
+     VXL_UNIT_BIT_(VXL_COLOUR_UNIT) | VXL_UNIT_BIT_(VXL_LABEL_BRICKS_UNIT) | VXL_UNIT_BIT_(VXL_BRICK_MINMAX_UNIT) |    \
+     (7ull << VXL_OVERLAY_VOLUME_UNIT) | (7ull << VXL_OVERLAY_TF_UNIT) | (7ull << VXL_OVERLAY_DISTANCE_UNIT))
+_Static_assert(VXL_UNITS_SUM_ == VXL_UNITS_UNION_, "two texture units share a number (gl_bindings.h)");
+
 /* Image units. */
 #define VXL_IMAGE_OUT 0           /* every compute pass: the texture it writes (the B-spline prefilter also reads it) */
 #define VXL_IMAGE_SLICE_ACCUM 1   /* slices.frag: the colour attachment, read and composited slice by slice */

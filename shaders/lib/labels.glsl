@@ -175,20 +175,6 @@ uint label_winner_w(uint ids[8], float mu[8], float w[8])
 {
     float wm[8];
     for (int k = 0; k < 8; k++) wm[k] = w[k] * mu[k];
-    // Most mixed cells hold two labels: one pass sums both, the same
-    // winner as the general loop below (ids[0]'s label wins a tie).
-    uint a = ids[0], b = ids[0];
-    float sa = 0.0, sb = 0.0;
-    bool third = false;
-    for (int k = 0; k < 8; k++) {
-        bool in_a = ids[k] == a;
-        bool in_b = !in_a && (b == a || ids[k] == b);
-        b = in_b ? ids[k] : b;
-        sa += in_a ? wm[k] : 0.0;
-        sb += in_b ? wm[k] : 0.0;
-        third = third || (!in_a && !in_b);
-    }
-    if (!third) return sb > sa ? b : a;
     uint id = ids[0];
     float top = -1.0;
     for (int k = 0; k < 8; k++) {

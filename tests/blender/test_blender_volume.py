@@ -211,4 +211,4 @@ def refuses_over_the_memory_budget():
     assert set(bpy.data.objects) == before
 
 
-u.run(os.path.basename(__file__))
+u.run("test_blender_volume")

@@ -158,4 +158,4 @@ def the_light_follows_the_world_and_its_image():
     assert vx.params.scene_lights(scene, dg).environment is None
 
 
-u.run("world_light")
+u.run("test_world_light")

@@ -58,23 +58,6 @@ static double gradient_magnitude(const vxl_volume *v, const vxl_frame *f, const 
     return sqrt(sum);
 }
 
-/* The transfer function's straight RGBA at normalised value vn: the 1D
- * table read with GL_LINEAR at classify.glsl's coordinate, opacity scaled
- * and clamped. */
-static void classify(const vxl_frame *f, double vn, double out[4])
-{
-    double x = (vn - f->window_offset) * f->window_scale;
-    x = x < 0 ? 0 : x > 1 ? 1 : x;
-    double u = x * (f->tf_size - 1);
-    uint32_t i0 = (uint32_t)floor(u);
-    if (i0 > f->tf_size - 1) i0 = f->tf_size - 1;
-    uint32_t i1 = i0 + 1 < f->tf_size ? i0 + 1 : i0;
-    double w = u - i0;
-    for (int k = 0; k < 4; k++) out[k] = f->tf[4 * i0 + k] * (1 - w) + f->tf[4 * i1 + k] * w;
-    double a = out[3] * f->opacity_scale;
-    out[3] = a < 0 ? 0 : a > 1 ? 1 : a;
-}
-
 /* Opacity of one voxel of path at voxel point p (the gradient-opacity
  * factor applied as raycast.frag applies it at a step of one voxel); col
  * receives the straight colour. */
@@ -82,11 +65,11 @@ static double voxel_opacity(const vxl_volume *v, const vxl_frame *f, const doubl
 {
     double vn = sample_value(v, p);
     if (f->gopacity == VXL_GOPACITY_ISO) {
-        classify(f, f->iso_pos, col);
+        vxl_frame_classify(f, f->iso_pos, col);
         double d = fabs(f->iso_pos - vn), r = f->iso_thickness, m = gradient_magnitude(v, f, p);
         return m > 0 ? (d <= r * m ? col[3] * (1 - d / (r * m)) : 0) : (d == 0 ? col[3] : 0);
     }
-    classify(f, vn, col);
+    vxl_frame_classify(f, vn, col);
     if (col[3] <= 0 || f->gopacity != VXL_GOPACITY_BOUNDARY) return col[3];
     return col[3] * pow(fmin(gradient_magnitude(v, f, p) / f->gradient_ref, 1.0), f->gradient_exp);
 }

@@ -30,6 +30,20 @@ vxl_volume_geom vxl_volume_geom_of(const vxl_volume *v)
     return g;
 }
 
+void vxl_frame_classify(const vxl_frame *f, double vn, double out[4])
+{
+    double x = (vn - f->window_offset) * f->window_scale;
+    x = x < 0 ? 0 : x > 1 ? 1 : x;
+    double u = x * (f->tf_size - 1);
+    uint32_t i0 = (uint32_t)floor(u);
+    if (i0 > f->tf_size - 1) i0 = f->tf_size - 1;
+    uint32_t i1 = i0 + 1 < f->tf_size ? i0 + 1 : i0;
+    double w = u - i0;
+    for (int k = 0; k < 4; k++) out[k] = f->tf[4 * i0 + k] * (1 - w) + f->tf[4 * i1 + k] * w;
+    double a = out[3] * f->opacity_scale;
+    out[3] = a < 0 ? 0 : a > 1 ? 1 : a;
+}
+
 static void world_bounds(const vxl_volume_geom *g, double center[3], double *radius)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};

@@ -122,6 +122,11 @@ typedef struct vxl_frame {
     } overlays;
 } vxl_frame;
 
+/* The frame's transfer function at normalised value vn, as the GPU reads
+ * it: the table sampled with GL_LINEAR at classify.glsl's coordinate,
+ * opacity scaled and clamped (straight RGBA; the CPU renderers' lookup). */
+void vxl_frame_classify(const vxl_frame *f, double vn, double out[4]);
+
 /* The gradient filter a frame evaluates: rays that never evaluate gradients
  * (no shading, no gradient opacity) run one program for every filter. */
 static inline uint32_t vxl_frame_filter(const vxl_frame *f)

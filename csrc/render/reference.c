@@ -11,22 +11,6 @@
 
 #define REF_MAX_STEP (1.0 / 16.0)
 
-/* GL_LINEAR lookup of a 1D texture at the coordinate classify.glsl uses. */
-static void classify(const ref_ctx *c, double v, double out[4])
-{
-    const vxl_frame *f = c->f;
-    double x = (v - f->window_offset) * f->window_scale;
-    x = x < 0 ? 0 : x > 1 ? 1 : x;
-    double u = x * (f->tf_size - 1);
-    uint32_t i0 = (uint32_t)floor(u);
-    if (i0 > f->tf_size - 1) i0 = f->tf_size - 1;
-    uint32_t i1 = i0 + 1 < f->tf_size ? i0 + 1 : i0;
-    double w = u - i0;
-    for (int k = 0; k < 4; k++) out[k] = f->tf[4 * i0 + k] * (1 - w) + f->tf[4 * i1 + k] * w;
-    double a = out[3] * f->opacity_scale;
-    out[3] = a < 0 ? 0 : a > 1 ? 1 : a;
-}
-
 /* CLASSIFY_PRE: classify the analytic field at the 8 surrounding voxel
  * centres (premultiplied), interpolate trilinearly with clamp-to-edge, as
  * the GL path samples its pre-classified texture. */
@@ -49,7 +33,7 @@ static void classify_pre(const ref_ctx *c, const double p[3], double out[4])
             wt *= hi ? w[a] : 1 - w[a];
         }
         vxl_phantom_eval(c->d, q, &v, g);
-        classify(c, (v - c->vol->tex_lo) / span, k);
+        vxl_frame_classify(c->f, (v - c->vol->tex_lo) / span, k);
         for (int ch = 0; ch < 3; ch++) acc[ch] += wt * k[ch] * k[3];
         acc[3] += wt * k[3];
     }
@@ -73,7 +57,7 @@ double vxl_ref_sample(const ref_ctx *c, const double p[3], double step, double c
     /* gradient magnitude in normalised value per voxel, as the shader sees it */
     *gm = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) / fabs(span);
     if (f->gopacity == VXL_GOPACITY_ISO) {
-        classify(c, f->iso_pos, col);
+        vxl_frame_classify(f, f->iso_pos, col);
         double dist = fabs(f->iso_pos - vn), r = f->iso_thickness, m = *gm;
         double a = m > 0 ? (dist <= r * m ? col[3] * (1 - dist / (r * m)) : 0) : (dist == 0 ? col[3] : 0);
         return correct_opacity(a, step);
@@ -81,7 +65,7 @@ double vxl_ref_sample(const ref_ctx *c, const double p[3], double step, double c
     /* PREINT approximates the same continuous integral as POST, so both
      * share this reference; PRE is a different image model. */
     if (f->classify == VXL_CLASSIFY_PRE) classify_pre(c, p, col);
-    else classify(c, vn, col);
+    else vxl_frame_classify(f, vn, col);
     if (col[3] <= 0) return 0;
     double alpha = correct_opacity(col[3], step);
     if (f->gopacity == VXL_GOPACITY_BOUNDARY) alpha *= pow(fmin(*gm / f->gradient_ref, 1.0), f->gradient_exp);

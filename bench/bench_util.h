@@ -3,11 +3,34 @@
 #define VXL_BENCH_UTIL_H
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "voxlight.h"
+
+/* An OSMesa renderer holding the volume at path (the CPU copy freed), or
+ * NULL with the library's message printed after `tool`. */
+static inline vxl_renderer *renderer_with_volume(const char *path, const char *tool)
+{
+    vxl_volume *v = NULL;
+    vxl_renderer *r = NULL;
+    vxl_renderer_options o = {.struct_size = sizeof o, .backend = VXL_BACKEND_OSMESA};
+    if (vxl_volume_load(path, NULL, &v) || vxl_renderer_create(&o, &r)) {
+        fprintf(stderr, "%s: %s\n", tool, vxl_last_error());
+        vxl_volume_destroy(v);
+        return NULL;
+    }
+    int rc = vxl_renderer_set_volume(r, v);
+    vxl_volume_destroy(v);
+    if (rc) {
+        fprintf(stderr, "%s: %s\n", tool, vxl_renderer_error(r));
+        vxl_renderer_destroy(r);
+        return NULL;
+    }
+    return r;
+}
 
 static inline double now_ms(void)
 {

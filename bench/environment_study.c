@@ -47,13 +47,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: voxlight-envbench [--size N] [--frames 1..64] [--rounds N]\n");
         return 2;
     }
-    vxl_volume *v = NULL;
-    if (vxl_volume_load(BRAIN, NULL, &v)) return fail(NULL);
-    vxl_renderer_options o = {.struct_size = sizeof o, .backend = VXL_BACKEND_OSMESA};
-    vxl_renderer *r = NULL;
-    if (vxl_renderer_create(&o, &r)) return vxl_volume_destroy(v), fail(NULL);
-    if (vxl_renderer_set_volume(r, v)) return vxl_volume_destroy(v), fail(r);
-    vxl_volume_destroy(v);
+    vxl_renderer *r = renderer_with_volume(BRAIN, "voxlight-envbench");
+    if (!r) return 1;
     float *img = malloc((size_t)size * size * 4 * sizeof *img), *map = malloc(MW * MH * 3 * sizeof *map);
     if (!img || !map) return 1;
     sky(map);

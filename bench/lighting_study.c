@@ -96,13 +96,8 @@ static void row(FILE *csv, const char *part, const char *config, uint32_t size, 
 /* ch2better at size^2: the cost table. */
 static int brain(FILE *csv, uint32_t size, int frames)
 {
-    vxl_volume *v = NULL;
-    if (vxl_volume_load(BRAIN, NULL, &v)) return fail(NULL);
-    vxl_renderer_options o = {.struct_size = sizeof o, .backend = VXL_BACKEND_OSMESA};
-    vxl_renderer *r = NULL;
-    if (vxl_renderer_create(&o, &r)) return vxl_volume_destroy(v), fail(NULL);
-    if (vxl_renderer_set_volume(r, v)) return vxl_volume_destroy(v), fail(r);
-    vxl_volume_destroy(v);
+    vxl_renderer *r = renderer_with_volume(BRAIN, "voxlight-lightbench");
+    if (!r) return 1;
     float *img = malloc((size_t)size * size * 4 * sizeof *img);
     if (!img) return 1;
     vxl_render_params p = {.struct_size = sizeof p, .width = size, .height = size, .azimuth_deg = 30, .elevation_deg = 15};

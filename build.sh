@@ -289,29 +289,50 @@ run_suite() {
 # run_c_tests DIR [LAUNCHER...]: every DIR/tests/test_* program (through
 # LAUNCHER, e.g. Wine, when given), counting their summary lines.
 run_c_tests() {
-    local dir=$1 fails=0 p=0 f=0
+    local dir=$1 p=0 f=0 jobs=${VXL_TEST_JOBS:-$(nproc)}
     shift
-    for t in "$dir"/tests/test_*; do
+    local tests=() t
+    # test_stress is the longest by far: it starts first, and the other
+    # programs share the second lane.
+    for t in "$dir"/tests/test_stress* "$dir"/tests/test_*; do
         [ -x "$t" ] || continue
-        local out t0=$SECONDS
-        set +e
-        out=$("$@" "$t" 2>&1)
-        local rc=$?
-        set -e
+        case " ${tests[*]} " in *" $t "*) continue ;; esac
+        tests+=("$t")
+    done
+    # Up to $jobs programs at once: most of a program's time is one thread
+    # (LLVM compiling a shader, a parser, a codec), so a 2-core machine runs
+    # two of them in little more than the time of one. Each writes its output
+    # to a file of its own; the results are printed in order afterwards.
+    local out_dir i=0
+    out_dir=$(mktemp -d)
+    for t in "${tests[@]}"; do
+        while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
+        ( local t0=$SECONDS rc=0
+          "$@" "$t" >"$out_dir/$i.out" 2>&1 || rc=$?
+          echo "$rc $((SECONDS - t0))" >"$out_dir/$i.rc" ) &
+        i=$((i + 1))
+    done
+    wait || true
+    i=0
+    for t in "${tests[@]}"; do
+        local out rc=1 secs=0 line
+        out=$(cat "$out_dir/$i.out" 2>/dev/null || true)
+        [ -f "$out_dir/$i.rc" ] && read -r rc secs <"$out_dir/$i.rc"
+        i=$((i + 1))
         echo "$out" | grep -E 'FAIL|CHECK failed|REQUIRE failed|ERROR|runtime error|^software backend:' || true
-        local line
         # || true: under pipefail a crashed test (no summary line) must not
         # end the suite and hide the tests after it
         line=$(echo "$out" | grep -E '^[0-9]+ passed, [0-9]+ failed' | tail -n 1 || true)
         # a crash: show the end of its output (the sanitizer's report and stack)
         [ -n "$line" ] || echo "$out" | tail -n 60
-        echo "$(basename "$t"): ${line:-crashed (exit $rc)} ($((SECONDS - t0)) s)"
+        echo "$(basename "$t"): ${line:-crashed (exit $rc)} ($secs s)"
         if [ -n "$line" ]; then
             p=$((p + $(echo "$line" | grep -oE '^[0-9]+')))
             f=$((f + $(echo "$line" | sed -E 's/^[0-9]+ passed, ([0-9]+) failed.*/\1/')))
         fi
-        if [ $rc -ne 0 ] && { [ -z "$line" ] || echo "$line" | grep -q ' 0 failed'; }; then f=$((f + 1)); fi
+        if [ "$rc" -ne 0 ] && { [ -z "$line" ] || echo "$line" | grep -q ' 0 failed'; }; then f=$((f + 1)); fi
     done
+    rm -rf "$out_dir"
     echo "$p passed, $f failed"
     [ $f -eq 0 ]
 }

@@ -88,7 +88,7 @@ def main():
         sun.data.energy = 1.0  # Voxlight: L = 1
         scene.cycles.max_bounces = scene.cycles.volume_bounces = 1
     ours, t_ours = _render(scene, a.size, "voxlight")
-    # the library's own image, display-referred, before the F12 decodes it from sRGB
+    # the library's own image (scene-linear, what F12 composites) through the scripting API
     library = vx.render_volume(ob)[..., :3]
     vo = bpy.ops.voxlight.convert_to_blender_volume(resolution=a.resolution)
     vo = bpy.context.view_layer.objects.active
@@ -111,7 +111,7 @@ def main():
     for s, t, img in rows:
         r = _rmse(img, ours)
         print("| %d | %.2f | %.4f | %.1f | %.4f |" % (s, t, r, _psnr(r), _rmse(img, best)))
-    print("mean value: Voxlight F12 (linear) %.4f, the library's own image (display-referred) %.4f, Cycles %d "
+    print("mean value: Voxlight F12 (linear) %.4f, the library's own image (linear) %.4f, Cycles %d "
           "samples %.4f; RMSE of the library's image against it %.4f"
           % (ours.mean(), library.mean(), counts[-1], best.mean(), _rmse(library, best)))
 

@@ -14,7 +14,7 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
-from .core import label_import, label_runtime, native
+from .core import colour_space, label_import, label_runtime, native
 from .operators import OnActiveVolume
 
 _MODE_UI = {
@@ -112,7 +112,7 @@ def fill_labels(settings, table):
         item = settings.labels.add()
         item.label_id = t["id"]
         item.name = t["name"] or "Label %d" % t["id"]
-        item.color = t["color"]
+        item.color = colour_space.rgba_to_linear(t["color"])  # lookup files hold sRGB
         item.visible = t["visible"]
     settings.active_index = 0
     settings.error = ""

@@ -37,6 +37,10 @@ def look_kwargs(props, fast=False, dragging=False):
         window = (lo, hi)
     step = props.step * (2.0 if fast else 1.0)
     return dict(
+        # Blender's colours (the ramp, lights, the World, MatCaps) are
+        # scene-linear, and so is the image F12 composites; the viewport
+        # encodes it for display (viewport.py).
+        color_space="linear",
         filter=props.filter,
         sample_distance=props.sample_distance,
         reuse_gradients=props.reuse_gradients,

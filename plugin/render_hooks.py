@@ -17,20 +17,6 @@ from .core import native
 last_error = ""
 
 
-def display_to_linear(rgba):
-    """The library's colours are display-referred (sRGB), as in its PNG
-    output and in the viewport. The compositor works in scene-linear, so
-    decode them (on straight colour, then premultiply again): with the
-    Standard view transform F12 then shows what the CLI and viewport show."""
-    rgba = np.asarray(rgba, np.float32)
-    a = rgba[..., 3:4]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        c = np.where(a > 0, rgba[..., :3] / a, 0.0)
-    c = np.clip(c, 0.0, 1.0)
-    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
-    return np.ascontiguousarray(np.concatenate([lin * a, a], axis=-1), np.float32)
-
-
 _pending = False  # a render job is between render_pre and its compositing
 
 
@@ -117,10 +103,10 @@ def render_frame(scene, depsgraph):
         return
     rgba, depth = result
     if s.render_separate_layer:
-        compositor.write_passes(scene, display_to_linear(rgba), depth)
+        compositor.write_passes(scene, rgba, depth)
         return
     img = compositor.ensure_image(w, h)
-    img.pixels.foreach_set(display_to_linear(rgba).ravel())
+    img.pixels.foreach_set(np.ascontiguousarray(rgba, np.float32).ravel())
     img.update()
 
 

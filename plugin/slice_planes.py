@@ -23,7 +23,6 @@ from bpy.props import EnumProperty, IntProperty, PointerProperty
 
 from . import app_handlers, params
 from .properties import INTERPOLATION_ITEMS
-from .render_hooks import display_to_linear
 from .core import native, runtime, slice_plane
 
 IMAGE_PREFIX = "Voxlight Slice "
@@ -75,8 +74,8 @@ def _image(ob, w, h):
         img = None
     if img is None:
         img = bpy.data.images.new(name, w, h, alpha=True, float_buffer=True)
-    # Float images hold scene-linear colour; the library's (display-referred
-    # sRGB, as in its PNGs) are decoded on the way in (display_to_linear).
+    # Float images hold scene-linear colour, as the library's slices are
+    # (params.look_kwargs asks for it).
     img.alpha_mode = "PREMUL"
     return img
 
@@ -143,7 +142,8 @@ def slice_inputs(ob, scene, depsgraph):
     w, h = slice_plane.image_size(plane, model, props.resolution)
     look = params.look_kwargs(vol.voxlight)
     p = native.make_params(width=w, height=h, model=model, preset=look["preset"],
-                           window=look["window"], tf_rgba=look["tf_rgba"])
+                           window=look["window"], tf_rgba=look["tf_rgba"],
+                           color_space=look["color_space"])
     entry = runtime.entry_for(bpy.path.abspath(vol.voxlight.filepath), vol.voxlight,
                               scene.frame_current, **runtime.options_of(scene.voxlight))
     interp = props.interpolation
@@ -172,7 +172,7 @@ def update(ob, scene, depsgraph):
         return False
     _errors[ob.name] = ""
     img = _image(ob, p.width, p.height)  # ob is the original (scene.objects)
-    img.pixels.foreach_set(display_to_linear(rgba).ravel())
+    img.pixels.foreach_set(np.ascontiguousarray(rgba, np.float32).ravel())
     img.update()
     _material(ob, img)
     _keys[ob.name] = key

@@ -26,7 +26,7 @@ import os
 import bpy
 import numpy as np
 
-from .core import lighting, runtime, tf_fit, tf_presets
+from .core import colour_space, lighting, runtime, tf_fit, tf_presets
 from .operators import OnActiveVolume
 
 TABLE_SIZE = tf_presets.TABLE_SIZE
@@ -34,10 +34,15 @@ TABLE_SIZE = tf_presets.TABLE_SIZE
 # 1: the single editor (ramp + explicit window); 2: the gradient filter's
 # default became sobel8, so a volume saved before with the old default
 # (central, never set, so not stored) is given central when its file opens;
-# 3: shading models (issue 17), new volumes default to shadowed, so a volume
-# from before is given phong, its look then (lighting.upgrade).
+# 3: shading models, new volumes default to shadowed, so a volume from
+# before is given phong, its look then (lighting.upgrade);
+# 4: the library renders in scene-linear colour, as Blender's ColorRamp and
+# colour properties hold colours; a volume saved before held its ramp's and
+# labels' colours as display (sRGB) values, which are decoded when its file
+# opens (linear_colours), so its image looks as it did.
 TF_SINGLE_EDITOR = 1
-TF_VERSION = 3
+TF_LINEAR_COLOUR = 4
+TF_VERSION = 4
 
 # Kept for scripts written against the ColorRamp presets of issue 6.
 SLICER_PRESETS = tf_presets.SLICER_PRESETS
@@ -125,6 +130,13 @@ def ensure_texture(obj, info=None):
     return tex
 
 
+def preset_stops(stops):
+    """A preset's stops [(position, rgba)] with their colours made
+    scene-linear, as a ColorRamp holds colours: the presets' tables are
+    display-referred (sRGB), as MRIcroGL's and 3D Slicer's are."""
+    return [(pos, colour_space.rgba_to_linear(rgba)) for pos, rgba in stops]
+
+
 def set_ramp(ramp, stops):
     """Replace a ColorRamp's stops with [(position, rgba), ...] (at most
     32, Blender's limit)."""
@@ -170,7 +182,7 @@ def load_preset(obj, key, info=None):
     tex = p.tf_texture
     if tex is None or not tex.use_color_ramp:
         tex = ensure_texture(obj, info)  # creates, then loads the default: reloaded below
-    set_ramp(tex.color_ramp, stops)
+    set_ramp(tex.color_ramp, preset_stops(stops))
     p.window_low, p.window_high = lo, hi
     _set_legacy_flags(p)
     p.tf_preset = key
@@ -264,7 +276,7 @@ def migrate_legacy(obj):
             tex = bpy.data.textures.new(".VXL TF %s" % obj.name, type="BLEND")
             tex.use_color_ramp = True
             p.tf_texture = tex
-        set_ramp(tex.color_ramp, tf_presets.table_to_stops(tf_presets.builtin_table(key.lower())))
+        set_ramp(tex.color_ramp, preset_stops(tf_presets.table_to_stops(tf_presets.builtin_table(key.lower()))))
         p.tf_preset = key
         p.tf_preset_signature = ramp_signature(tex.color_ramp)
     _set_legacy_flags(p)
@@ -394,7 +406,24 @@ def upgrade(obj):
     if old < 2 and p.get("filter") is None:
         p.filter = "central"  # the default it was saved with
     lighting.upgrade(p, old)
+    if TF_SINGLE_EDITOR <= old < TF_LINEAR_COLOUR:  # a migrated legacy ramp is linear already
+        linear_colours(obj)
     p.tf_version = TF_VERSION
+
+
+def linear_colours(obj):
+    """Decode the display (sRGB) colours a volume saved before
+    TF_LINEAR_COLOUR holds: its ramp's stops and its labels' colours."""
+    p = obj.voxlight
+    tex = p.tf_texture
+    if tex is not None and tex.use_color_ramp:
+        signature_current = ramp_signature(tex.color_ramp) == p.tf_preset_signature
+        for e in tex.color_ramp.elements:
+            e.color = colour_space.rgba_to_linear(tuple(e.color))
+        if signature_current:  # an unedited preset stays unedited
+            p.tf_preset_signature = ramp_signature(tex.color_ramp)
+    for lab in getattr(getattr(obj, "voxlight_labels", None), "labels", ()):
+        lab.color = colour_space.rgba_to_linear(tuple(lab.color))
 
 
 @bpy.app.handlers.persistent

@@ -248,6 +248,20 @@ float planar(float w)
     return clamp(d, box.x, box.y);
 }
 
+/* The library's image is scene-linear (params.look_kwargs) and is filtered
+   as such; the viewport draws display colour, so the straight colour is
+   encoded as sRGB at the end, as the Standard view transform would
+   (core/colour_space.py's linear_to_srgb). */
+vec4 to_display(vec4 c)
+{
+    if (c.a <= 0.0) {
+        return vec4(0.0);
+    }
+    vec3 s = clamp(c.rgb / c.a, 0.0, 1.0);
+    vec3 e = mix(s * 12.92, 1.055 * pow(s, vec3(1.0 / 2.4)) - 0.055, greaterThan(s, vec3(0.0031308)));
+    return vec4(e * c.a, c.a);
+}
+
 void main()
 {
     ivec2 cs = textureSize(color_tex, 0);
@@ -256,7 +270,7 @@ void main()
     if (filter_mode == 0) {
         ivec2 t = clamp(ivec2(uv * vec2(cs)), ivec2(0), cs - 1);
         vec2 hs = texelFetch(depth_tex, t, 0).rg;
-        fragColor = texelFetch(color_tex, t, 0);
+        fragColor = to_display(texelFetch(color_tex, t, 0));
         gl_FragDepth = hs.r < 1.0 ? min(hs.r, hs.g) : hs.g;
         return;
     }
@@ -317,6 +331,7 @@ void main()
         fragColor = w_c > 1e-4 ? acc_c / w_c : accu_c / n_c;
         hit = hit_c;
     }
+    fragColor = to_display(fragColor);
     gl_FragDepth = min(hit, scene);
 }
 """

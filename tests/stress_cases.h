@@ -905,10 +905,14 @@ enum {
     F_ALLOW_CREATE_ERROR = 8, /* vxl_volume_create may refuse the data cleanly instead */
     F_BAD_VOLUME = 16,        /* the volume itself is the invalid input: check recovery on a good one */
     F_TF_MATCHES_256 = 64,    /* the image equals (within rounding) the one with the 256-entry ramp */
-    F_FULL_ONLY = 32,
-    F_NEAR_INVARIANT = 128,   /* equals (within rounding) the image with the near plane at 0.1: the volume
-                                 lies far beyond both, so the near plane must not change a pixel */         /* --full only: the case needs a texture state of its own (8-bit volumes, no
+    F_FULL_ONLY = 32,         /* --full only: the case needs a texture state of its own (8-bit volumes, no
                                  skipping), which costs llvmpipe a recompilation of every program */
+    F_NEAR_INVARIANT = 128,   /* equals (within rounding) the image with the near plane at 0.1: the volume
+                                 lies far beyond both, so the near plane must not change a pixel */
+    F_ONE_FILTER = 256,       /* by default one filter (the case's index modulo VXL_FILTER_COUNT, so a group of
+                                 such cases covers several), --full every filter: the case's programs are
+                                 variants of their own (a colour volume's texture, the environment's light), each a cold compilation
+                                 for llvmpipe in CI, and the filters' code is the same as in every other case */
 };
 
 typedef struct stress_case {
@@ -966,13 +970,13 @@ static const stress_case stress_cases[] = {
      F_VISIBLE, 0},
     /* colour volumes: the voxels' colour beside the luminance scalar (docs/colour.md) */
     {"colour_rgb_u8_const", GROUP_dtypes_and_scaling, {VXL_DTYPE_U8, N3, fill_u8_max, AFF_NONE, 0, 0, 3}, view_default,
-     OK, 0, 0},
+     OK, F_ONE_FILTER, 0},
     {"colour_rgba_u16_ball", GROUP_dtypes_and_scaling, {VXL_DTYPE_U16, N3, fill_u16_max_ball, AFF_NONE, 0, 0, 4},
-     view_default, OK, 0, 0},
+     view_default, OK, F_ONE_FILTER, 0},
     {"colour_rgb_f32_nan_inf_mix", GROUP_dtypes_and_scaling, {F32, N3, fill_nan_inf_mix, AFF_NONE, 0, 0, 3},
-     view_default, OK, 0, 0},
+     view_default, OK, F_ONE_FILTER, 0},
     {"colour_rgb_f64_max_and_nan", GROUP_dtypes_and_scaling, {VXL_DTYPE_F64, N3, fill_f64_max_and_nan, AFF_ROT_SHEAR, 0, 0, 3},
-     view_default, OK, 0, 0},
+     view_default, OK, F_ONE_FILTER, 0},
     {"i32_extremes_checker", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_I32, fill_i32_checker), view_default, OK, 0, 0},
     {"u32_full_range_ball", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_U32, fill_u32_max_ball), view_default, OK,
      F_VISIBLE, 0},
@@ -1128,8 +1132,8 @@ static const stress_case stress_cases[] = {
     {"light_direction_1e-38", GROUP_lighting, BALL, light_tiny_direction, OK, F_VISIBLE, 0},
     {"material_extreme", GROUP_lighting, BALL, material_extreme, OK, F_VISIBLE, 0},
     {"material_zero", GROUP_lighting, BALL, material_zero, OK, 0, 0},
-    {"environment_extreme", GROUP_lighting, BALL, environment_extreme, OK, F_VISIBLE, 0},
-    {"environment_uniform_shadowed", GROUP_lighting, BALL, environment_uniform_shadowed, OK, F_VISIBLE, 0},
+    {"environment_extreme", GROUP_lighting, BALL, environment_extreme, OK, F_VISIBLE | F_ONE_FILTER, 0},
+    {"environment_uniform_shadowed", GROUP_lighting, BALL, environment_uniform_shadowed, OK, F_VISIBLE | F_ONE_FILTER, 0},
 
     /* deliberately invalid inputs */
     {"invalid_tf_size_zero", GROUP_invalid_inputs, BALL, bad_tf_size_zero, BAD, 0, 0},

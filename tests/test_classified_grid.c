@@ -60,6 +60,40 @@ TEST(density_and_colour_at_voxel_centres)
     vxl_volume_destroy(v);
 }
 
+/* In scene-linear colour the caller's table is the albedo as given, and the
+ * library's own (display-referred) presets are decoded once, by the table:
+ * a preset's grid is the same in both colour spaces. */
+TEST(linear_colour_space_keeps_the_callers_colours_and_decodes_the_presets)
+{
+    const uint8_t data[3] = {0, 51, 255};
+    vxl_volume *v = row_volume(data, 3, 1.0);
+    REQUIRE(v);
+    vxl_render_params p = params();
+    p.color_space = VXL_COLOR_SPACE_LINEAR;
+    vxl_grid_info info = {.struct_size = sizeof info};
+    float rgb[9], rgb_display[9], dens[3], dens_display[3];
+    REQUIRE(vxl_classified_grid(v, &p, NULL, &info, dens, rgb) == VXL_OK);
+    for (int i = 0; i < 3; i++) {
+        double x = data[i] / 255.0;
+        CHECKF(near(rgb[3 * i], 1 - x) && rgb[3 * i + 1] == 0 && near(rgb[3 * i + 2], x), "cell %d: %g %g %g", i,
+               rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
+    }
+    p = (vxl_render_params){.struct_size = sizeof p, .preset = VXL_PRESET_HOT, .has_window = 1, .window_high = 255};
+    REQUIRE(vxl_classified_grid(v, &p, NULL, &info, dens_display, rgb_display) == VXL_OK);
+    p.color_space = VXL_COLOR_SPACE_LINEAR;
+    REQUIRE(vxl_classified_grid(v, &p, NULL, &info, dens, rgb) == VXL_OK);
+    int coloured = 0;
+    for (int i = 0; i < 9; i++) {
+        CHECKF(fabs(rgb[i] - rgb_display[i]) <= 1e-6, "component %d: %g linear, %g display", i, rgb[i], rgb_display[i]);
+        coloured += rgb[i] > 0.01f && rgb[i] < 0.99f;
+    }
+    for (int i = 0; i < 3; i++) CHECK(dens[i] == dens_display[i]);
+    CHECK(coloured > 0); /* the decode was exercised, not only 0 and 1 */
+    p.color_space = VXL_COLOR_SPACE_COUNT;
+    CHECK(vxl_classified_grid(v, &p, NULL, &info, dens, rgb) == VXL_ERR_INVALID_ARGUMENT);
+    vxl_volume_destroy(v);
+}
+
 TEST(coarser_grid_interpolates_between_voxels)
 {
     /* 4 voxels, 2 cells: cell centres at voxel x = 0.5 and 2.5 */
@@ -140,6 +174,7 @@ TEST(refusals)
 int main(void)
 {
     RUN(density_and_colour_at_voxel_centres);
+    RUN(linear_colour_space_keeps_the_callers_colours_and_decodes_the_presets);
     RUN(coarser_grid_interpolates_between_voxels);
     RUN(clip_plane_baked_into_density);
     RUN(slices_filled_by_every_worker);

@@ -236,11 +236,62 @@ TEST(colour_source_tf_renders_what_the_luminance_renders)
     p.color_source = VXL_COLOR_SOURCE_COUNT;
     CHECK(vxl_render(r, &p, IMG, NULL) == VXL_ERR_INVALID_ARGUMENT);
     p.color_source = 0;
-    p.reserved2 = 1;
+    p.color_space = VXL_COLOR_SPACE_COUNT;
     CHECK(vxl_render(r, &p, IMG, NULL) == VXL_ERR_INVALID_ARGUMENT);
     vxl_renderer_destroy(r);
     vxl_volume_destroy(v);
     vxl_volume_destroy(lum);
+}
+
+/* A colour volume's RGB is display-referred: in scene-linear colour the
+ * image is its decoded value (emission only, the first voxel opaque); a lit
+ * image is not clamped to 1 there, and is in display colour. */
+TEST(linear_colour_space_decodes_the_data_colour_and_keeps_light_above_one)
+{
+    static uint8_t rgb[N * N * N * 3];
+    const uint8_t c8[3] = {200, 90, 30};
+    for (int i = 0; i < N * N * N; i++) memcpy(rgb + 3 * i, c8, 3);
+    vxl_volume_desc d = {.struct_size = sizeof d, .dtype = VXL_DTYPE_U8, .dims = {N, N, N}, .data = rgb,
+                         .components = 3};
+    vxl_volume *v = NULL;
+    REQUIRE(vxl_volume_create(&d, NULL, &v) == VXL_OK);
+    vxl_renderer *r = make_stored_renderer(VXL_STORAGE_DENSE, 0, 0, 0);
+    REQUIRE(r);
+    vxl_render_params p = axis_params(0);
+    REQUIRE(render(r, v, &p, IMG) == VXL_OK);
+    p.color_space = VXL_COLOR_SPACE_LINEAR;
+    REQUIRE(render(r, v, &p, REF) == VXL_OK);
+    const float *disp = IMG + 4 * ((N / 2) * N + N / 2), *lin = REF + 4 * ((N / 2) * N + N / 2);
+    for (int c = 0; c < 3; c++) {
+        double s = c8[c] / 255.0, want = s <= 0.04045 ? s / 12.92 : pow((s + 0.055) / 1.055, 2.4);
+        CHECKF(fabs(disp[c] - s) <= 2e-3, "display channel %d: %g, want %g", c, disp[c], s);
+        CHECKF(fabs(lin[c] - want) <= 2e-3, "linear channel %d: %g, want %g", c, lin[c], want);
+    }
+    CHECK(fabs(disp[3] - 1) <= 1e-4 && fabs(lin[3] - 1) <= 1e-4);
+    /* a light ten times white on the cube's faces: lit colour above 1 in
+     * linear, clamped in display */
+    vxl_volume_destroy(v);
+    v = cube_volume(3, NULL);
+    REQUIRE(v);
+    p.color_space = VXL_COLOR_SPACE_LINEAR;
+    p.shading_off = 0;
+    p.light_count = 2; /* along the view axis, one of them facing the camera */
+    p.lights[0] = (vxl_light){.position = {1, 0, 0, 0}, .color = {1, 1, 1}, .intensity = 10};
+    p.lights[1] = (vxl_light){.position = {-1, 0, 0, 0}, .color = {1, 1, 1}, .intensity = 10};
+    REQUIRE(render(r, v, &p, REF) == VXL_OK);
+    p.color_space = VXL_COLOR_SPACE_DISPLAY;
+    REQUIRE(render(r, v, &p, IMG) == VXL_OK);
+    float max_lin = 0, max_disp = 0;
+    for (int i = 0; i < N * N; i++) {
+        for (int c = 0; c < 3; c++) {
+            max_lin = fmaxf(max_lin, REF[4 * i + c]);
+            max_disp = fmaxf(max_disp, IMG[4 * i + c]);
+        }
+        CHECK(REF[4 * i + 3] <= 1.0f && isfinite(REF[4 * i]));
+    }
+    CHECKF(max_lin > 1.5f && max_disp <= 1.0f, "brightest: %g linear, %g display", max_lin, max_disp);
+    vxl_renderer_destroy(r);
+    vxl_volume_destroy(v);
 }
 
 TEST(opacity_source_picks_the_scalar)
@@ -447,6 +498,7 @@ int main(void)
     RUN(faces_render_their_own_colour_in_every_storage_mode);
     RUN(classification_and_render_modes_keep_the_colour);
     RUN(colour_source_tf_renders_what_the_luminance_renders);
+    RUN(linear_colour_space_decodes_the_data_colour_and_keeps_light_above_one);
     RUN(opacity_source_picks_the_scalar);
     RUN(slice_planes_show_the_data_colour);
     RUN(colour_is_charged_to_the_budget);

@@ -571,6 +571,7 @@ static void *run_backend(void *arg)
         for (uint32_t cl = 0; cl < VXL_CLASSIFY_COUNT; cl++)
             for (int m = 0; m < MODE_COUNT; m++) {
                 if (!mode_selected(cr->idx, f, cl, m)) continue;
+                if (!ENV.full && (c->flags & F_ONE_FILTER) && f != cr->idx % VXL_FILTER_COUNT) continue;
                 for (int var = 0; var < ENV.variant_count; var++) {
                     /* --full: every mode at the base variant; the other variants
                      * shaded, every filter, one classify mode in rotation */

@@ -11,6 +11,7 @@
 #include "error.h"
 #include "frame.h"
 #include "mat4.h"
+#include "srgb.h"
 #include "threads.h"
 #include "volume.h"
 #include "voxlight.h"
@@ -74,14 +75,6 @@ static double voxel_opacity(const vxl_volume *v, const vxl_frame *f, const doubl
     return col[3] * pow(fmin(gradient_magnitude(v, f, p) / f->gradient_ref, 1.0), f->gradient_exp);
 }
 
-/* The library's colours are display-referred (sRGB-encoded, as its PNG
- * output and the viewport show them); a medium's albedo is linear. */
-static double srgb_to_linear(double c)
-{
-    c = c < 0 ? 0 : c > 1 ? 1 : c;
-    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-}
-
 /* What the frame asks that a grid of extinction and colour cannot hold. */
 static int check_frame(const vxl_frame *f)
 {
@@ -127,6 +120,7 @@ static void *fill_slab(void *arg)
     slab_job *j = arg;
     const uint32_t *dims = j->dims;
     double max_sigma = -log(MIN_VOXEL_TRANSMITTANCE);
+    const int linear = j->f->color_space == VXL_COLOR_SPACE_LINEAR;
     for (uint32_t z = j->z0; z < j->z1; z++)
         for (uint32_t y = 0; y < dims[1]; y++)
             for (uint32_t x = 0; x < dims[0]; x++) {
@@ -140,8 +134,10 @@ static void *fill_slab(void *arg)
                 double d = sigma / j->voxel_length;
                 if (d > j->max_density) j->max_density = d;
                 if (j->density) j->density[i] = (float)d;
+                /* a medium's albedo is linear: display-referred colours are decoded */
                 if (j->rgb)
-                    for (int k = 0; k < 3; k++) j->rgb[3 * i + k] = (float)srgb_to_linear(col[k]);
+                    for (int k = 0; k < 3; k++)
+                        j->rgb[3 * i + k] = (float)(linear ? fmax(col[k], 0.0) : vxl_srgb_to_linear(col[k]));
             }
     return NULL;
 }

@@ -8,6 +8,7 @@
 
 #include "hash.h"
 #include "mat4.h"
+#include "srgb.h"
 #include "volume.h"
 
 #define DEFAULT_STEP 0.5f
@@ -120,6 +121,11 @@ int vxl_frame_resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_vol
     } else {
         if (!vxl_preset_table(preset, f->preset_tf))
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown preset %u", p->preset);
+        /* the presets' colours are display-referred */
+        if (p->color_space == VXL_COLOR_SPACE_LINEAR)
+            for (uint32_t i = 0; i < VXL_PRESET_TABLE_SIZE; i++)
+                for (int c = 0; c < 3; c++)
+                    f->preset_tf[4 * i + c] = (float)vxl_srgb_to_linear(f->preset_tf[4 * i + c]);
         f->tf = f->preset_tf;
         f->tf_size = VXL_PRESET_TABLE_SIZE;
     }
@@ -291,9 +297,10 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     f->technique = p->technique;
     if (p->color_source >= VXL_COLOR_SOURCE_COUNT)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown color_source %u (0 auto, 1 data, 2 tf)", p->color_source);
-    if (p->reserved2)
-        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "render params reserved2 is %u: it must be 0", p->reserved2);
+    if (p->color_space >= VXL_COLOR_SPACE_COUNT)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown color_space %u (0 display, 1 linear)", p->color_space);
     f->color_source = p->color_source;
+    f->color_space = p->color_space;
     rc = vxl_frame_resolve_mode(f, p, e); /* issue 19: mode, iso_value, MatCap */
     if (rc) return rc;
     f->gradient_ref = p->gradient_ref == 0 ? 0.05f : p->gradient_ref;

@@ -43,6 +43,7 @@ typedef struct vxl_frame {
     uint32_t classify, preint_size;
     uint32_t gopacity;          /* VXL_GOPACITY_* */
     uint32_t technique;         /* VXL_TECHNIQUE_*: the ray caster or a slicing comparison mode (slices.c) */
+    uint32_t color_space;       /* VXL_COLOR_SPACE_*: display-referred or scene-linear colours */
     uint32_t color_source;      /* VXL_COLOR_SOURCE_*: whether a colour volume's own colour replaces the table's */
     float gradient_ref, gradient_exp, iso_pos, iso_thickness; /* iso_pos: normalised value */
     float sample_distance, step;

@@ -67,6 +67,7 @@ static int resolve_one(vxl_frame *f, vxl_frame_overlay *ov, const vxl_overlay_st
     q.window_low = s->window_low;
     q.window_high = s->window_high;
     q.opacity_scale = s->opacity_scale;
+    q.color_space = f->color_space; /* a preset's colours decoded as the base volume's are */
     vxl_frame *tmp = calloc(1, sizeof *tmp);
     if (!tmp) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory resolving overlay %u", i);
     int rc = vxl_frame_resolve_tf(tmp, &q, g, e);

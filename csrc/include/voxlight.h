@@ -799,7 +799,16 @@ typedef struct vxl_render_params {
      * grey volume (the colour volume then renders as its opacity source).
      * Opacity always comes from the transfer function of the scalar. */
     uint32_t color_source;
-    uint32_t reserved2;         /* must be 0 */
+    /* What the colours mean, VXL_COLOR_SPACE_*. DISPLAY (0): the caller's
+     * colours and the image are display-referred (sRGB-encoded), as the
+     * CLI's PNGs are. LINEAR: the transfer function's, the labels' and the
+     * lights' colours, the environment and the MatCap are scene-linear, and
+     * so is the image (premultiplied; colour above 1 where the light makes
+     * it, alpha at most 1); the library's own display-referred colours (its
+     * presets, a colour volume's RGB) are decoded from sRGB. The lit models
+     * are physical only in LINEAR (docs/physical_model.md). This field was
+     * reserved2, which had to be 0: DISPLAY keeps those callers' images. */
+    uint32_t color_space;
     /* Appended: the World's light (vxl_environment); read only when
      * struct_size covers it. NULL: no environment (the lamps and the
      * ambient term only, as before). */
@@ -925,6 +934,11 @@ typedef struct vxl_slice_params {
 VXL_API int vxl_render_slice(vxl_renderer *r, const vxl_render_params *p, const vxl_slice_params *s,
                              float *rgba);
 
+/* vxl_render_params.color_space */
+#define VXL_COLOR_SPACE_DISPLAY 0u /* sRGB-encoded colours in and out (the default) */
+#define VXL_COLOR_SPACE_LINEAR 1u  /* scene-linear colours in and out (Blender's, Cycles') */
+#define VXL_COLOR_SPACE_COUNT 2u
+
 /* The camera vxl_render uses when has_camera is 0, for callers that want to
  * start from it. */
 VXL_API int vxl_default_camera(vxl_renderer *r, const vxl_render_params *p, float view[16],
@@ -956,8 +970,8 @@ typedef struct vxl_grid_info {   /* output */
 /* Fills density (dims product floats, x fastest: extinction per world unit,
  * 0 where the clip planes or the crop box of params.cutaway cut the volume
  * away) and rgb (3 floats per cell: the transfer function's straight
- * colour, which the library treats as display-referred sRGB, decoded to
- * linear, 0..1) for vol classified as p classifies it (preset or
+ * colour as a linear albedo: decoded from sRGB when p.color_space is
+ * DISPLAY, as given when it is LINEAR) for vol classified as p classifies it (preset or
  * table, window, opacity scale, gradient opacity from central differences
  * sample_distance apart). Either buffer may be NULL; both NULL fills info
  * only, so a caller can size its buffers. CPU only: no renderer, no GL.

@@ -114,6 +114,7 @@ static void set_frame_uniforms(vxl_renderer *r, GLuint prog, const vxl_frame *f)
     gl->Uniform1f(LOC("u_opacity_scale"), f->opacity_scale);
     gl->Uniform1f(LOC("u_sample_distance"), f->sample_distance);
     gl->Uniform4fv(LOC("u_material"), 1, f->material);
+    gl->Uniform1i(LOC("u_linear"), f->color_space == VXL_COLOR_SPACE_LINEAR);
     gl->Uniform1i(LOC("u_light_count"), f->light_count);
     gl->Uniform4fv(LOC("u_light_pos"), VXL_MAX_LIGHTS, &f->light_pos[0][0]);
     gl->Uniform3fv(LOC("u_light_color"), VXL_MAX_LIGHTS, &f->light_color[0][0]);

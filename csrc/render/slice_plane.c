@@ -43,7 +43,8 @@ static int slice_frame(vxl_frame *f, const vxl_render_params *in, const vxl_volu
                            .has_window = p.has_window,
                            .window_low = p.window_low,
                            .window_high = p.window_high,
-                           .color_source = p.color_source};
+                           .color_source = p.color_source,
+                           .color_space = p.color_space};
     memcpy(q.model, p.model, sizeof q.model);
     return vxl_frame_resolve(f, &q, g, e);
 }
@@ -116,6 +117,7 @@ static int resample(vxl_renderer *r, const vxl_frame *f, uint32_t interp, const 
     vxl_uniform_i(&r->gpu, prog, "u_tf", VXL_TF_UNIT);
     vxl_uniform_i(&r->gpu, prog, "u_tf_size", (int)f->tf_size);
     gl->Uniform2f(gl->GetUniformLocation(prog, "u_window"), f->window_offset, f->window_scale);
+    vxl_uniform_i(&r->gpu, prog, "u_linear", f->color_space == VXL_COLOR_SPACE_LINEAR);
     vxl_colour_bind(&r->colour, colour_flags, prog);
     gl->DispatchCompute((f->width + 7) / 8, (f->height + 7) / 8, 1);
     gl->MemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);

@@ -34,6 +34,7 @@ BLENDS = ("over", "add", "max")  # VXL_BLEND_*
 STREAMING_MODES = ("auto", "off", "on")  # VXL_STREAMING_*
 OPACITY_SOURCES = ("luminance", "channel", "alpha")  # VXL_OPACITY_SOURCE_*: a colour volume's scalar
 COLOR_SOURCES = ("auto", "data", "tf")  # VXL_COLOR_SOURCE_*
+COLOR_SPACES = ("display", "linear")  # VXL_COLOR_SPACE_*: what render params' colours mean
 MAX_OVERLAYS = 3  # VXL_MAX_OVERLAYS
 MAX_LABEL_ID = 65535  # VXL_MAX_LABEL_ID
 NOTES_MAX = 512  # VXL_NOTES_MAX: vxl_volume_info.notes, its NUL included
@@ -360,7 +361,7 @@ class RenderParams(ctypes.Structure):
                 ("minip_floor_on", ctypes.c_uint32),     # appended: MinIP's floor
                 ("minip_floor", ctypes.c_float),
                 ("color_source", ctypes.c_uint32),       # appended: colour volumes
-                ("reserved2", ctypes.c_uint32),
+                ("color_space", ctypes.c_uint32),        # VXL_COLOR_SPACE_* (COLOR_SPACES)
                 ("environment", ctypes.POINTER(Environment))]  # appended: the World's light
 
 

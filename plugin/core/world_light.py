@@ -22,6 +22,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .colour_space import srgb_to_linear
+
 MAX_WIDTH, MAX_HEIGHT = 128, 64
 
 
@@ -47,11 +49,6 @@ def downsample(rgb, max_width=MAX_WIDTH, max_height=MAX_HEIGHT):
     acc = np.add.reduceat(np.add.reduceat(rgb.astype(np.float64), ys[:-1], axis=0), xs[:-1], axis=1)
     counts = np.outer(np.diff(ys), np.diff(xs))[:, :, None]
     return np.ascontiguousarray(acc / counts, dtype=np.float32)
-
-
-def srgb_to_linear(c):
-    c = np.asarray(c, np.float32)
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
 
 
 def image_rgb(image):

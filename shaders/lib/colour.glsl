@@ -7,7 +7,17 @@
 #ifdef DATA_COLOUR
 uniform sampler3D u_colour;
 
-vec3 data_colour(vec3 p) { return textureLod(u_colour, (p + 0.5) / u_dims, 0.0).rgb; }
+vec3 srgb_to_linear(vec3 c)
+{
+    c = clamp(c, 0.0, 1.0);
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+vec3 data_colour(vec3 p)
+{
+    vec3 c = textureLod(u_colour, (p + 0.5) / u_dims, 0.0).rgb;
+    return u_linear ? srgb_to_linear(c) : c; // the data's RGB is display-referred
+}
 
 // Classified sample c (straight colour) at voxel position p with its colour
 // taken from the data.

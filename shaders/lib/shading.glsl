@@ -79,7 +79,7 @@ vec3 shade(vec3 rgb, vec3 g, vec3 pos, RayLighting r, bool one_directional)
             }
         }
     }
-    return clamp(acc, 0.0, 1.0);
+    return clamp_colour(acc);
 }
 
 // Shading models beyond Phong (issue 17), one per program: SHADING_MODEL 1
@@ -167,6 +167,6 @@ vec3 shade_lit(vec3 rgb, vec3 g, vec3 pos, vec3 p, RayLighting r, bool one_direc
                 acc += mask * light_transmittance(i, p) * lit_term(i, rgb, n, has_normal, w, l, normalize(l + r.v), r.v);
         }
     }
-    return clamp(acc, 0.0, 1.0);
+    return clamp_colour(acc);
 }
 #endif

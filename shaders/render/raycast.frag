@@ -340,6 +340,6 @@ void main()
     if (old + taken < old) atomicAdd(st_samples_hi, 1u); // carry into the high word
     atomicMax(st_max_ray, taken);
     atomicAdd(st_rays, 1u);
-    o_color = clamp(acc, 0.0, 1.0);
+    o_color = vec4(clamp_colour(acc.rgb), clamp(acc.a, 0.0, 1.0));
     o_depth = depth;
 }

@@ -141,9 +141,9 @@ def slice_plane_shows_the_library_resample_and_follows_the_plane():
         entry = _mod("core.runtime").find_entry(bpy.path.abspath(ob.voxlight.filepath))
         look = _mod("params").look_kwargs(ob.voxlight)
         p = native.make_params(width=w, height=h, model=model, preset=look["preset"],
-                               window=look["window"], tf_rgba=look["tf_rgba"])
-        # the library's colours are display-referred: the image holds them scene-linear
-        want = _mod("render_hooks").display_to_linear(entry.renderer.render_slice(p, sq, "nearest"))
+                               window=look["window"], tf_rgba=look["tf_rgba"], color_space=look["color_space"])
+        # the slice is scene-linear, as the image holds it
+        want = entry.renderer.render_slice(p, sq, "nearest")
         # equal to float rounding: the add-on takes the plane and model from
         # the evaluated objects, this check from the originals, whose float
         # matrices may differ in the last bit (seen once: 6e-8 after a move)

@@ -251,7 +251,11 @@ def steps():
     yield from settled()
     after = capture.img
     change = np.abs(after[..., :3] - before[..., :3]).max(axis=2).mean()
-    check("orbit_changes_image", change > 0.01, "mean change %.4f" % change)
+    # (a frame left stale changes nothing: 0; the shading turning with the
+    # view changes the image by about 0.01 of the display range, less since
+    # the lit colour is scene-linear and encoded for display, which
+    # compresses the lit side's contrast)
+    check("orbit_changes_image", change > 0.004, "mean change %.4f" % change)
     check("refined_after_moving", rt.render_count >= n + 2 and moving_w < st.shown.width
           and st.shown.full,
           "renders %d -> %d, widths %d -> %d" % (n, rt.render_count, moving_w, st.shown.width))

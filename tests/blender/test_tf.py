@@ -87,7 +87,8 @@ def every_preset_round_trips_through_the_colorramp():
             wlo, whi, stops = vx.core.tf_fit.place(key, p.data_kind, stats)
             assert abs(p.window_low - wlo) < 1e-3 * max(1.0, abs(wlo)), (key, p.window_low, wlo)
             assert abs(p.window_high - whi) < 1e-3 * max(1.0, abs(whi)), (key, p.window_high, whi)
-            want = vx.core.tf_presets.stops_table(stops)
+            # the ramp holds the preset's (sRGB) colours scene-linear
+            want = vx.core.tf_presets.stops_table(vx.tf.preset_stops(stops))
             got = vx.tf.table(p)
             err = float(np.abs(got - want).max())
             assert err < 0.01, (key, err)
@@ -106,7 +107,8 @@ def every_preset_round_trips_through_the_colorramp():
             x = np.linspace(0.0, 1.0, len(lib_ct))
             ref = np.stack([np.interp((hu + 1000.0) / 3000.0, x, lib_ct[:, c])
                             for c in range(4)], 1)
-            assert float(np.abs(got - ref).max()) < 0.01
+            ref[:, :3] = vx.core.colour_space.srgb_to_linear(ref[:, :3])
+            assert float(np.abs(got - ref).max()) < 0.02, float(np.abs(got - ref).max())
 
 
 @test
@@ -212,6 +214,36 @@ def files_from_before_the_sobel8_default_keep_their_filter():
     assert old_default.voxlight.filter == "central", old_default.voxlight.filter
     assert chosen.voxlight.filter == "sobel26", chosen.voxlight.filter
     assert old_default.voxlight.tf_version == chosen.voxlight.tf_version == vx.tf.TF_VERSION
+
+
+@test
+def files_from_before_linear_colour_have_their_colours_decoded():
+    """Before tf_version 4 the library took the ramp's and the labels'
+    colours as display (sRGB) values; the add-on now renders scene-linear,
+    as Blender holds colours. A file from before opens with those colours
+    decoded, so it looks as it did; an unedited preset stays unedited."""
+    ob = _volume("v3_colours.nii.gz")
+    p = ob.voxlight
+    ramp = p.tf_texture.color_ramp
+    display = [tuple(e.color) for e in ramp.elements]
+    assert any(0.05 < c < 0.95 for rgba in display for c in rgba[:3]), display
+    lab = ob.voxlight_labels.labels.add()
+    lab.label_id, lab.color = 7, (0.5, 0.25, 1.0, 0.8)
+    p.tf_version = 3
+    p.tf_preset_signature = vx.tf.ramp_signature(ramp)  # the preset as loaded then
+    ob = u.reopen((ob,), "tf_v3.blend")[0]
+    p = ob.voxlight
+    assert p.tf_version == vx.tf.TF_VERSION
+    got = [tuple(e.color) for e in p.tf_texture.color_ramp.elements]
+    want = [vx.core.colour_space.rgba_to_linear(c) for c in display]
+    assert np.abs(np.array(got) - np.array(want)).max() < 1e-6, (got, want)
+    assert vx.tf.preset_state(p)[1] is False  # still the unedited preset
+    c = tuple(ob.voxlight_labels.labels[0].color)
+    assert np.abs(np.array(c) - np.array((0.2140, 0.0508, 1.0, 0.8))).max() < 1e-3, c
+    # opening it again changes nothing more
+    ob = u.reopen((ob,), "tf_v4.blend")[0]
+    again = [tuple(e.color) for e in ob.voxlight.tf_texture.color_ramp.elements]
+    assert np.abs(np.array(again) - np.array(got)).max() == 0
 
 
 @test

@@ -168,6 +168,8 @@ class VOXLIGHT_PT_volume_tf(_VolumePanel, bpy.types.Panel):
         col.prop(p, "window_high", text="High")
         layout.operator("voxlight.tf_fit_window", icon="FULLSCREEN_EXIT")
         _split(layout).prop(p, "opacity_scale")
+        if _components(p) >= 3:  # a colour volume: its own colour or the ramp's
+            _split(layout).prop(p, "color_source")
 
 
 class VOXLIGHT_PT_volume_rendering(_VolumePanel, bpy.types.Panel):
@@ -252,6 +254,12 @@ class VOXLIGHT_PT_volume_advanced(_VolumePanel, bpy.types.Panel):
 # -------------------------------------------------------------- statistics
 
 stats_drawn = []  # (object name, frame kind) the Statistics header showed last (tests)
+
+
+def _components(p):
+    """1 for a grey volume, 3 or 4 for a colour one; 1 while not loaded."""
+    entry = runtime.find_entry(bpy.path.abspath(p.filepath), p.series)
+    return entry.info.get("components", 1) if entry is not None else 1
 
 
 def _last_frame(p):

@@ -41,6 +41,7 @@ def look_kwargs(props, fast=False, dragging=False):
         # scene-linear, and so is the image F12 composites; the viewport
         # encodes it for display (viewport.py).
         color_space="linear",
+        color_source=props.color_source,
         filter=props.filter,
         sample_distance=props.sample_distance,
         reuse_gradients=props.reuse_gradients,

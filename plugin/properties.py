@@ -273,6 +273,14 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     window_high: FloatProperty(name="High", default=1.0, update=tag_redraw,
                                description="The data value at the ramp's right end: higher "
                                            "values take the rightmost colour")
+    color_source: EnumProperty(
+        name="Colour", default="auto", update=tag_redraw,
+        items=[("auto", "Data", "A colour volume's own colour (RGB, RGBA) at each sample; the "
+                                "transfer function gives the opacity"),
+               ("tf", "Transfer Function", "The ramp's colour, as for a grey volume: the colour "
+                                           "volume shows its opacity source")],
+        description="Where the colour of a colour volume (RGB, RGBA) comes from; grey volumes "
+                    "always take the ramp's")
     opacity_scale: FloatProperty(name="Opacity", default=1.0, min=0.0, soft_max=4.0, max=100.0,
                                  description="Makes the whole volume more (above 1) or less "
                                              "(below 1) opaque",

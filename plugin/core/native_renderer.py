@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from .native_abi import (COLOR_SPACES, LABEL_BOUNDARIES, Environment, LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
+from .native_abi import (COLOR_SOURCES, COLOR_SPACES, LABEL_BOUNDARIES, Environment, LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
                          RendererInfo, RendererOptions, SceneShadows, VoxlightError, matrix_from_cm, _fptr,
                          _matrix_cm, _sized)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct
@@ -47,7 +47,7 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 shading_model=0, ambient_occlusion=0.0, occlusion_strength=0.0, anisotropy=0.0,
                 illumination_size=0, mode="dvr", matcap=None, matcap_key=0, cutaway=None,
                 scene_shadows=None, labels=None, overlays=None, minip_floor=None, environment=None,
-                color_space="display", lib=None):
+                color_space="display", color_source="auto", lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -74,7 +74,9 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     bottom; strength; rotation_deg about world +Z) as world_light.Environment
     gives it, or None. `color_space` is "display" (sRGB-encoded colours
     in and out, as the CLI's PNGs) or "linear" (scene-linear, Blender's and
-    Cycles' colours: the add-on's), or VXL_COLOR_SPACE_*."""
+    Cycles' colours: the add-on's), or VXL_COLOR_SPACE_*. `color_source`
+    says where a colour volume's colour comes from: "auto" (its own RGB;
+    the table's for a grey volume), "data" or "tf" (COLOR_SOURCES)."""
     lib = lib or load_library()
     p = _sized(RenderParams)
     p.width, p.height = int(width), int(height)
@@ -117,6 +119,7 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
         p.tf_size = len(tf)
         p.tf_rgba = _fptr(tf)
     p.color_space = color_space if isinstance(color_space, int) else COLOR_SPACES.index(color_space)
+    p.color_source = color_source if isinstance(color_source, int) else COLOR_SOURCES.index(color_source)
     p.classify = classify if isinstance(classify, int) else lib.index("classify", classify)
     p.gradient_opacity = (gradient_opacity if isinstance(gradient_opacity, int)
                           else lib.index("gradient_opacity", gradient_opacity))

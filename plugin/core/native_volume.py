@@ -9,8 +9,8 @@ import os
 
 import numpy as np
 
-from .native_abi import (PROGRESS_CALLBACK, DicomSeries, GridInfo, GridParams, LabelEntry, LibraryObject,
-                         LoadOptions, PhantomDesc, VolumeDesc, VolumeInfo, VoxlightError, matrix_from_cm,
+from .native_abi import (OPACITY_SOURCES, PROGRESS_CALLBACK, DicomSeries, GridInfo, GridParams, LabelEntry,
+                         LibraryObject, LoadOptions, PhantomDesc, VolumeDesc, VolumeInfo, VoxlightError, matrix_from_cm,
                          _DTYPES, _fptr, _sized)
 from .native_library import load_library
 
@@ -173,6 +173,10 @@ class Volume(LibraryObject):
             "bytes_read": info.bytes_read,
             # what the reader decided rather than read ("PixelSpacing missing: 1 mm assumed"); "" if nothing
             "notes": info.notes.decode("utf-8", "replace"),
+            # 1 grey; 3 RGB, 4 RGBA: a colour volume, whose scalar is its opacity source
+            "components": max(1, int(info.components)),
+            "opacity_source": OPACITY_SOURCES[info.opacity_source]
+            if info.opacity_source < len(OPACITY_SOURCES) else str(info.opacity_source),
         }
 
     def histogram(self, bins=32, lo=None, hi=None):

@@ -11,10 +11,13 @@ _CODES = {np.dtype(np.uint8): 2, np.dtype(np.int16): 4, np.dtype(np.int32): 8,
           np.dtype(np.uint16): 512, np.dtype(np.uint32): 768}
 
 
-def nifti1_bytes(data, affine=None, scl_slope=0.0, scl_inter=0.0):
+def nifti1_bytes(data, affine=None, scl_slope=0.0, scl_inter=0.0, rgb=False):
     """data indexed [i, j, k]; affine 4x4 voxel -> mm (sform); default
-    diag(1) at the origin."""
+    diag(1) at the origin. rgb: data is uint8 [i, j, k, 3], written as
+    NIfTI's RGB24 (datatype 128, the colour of each voxel interleaved)."""
     data = np.asarray(data)
+    if rgb:
+        return _rgb24_bytes(np.asarray(data, np.uint8), affine)
     if data.dtype not in _CODES:
         data = data.astype(np.float32)
     data = data.astype(data.dtype.newbyteorder("<"))
@@ -33,6 +36,16 @@ def nifti1_bytes(data, affine=None, scl_slope=0.0, scl_inter=0.0):
         struct.pack_into("<4f", hdr, 280 + 16 * r, *aff[r])
     hdr[344:348] = b"n+1\0"
     return bytes(hdr) + np.asfortranarray(data).tobytes(order="F")
+
+
+def _rgb24_bytes(rgb, affine):
+    if rgb.ndim != 4 or rgb.shape[3] != 3:
+        raise ValueError("RGB24 data is [i, j, k, 3], got %r" % (rgb.shape,))
+    grey = nifti1_bytes(np.zeros(rgb.shape[:3], np.uint8), affine)
+    hdr = bytearray(grey[:352])
+    struct.pack_into("<hh", hdr, 70, 128, 24)  # DT_RGB24, 24 bits per voxel
+    # i fastest, the three bytes of a voxel together
+    return bytes(hdr) + np.ascontiguousarray(rgb.transpose(2, 1, 0, 3)).tobytes()
 
 
 def write_nifti(path, data, affine=None, **kw):

@@ -43,6 +43,7 @@ static const char usage_format[] =
     "                   [--hide-labels ID,...] [--label-opacity ID:ALPHA,...]]\n"
     "                  [--overlay FILE[:PRESET][:LO:HI] [--overlay-blend over|add|max] [--overlay-opacity X]]...\n"
     "                  [--color-source auto|data|tf] [--opacity-source luminance|alpha|channel:N]\n"
+    "                  [--color-space display|linear]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID] [--streaming MODE] [--cache-dir DIR]\n"
     "                  [--opacity-source luminance|alpha|channel:N]\n"
     "  voxlight labels FILE   (a label lookup table: FreeSurfer LUT, ITK-SNAP, Slicer .ctbl, MRIcron .lut/.txt)\n"
@@ -561,6 +562,7 @@ static int cmd_render(int argc, char **argv)
     const double t0 = vxl_monotonic_s();
     if (vxl_render(r, &a.p, rgba, depth)) { die("%s", vxl_renderer_error(r)); goto done; }
     const double t1 = vxl_monotonic_s();
+    vxl_cli_colour_for_output(&a.p, a.output, rgba, (size_t)w * h);
     if (vxl_write_image(a.output, rgba, depth, w, h)) { die("%s", vxl_last_error()); goto done; }
     vxl_renderer_info ri = {.struct_size = sizeof ri};
     vxl_renderer_get_info(r, &ri);

@@ -108,3 +108,27 @@ def test_alpha_of_rgb_and_data_colour_of_grey_are_clean_errors(rgb, tmp_path):
     grey = tmp_path / "grey.nii"
     write_nifti(grey, np.full((4, 4, 4), 100, np.uint8))
     assert_clean_error(run("render", grey, "-o", tmp_path / "y.png", "--color-source", "data"), "no colour")
+
+
+def test_color_space_linear_decodes_the_data_and_writes_display_png(tmp_path):
+    """--color-space linear: the file's sRGB bytes are decoded, the image is
+    scene-linear, and a PNG gets it encoded again: an opaque orange voxel
+    comes back as its own bytes. A lit render differs (the light is linear
+    there); a bad name is a clean error."""
+    rgb = np.zeros((N, N, N, 3), np.uint8)
+    rgb[...] = (200, 90, 30)
+    path = tmp_path / "orange.nii"
+    write_rgb_nifti(path, rgb)
+    for space in ("display", "linear"):
+        px = centre(path, "--color-space", space)
+        assert abs(int(px[0]) - 200) <= 1 and abs(int(px[1]) - 90) <= 1 and abs(int(px[2]) - 30) <= 1, (space, px)
+    cube_path = tmp_path / "cube.nii"
+    write_rgb_nifti(cube_path, np.ascontiguousarray(cube()[..., :3]))
+    lit = []
+    for space in ("display", "linear"):
+        out = tmp_path / ("lit_%s.png" % space)
+        res = run("render", cube_path, "-o", out, "--size", "24x24", "--color-space", space, "--no-jitter")
+        assert res.returncode == 0, res.stderr
+        lit.append(png_rgba(out).astype(int))
+    assert np.abs(lit[0] - lit[1]).max() > 3
+    assert_clean_error(run("render", path, "-o", tmp_path / "x.png", "--color-space", "srgb"), "--color-space", "linear")

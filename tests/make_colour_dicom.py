@@ -2,6 +2,7 @@
 a writer independent of dcmtk and of our decoders.
 
 usage: make_colour_dicom.py OUT rgb|rgb-planar|ybr|ybr422|j2k|palette|palette8
+       make_colour_dicom.py FOLDER series
 
 Pixel (i, j) of frame k is R = (40 i + 10 k) % 256, G = (50 j + 30) % 256,
 B = (7 i j + k) % 256 (tests/test_dicom_frames.c computes the same), stored
@@ -12,6 +13,11 @@ transform (YBR_RCT), or as PALETTE COLOR: one index per pixel into red,
 green and blue tables of the pattern's distinct colours, 4096 16-bit
 entries from index 0 ("palette") or 8-bit entries packed two to a word
 from index 10 ("palette8").
+
+"series" writes frames 0, 1, 2 and 4 of the same pattern (frame 3 left out)
+as single-frame RGB files 2 mm apart into FOLDER, named in the reverse of
+their order along the normal and with InstanceNumber shuffled, so a reader
+must sort them by position and fill the missing slice.
 """
 import sys
 
@@ -24,10 +30,10 @@ from pydicom_util import encapsulated, j2k_frame, save
 COLS, ROWS, FRAMES = 8, 6, 2
 
 
-def rgb_frames():
+def rgb_frames(frames=FRAMES):
     j, i = np.mgrid[0:ROWS, 0:COLS]
     return [np.stack([(40 * i + 10 * k) % 256, (50 * j + 30) % 256, (7 * i * j + k) % 256], -1).astype(np.uint8)
-            for k in range(FRAMES)]
+            for k in range(frames)]
 
 
 def ycbcr(rgb):
@@ -39,7 +45,37 @@ def ycbcr(rgb):
     return np.clip(np.rint(np.stack([y, cb, cr], -1)), 0, 255).astype(np.uint8)
 
 
+def series(folder):
+    frames = rgb_frames(5)
+    series_uid, study_uid = generate_uid(), generate_uid()
+    for n, k in enumerate([0, 1, 2, 4]):
+        ds = base("1.2.840.10008.5.1.4.1.1.7")  # Secondary Capture, one frame a file
+        ds.StudyInstanceUID, ds.SeriesInstanceUID = study_uid, series_uid
+        ds.Rows, ds.Columns, ds.SamplesPerPixel, ds.PlanarConfiguration = ROWS, COLS, 3, 0
+        ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 8, 8, 7, 0
+        ds.PixelSpacing, ds.SliceThickness = [1, 1], 2
+        ds.ImagePositionPatient, ds.ImageOrientationPatient = [0, 0, 2 * k], [1, 0, 0, 0, 1, 0]
+        ds.InstanceNumber = [3, 1, 4, 2][n]
+        ds.PhotometricInterpretation = "RGB"
+        ds.PixelData = frames[k].tobytes()
+        save(ds, "%s/IM%d.dcm" % (folder, 9 - n))
+
+
+def base(sop_class):
+    meta = FileMetaDataset()
+    meta.MediaStorageSOPClassUID = sop_class
+    meta.MediaStorageSOPInstanceUID = generate_uid()
+    meta.TransferSyntaxUID = ExplicitVRLittleEndian
+    ds = Dataset()
+    ds.file_meta = meta
+    ds.SOPClassUID, ds.SOPInstanceUID = meta.MediaStorageSOPClassUID, meta.MediaStorageSOPInstanceUID
+    ds.Modality = "OT"
+    return ds
+
+
 def main(out, mode):
+    if mode == "series":
+        return series(out)
     meta = FileMetaDataset()
     meta.MediaStorageSOPClassUID = "1.2.840.10008.5.1.4.1.1.7.3"  # Multi-frame True Color Secondary Capture
     meta.MediaStorageSOPInstanceUID = generate_uid()

@@ -3,6 +3,7 @@ a writer independent of dcmtk and of our decoders.
 
 usage: make_colour_dicom.py OUT rgb|rgb-planar|ybr|ybr422|j2k|palette|palette8
        make_colour_dicom.py FOLDER series
+       make_colour_dicom.py FOLDER raw RAW COLS ROWS SLICES
 
 Pixel (i, j) of frame k is R = (40 i + 10 k) % 256, G = (50 j + 30) % 256,
 B = (7 i j + k) % 256 (tests/test_dicom_frames.c computes the same), stored
@@ -18,6 +19,12 @@ from index 10 ("palette8").
 as single-frame RGB files 2 mm apart into FOLDER, named in the reverse of
 their order along the normal and with InstanceNumber shuffled, so a reader
 must sort them by position and fill the missing slice.
+
+"raw" writes the RGB voxels of the file RAW (8 bits a sample, R G B of a
+voxel together, x fastest, then y, then z) as single-frame RGB files, slice
+k at z = k mm with 1 mm pixels, oriented so that voxel (i, j, k) lands at
+RAS (i, j, k) as a reader turns DICOM's LPS into RAS: the same affine as a
+NIfTI without transforms.
 """
 import sys
 
@@ -61,6 +68,24 @@ def series(folder):
         save(ds, "%s/IM%d.dcm" % (folder, 9 - n))
 
 
+def from_raw(folder, raw, cols, rows, slices):
+    with open(raw, "rb") as f:
+        data = np.frombuffer(f.read(), np.uint8).reshape(slices, rows, cols, 3)
+    series_uid, study_uid = generate_uid(), generate_uid()
+    for k in range(slices):
+        ds = base("1.2.840.10008.5.1.4.1.1.7")
+        ds.StudyInstanceUID, ds.SeriesInstanceUID = study_uid, series_uid
+        ds.Rows, ds.Columns, ds.SamplesPerPixel, ds.PlanarConfiguration = rows, cols, 3, 0
+        ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 8, 8, 7, 0
+        ds.PixelSpacing, ds.SliceThickness = [1, 1], 1
+        # LPS: rows along -x, columns along -y (RAS +x, +y), slices along +z
+        ds.ImagePositionPatient, ds.ImageOrientationPatient = [0, 0, k], [-1, 0, 0, 0, -1, 0]
+        ds.InstanceNumber = k + 1
+        ds.PhotometricInterpretation = "RGB"
+        ds.PixelData = data[k].tobytes()
+        save(ds, "%s/IM%04d.dcm" % (folder, k))
+
+
 def base(sop_class):
     meta = FileMetaDataset()
     meta.MediaStorageSOPClassUID = sop_class
@@ -76,6 +101,8 @@ def base(sop_class):
 def main(out, mode):
     if mode == "series":
         return series(out)
+    if mode == "raw":
+        return from_raw(out, sys.argv[3], *map(int, sys.argv[4:7]))
     meta = FileMetaDataset()
     meta.MediaStorageSOPClassUID = "1.2.840.10008.5.1.4.1.1.7.3"  # Multi-frame True Color Secondary Capture
     meta.MediaStorageSOPInstanceUID = generate_uid()

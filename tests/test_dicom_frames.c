@@ -539,6 +539,42 @@ TEST(colour_series_is_sorted_and_its_missing_slice_blended)
     vxl_volume_destroy(v);
 }
 
+/* An enhanced multi-frame RGB file, frames shuffled, 2 time points: each
+ * time point a colour volume whose slices come out in the order (and with
+ * the affine) the grey file of the same geometry gets. */
+TEST(enhanced_colour_frames_follow_the_slice_plan)
+{
+    char dir[256], grey[512], rgb[512];
+    dicom_folder(g_dir, dir, sizeof dir, "enhanced_rgb");
+    snprintf(grey, sizeof grey, "%s/grey.dcm", dir);
+    snprintf(rgb, sizeof rgb, "%s/rgb.dcm", dir);
+    REQUIRE(write_enhanced(grey, 2, 11, "") == 0 && write_enhanced(rgb, 2, 13, "rgb") == 0);
+    for (uint32_t t = 0; t < 2; t++) {
+        vxl_volume *g = load_dicom(grey, NULL, t), *v = load_dicom(rgb, NULL, t);
+        CHECKF(g && v && v->colour && v->components == 3 && v->frame_count == 2, "time %u: %s", t,
+               v ? "not a colour volume of 2 frames" : vxl_last_error());
+        if (!g || !v || !v->colour) {
+            vxl_volume_destroy(g);
+            vxl_volume_destroy(v);
+            continue;
+        }
+        CHECK(!memcmp(v->dims, g->dims, sizeof v->dims) && same_affine(g, v));
+        double worst = 0;
+        for (uint32_t s = 0; s < v->dims[2]; s++)
+            for (int j = 0; j < R; j++)
+                for (int i = 0; i < C; i++) {
+                    const uint64_t at = (uint64_t)i + C * (j + (uint64_t)R * s);
+                    /* the grey file's value says which slice k landed here */
+                    const int k = (int)lround((voxel(g, at) + 1024 - 1000.0 * t - 10 * j - i) / 100);
+                    const int want[3] = {(10 * j + i) % 256, (40 * k + 5) % 256, (90 * (int)t + 7 * k) % 256};
+                    for (int c = 0; c < 3; c++) worst = fmax(worst, fabs((double)v->colour[3 * at + c] - want[c]));
+                }
+        CHECKF(worst == 0, "time %u: colour off by %g", t, worst);
+        vxl_volume_destroy(g);
+        vxl_volume_destroy(v);
+    }
+}
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/vxl_dicom_frames_XXXXXX");
@@ -555,6 +591,7 @@ int main(void)
     RUN(colour_in_every_encoding_loads_as_colour);
     RUN(colour_dicom_opacity_source_is_the_load_option);
     RUN(colour_series_is_sorted_and_its_missing_slice_blended);
+    RUN(enhanced_colour_frames_follow_the_slice_plan);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

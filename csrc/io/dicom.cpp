@@ -14,8 +14,8 @@
 // Colour (RGB, YBR_*, PALETTE COLOR, decoded to RGB) goes the same way with
 // three samples a pixel into vxl_volume_build_colour: a colour volume whose
 // scalar is the opacity source the options ask for (luminance by default);
-// colour has no rescale (PS3.3 C.7.6.16.2.11.1.1: the Modality LUT is grey
-// only).
+// colour has no rescale (the Modality LUT, PS3.3 C.11.1, is for grey
+// images only).
 // What the reader decided (a localizer left out, 1 mm assumed, slices
 // interpolated) goes to vxl_volume.notes.
 //

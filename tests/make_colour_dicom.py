@@ -1,7 +1,7 @@
 """Writes one colour DICOM file (two frames, 8 bits a sample) with pydicom,
 a writer independent of dcmtk and of our decoders.
 
-usage: make_colour_dicom.py OUT rgb|rgb-planar|ybr|ybr422|j2k|palette|palette8
+usage: make_colour_dicom.py OUT rgb|rgb-planar|ybr|ybr422|j2k|htj2k|htj2k-rpcl|palette|palette8
        make_colour_dicom.py FOLDER series
        make_colour_dicom.py FOLDER raw RAW COLS ROWS SLICES
 
@@ -10,7 +10,9 @@ B = (7 i j + k) % 256 (tests/test_dicom_frames.c computes the same), stored
 as RGB (samples of a pixel together, or as planes), as full-range YCbCr
 (YBR_FULL; YBR_FULL_422 with the chroma of each two pixels averaged), or as
 JPEG 2000 frames from opj_compress, which applies its reversible colour
-transform (YBR_RCT), or as PALETTE COLOR: one index per pixel into red,
+transform (YBR_RCT), or as HTJ2K frames from pip's imagecodecs (OpenJPH,
+the same transform) under 1.2.840.10008.1.2.4.203 (HTJ2K) or .202 (HTJ2K
+with RPCL Options), or as PALETTE COLOR: one index per pixel into red,
 green and blue tables of the pattern's distinct colours, 4096 16-bit
 entries from index 0 ("palette") or 8-bit entries packed two to a word
 from index 10 ("palette8").
@@ -32,7 +34,7 @@ import numpy as np
 from pydicom.dataset import Dataset, FileMetaDataset
 from pydicom.uid import ExplicitVRLittleEndian, generate_uid
 
-from pydicom_util import encapsulated, j2k_frame, save
+from pydicom_util import encapsulated, htj2k_frame, j2k_frame, save, save_htj2k
 
 COLS, ROWS, FRAMES = 8, 6, 2
 
@@ -140,6 +142,11 @@ def main(out, mode):
         ds.PhotometricInterpretation = "YBR_RCT"
         ppm = [b"P6\n%d %d\n255\n" % (COLS, ROWS) + f.tobytes() for f in frames]
         encapsulated(ds, [j2k_frame(p) for p in ppm], "1.2.840.10008.1.2.4.90")
+    elif mode in ("htj2k", "htj2k-rpcl"):
+        ds.PhotometricInterpretation = "YBR_RCT"
+        ppm = [b"P6\n%d %d\n255\n" % (COLS, ROWS) + f.tobytes() for f in frames]
+        uid = "1.2.840.10008.1.2.4.203" if mode == "htj2k" else "1.2.840.10008.1.2.4.202"
+        return save_htj2k(ds, [htj2k_frame(p) for p in ppm], out, uid)
     elif mode in ("palette", "palette8"):
         ds.PhotometricInterpretation, ds.SamplesPerPixel = "PALETTE COLOR", 1
         del ds.PlanarConfiguration

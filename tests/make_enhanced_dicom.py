@@ -1,7 +1,7 @@
 """Writes one Enhanced CT file (multi-frame, functional groups) with pydicom,
 a writer independent of the dcmtk we read with and of our C test writer.
 
-usage: make_enhanced_dicom.py OUT COLS ROWS SLICES TIMES IOP(6) ORIGIN(3) STEP(3) SEED [j2k|stacks|rgb]
+usage: make_enhanced_dicom.py OUT COLS ROWS SLICES TIMES IOP(6) ORIGIN(3) STEP(3) SEED [j2k|htj2k|stacks|rgb]
 
 Frame (k, t): slice k at ORIGIN + k * STEP, time point t; pixel (i, j) holds
 1000 t + 100 k + 10 j + i, as tests/test_dicom_frames.c's single-frame copy
@@ -12,6 +12,9 @@ With stacks, the TIMES groups are stacks instead (StackID t + 1, no
 temporal index): one file holding several volumes. With j2k, each frame is a JPEG 2000 codestream from Debian's opj_compress
 (lossless, 2 resolution levels: the frames are small), encapsulated with a basic offset table (transfer syntax
 1.2.840.10008.1.2.4.90): an encoder independent of our decoder.
+With htj2k, the same frames are lossless HTJ2K codestreams from pip's
+imagecodecs (OpenJPH; tests/pydicom_util.py) under transfer syntax
+1.2.840.10008.1.2.4.201 (HTJ2K Lossless Only).
 With rgb, the frames are 8-bit RGB (samples of a pixel together) whose
 pixel (i, j) of frame (k, t) is R = (10 j + i) mod 256, G = (40 k + 5) mod
 256, B = (90 t + 7 k) mod 256, as tests/test_dicom_frames.c computes them.
@@ -25,7 +28,7 @@ from pydicom.dataset import Dataset, FileMetaDataset
 from pydicom.sequence import Sequence
 from pydicom.uid import ExplicitVRLittleEndian, generate_uid
 
-from pydicom_util import encapsulated, j2k_frame, save
+from pydicom_util import encapsulated, htj2k_frame, j2k_frame, save, save_htj2k
 
 
 def item(**kw):
@@ -93,6 +96,8 @@ def main(argv):
         else:
             pixels.append((1000 * t + 100 * k + 10 * j + i).astype("<u2"))
     ds.PerFrameFunctionalGroupsSequence = Sequence(per_frame)
+    if mode == "htj2k":
+        return save_htj2k(ds, [htj2k_frame(pgm(p)) for p in pixels], out)
     if mode == "j2k":  # JPEG 2000 Image Compression (Lossless Only)
         encapsulated(ds, [j2k_frame(pgm(p)) for p in pixels], "1.2.840.10008.1.2.4.90")
     else:

@@ -61,8 +61,8 @@ static int write_reference(const char *dir, int t)
     return 0;
 }
 
-/* The enhanced file (tests/make_enhanced_dicom.py) at path; codec "" or
- * "j2k" (frames from opj_compress). */
+/* The enhanced file (tests/make_enhanced_dicom.py) at path; codec "",
+ * "j2k" (frames from opj_compress), "htj2k" (pip's imagecodecs) or "rgb". */
 static int write_enhanced(const char *path, int times, int seed, const char *codec)
 {
     char cmd[1024];
@@ -93,7 +93,8 @@ static int same_affine(const vxl_volume *a, const vxl_volume *b)
 /* An enhanced CT whose frames are stored shuffled loads in anatomical order
  * with the affine the same slices get as single-frame files; dcmtk's
  * encoders compress the multi-frame file (one or several fragments per
- * frame, with and without a basic offset table) and it still loads the same. */
+ * frame, with and without a basic offset table), OpenJPEG's and OpenJPH's
+ * (JPEG 2000, HTJ2K) encode its frames, and it still loads the same. */
 TEST(enhanced_frames_in_shuffled_order_come_out_in_anatomical_order)
 {
     char ref_dir[256], dir[256], path[512];
@@ -133,6 +134,15 @@ TEST(enhanced_frames_in_shuffled_order_come_out_in_anatomical_order)
     REQUIRE(write_enhanced(path, 1, 5, "j2k") == 0);
     v = load_dicom(path, NULL, 0);
     CHECKF(v && same_volume(ref, v) && same_affine(ref, v), "j2k: %s", v ? "voxels or affine differ" : vxl_last_error());
+    vxl_volume_destroy(v);
+    /* HTJ2K Lossless (.201; pip's imagecodecs encodes, OpenJPEG decodes):
+     * dcmtk 3.6.7 does not know the syntax, the reader knows it by UID */
+    dicom_folder(g_dir, dir, sizeof dir, "enhanced_htj2k");
+    snprintf(path, sizeof path, "%s/htj2k.dcm", dir);
+    REQUIRE(write_enhanced(path, 1, 3, "htj2k") == 0);
+    v = load_dicom(path, NULL, 0);
+    CHECKF(v && same_volume(ref, v) && same_affine(ref, v), "htj2k: %s",
+           v ? "voxels or affine differ" : vxl_last_error());
     vxl_volume_destroy(v);
     vxl_volume_destroy(ref);
 }
@@ -407,8 +417,8 @@ static vxl_volume *load_with_opacity(const char *path, uint32_t source, uint32_t
 }
 
 /* Colour DICOM (RGB by pixel and by plane, YBR_FULL, YBR_FULL_422, JPEG
- * 2000 with its colour transform, and dcmtk's RLE, lossless JPEG, JPEG-LS
- * and Baseline of the RGB file; PALETTE COLOR with 16-bit and packed 8-bit
+ * 2000 and HTJ2K (.203 and .202) with their colour transform, and dcmtk's
+ * RLE, lossless JPEG, JPEG-LS and Baseline of the RGB file; PALETTE COLOR with 16-bit and packed 8-bit
  * tables, and its RLE) loads as a colour volume through the reader helper:
  * its RGB8 colour is the pattern, exactly where the encoding is lossless
  * and RGB or palette; within 2 of the YCbCr the writer rounded to 8 bits
@@ -432,6 +442,8 @@ TEST(colour_in_every_encoding_loads_as_colour)
         {"ybr", NULL, 2, 0, "DICOM YBR_FULL: colour from the data"},
         {"ybr422", NULL, 0, 1, "DICOM YBR_FULL_422: colour from the data"},
         {"j2k", NULL, 0, 0, "DICOM YBR_RCT: colour from the data"},
+        {"htj2k", NULL, 0, 0, "DICOM YBR_RCT: colour from the data"},
+        {"htj2k-rpcl", NULL, 0, 0, "DICOM YBR_RCT: colour from the data"},
         {"rgb", "dcmcrle", 0, 0, "DICOM RGB: colour"},
         {"rgb-planar", "dcmcrle", 0, 0, "DICOM RGB: colour"},
         {"rgb", "dcmcjpeg", 0, 0, "DICOM RGB: colour"},

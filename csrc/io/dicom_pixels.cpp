@@ -46,7 +46,7 @@ Codec codec_of(const Image &im)
     // our lossless JPEG decoder is grey only; dcmtk's takes colour
     if (im.xs == EXS_JPEGProcess14 || im.xs == EXS_JPEGProcess14SV1)
         return im.samples == 1 ? Codec::jpeg_lossless : Codec::dcmtk;
-    if (im.xs == EXS_JPEG2000LosslessOnly || im.xs == EXS_JPEG2000) return Codec::j2k;
+    if (im.xs == EXS_JPEG2000LosslessOnly || im.xs == EXS_JPEG2000 || im.htj2k) return Codec::j2k;
     if (im.xs == EXS_JPEGProcess1 || im.xs == EXS_JPEGProcess2_4 || im.xs == EXS_JPEGLSLossless ||
         im.xs == EXS_JPEGLSLossy)
         return Codec::dcmtk;
@@ -143,8 +143,13 @@ int fragments_of(const Image &s, DcmElement *el, Fragments &fr, vxl_err *e)
 {
     const char *p = s.path.c_str();
     DcmPixelSequence *seq = nullptr;
+    // the fragments are kept under the syntax the data set was read with:
+    // for one dcmtk does not know (HTJ2K on 3.6.7), not s.xs
+    E_TransferSyntax held = s.xs;
+    const DcmRepresentationParameter *param = nullptr;
+    if (el->ident() == EVR_PixelData && s.htj2k) static_cast<DcmPixelData *>(el)->getOriginalRepresentationKey(held, param);
     if (el->ident() != EVR_PixelData ||
-        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(s.xs, nullptr, seq).bad() || !seq ||
+        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(held, param, seq).bad() || !seq ||
         seq->card() < 1)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': compressed PixelData holds no fragments", p);
     uint64_t at = 0;

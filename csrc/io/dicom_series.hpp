@@ -49,6 +49,7 @@ struct Image {
     unsigned rows = 0, cols = 0, bits_alloc = 0, bits_stored = 0, pixel_rep = 0, samples = 1;
     unsigned planar = 0; // PlanarConfiguration of colour: 0 samples of a pixel together, 1 planes
     bool has_ipp = false, has_iop = false, has_spacing = false, encapsulated = false;
+    bool htj2k = false; // HTJ2K (1.2.840.10008.1.2.4.201-.203), known by its UID: dcmtk 3.6.7 does not know it
     E_TransferSyntax xs = EXS_Unknown;
     std::string xfer; // the transfer syntax's name, for messages
     double ipp[3] = {0, 0, 0}, iop[6] = {1, 0, 0, 0, 1, 0}, ps[2] = {1, 1};

@@ -147,7 +147,8 @@ int fragments_of(const Image &s, DcmElement *el, Fragments &fr, vxl_err *e)
     // for one dcmtk does not know (HTJ2K on 3.6.7), not s.xs
     E_TransferSyntax held = s.xs;
     const DcmRepresentationParameter *param = nullptr;
-    if (el->ident() == EVR_PixelData && s.htj2k) static_cast<DcmPixelData *>(el)->getOriginalRepresentationKey(held, param);
+    if (el->ident() == EVR_PixelData && s.htj2k)
+        static_cast<DcmPixelData *>(el)->getOriginalRepresentationKey(held, param);
     if (el->ident() != EVR_PixelData ||
         static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(held, param, seq).bad() || !seq ||
         seq->card() < 1)

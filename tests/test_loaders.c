@@ -564,7 +564,7 @@ TEST(numbered_series_and_folders_of_png_and_tiff)
  * its rows flipped (voxel j up) like grey stacks, the opacity source the
  * caller asked for (alpha: its values exactly), the 16-bit colour windowed
  * into 8 bits over the R, G and B range with a note, and its 3 bytes a
- * voxel charged to the budget. */
+ * voxel charged to the budget; 5 channels read as RGB with a note. */
 TEST(rgba_tiff_stack_is_a_colour_volume)
 {
     char p[256];
@@ -607,6 +607,16 @@ TEST(rgba_tiff_stack_is_a_colour_volume)
     CHECK(load(p, &opt, &v) == VXL_ERR_INVALID_ARGUMENT && !v);
     CHECKF(strstr(vxl_last_error(), "opacity source alpha needs RGBA data; this has 3 channels"), "%s",
            vxl_last_error());
+    /* 5 channels (microscopy): OpenImageIO takes the 4th for alpha when no
+     * ExtraSamples say otherwise, so RGBA, and the 5th left out, said */
+    uint8_t five[SW * SH * 5];
+    for (int i = 0; i < SW * SH * 5; i++) five[i] = (uint8_t)(i * 3);
+    REQUIRE(tw_write_tiff(tmp(p, sizeof p, "five.tif"), SW, SH, 1, 5, 8, 1, five) == 0);
+    CHECKF(load(p, NULL, &v) == VXL_OK && v->components == 4 && v->colour && v->colour[0] == five[5 * SW * (SH - 1)] &&
+               strstr(v->notes, "channel 5 of 5 left out"),
+           "%s", v ? v->notes : vxl_last_error());
+    vxl_volume_destroy(v);
+    v = NULL;
     /* 4x3x1 RGB8: 36 raw bytes, 48 once built (a byte of scalar and 3 of colour a voxel) */
     vxl_load_options small = {.struct_size = sizeof small, .memory_budget_bytes = 40};
     CHECK(load(p, &small, &v) == VXL_ERR_LIMIT && !v);

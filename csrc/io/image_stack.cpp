@@ -10,7 +10,8 @@
 // our voxel j axis points up. Images carry no reliable geometry, so the
 // affine is diag(voxel size) from vxl_load_options.voxel_size (1 mm when
 // unset). Pixel types: 8/16/32-bit integers, half/float/double. RGB and
-// RGBA images (3 or more channels: the first 3 or 4) make a colour volume
+// RGBA images (3 or more channels: the first 3, or 4 when the 4th is alpha
+// or there are exactly 4; the rest left out with a note) make a colour volume
 // (colour_volume.h: the scalar is the opacity source, luminance by default,
 // beside the RGB8 colour), grey+alpha the grey channel.
 //
@@ -367,7 +368,9 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
                 dims[0] = static_cast<uint32_t>(spec.width);
                 dims[1] = static_cast<uint32_t>(spec.height);
                 nch = spec.nchannels;
-                nread = nch >= 4 ? 4 : nch >= 3 ? 3 : 1;
+                // RGBA: 4 channels, or more whose 4th is the image's alpha;
+                // further channels (microscopy's) are left out with a note
+                nread = nch >= 3 ? (nch == 4 || spec.alpha_channel == 3 ? 4 : 3) : 1;
                 first = name;
                 uint64_t nbytes = 0;
                 rc = nread > 1 ? vxl_plan_colour_voxels(path, dims, dtype, uint32_t(nread), opt, &nbytes, e)
@@ -409,6 +412,9 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
         else
             rc = vxl_volume_build(raw.data(), dtype, dims, vs, nullptr, 0.0, 0.0, opt, out, &inner);
         if (rc) return vxl_fail_in(e, path, &inner);
+        if (nread > 1 && nch == nread + 1) vxl_volume_note(*out, "channel %d of %d left out", nch, nch);
+        else if (nread > 1 && nch > nread)
+            vxl_volume_note(*out, "channels %d to %d of %d left out", nread + 1, nch, nch);
         return VXL_OK;
     } catch (const std::bad_alloc &) {
         // the helper's address-space cap (helper_main.c) turns an absurd

@@ -134,8 +134,24 @@ portable_cc() {
     echo "$ROOT/$dir/bin/python -m ziglang cc -target x86_64-linux-gnu.2.28 -mcpu=x86_64 -idirafter /usr/include -idirafter /usr/include/$(cc -print-multiarch)"
 }
 
+# HTJ2K test frames (DICOM 1.2.840.10008.1.2.4.201-.203): no Debian tool
+# encodes the HT block coder, so the tests' writers hand frames to pip's
+# imagecodecs (OpenJPH inside) in a venv of its own, apart from the system's
+# numpy and pydicom that the writers themselves use (tests/pydicom_util.py).
+IMAGECODECS_VERSION=2026.3.6
+htj2k_encoder() {
+    local dir=build/imagecodecs py
+    if ! "$dir/bin/python" -c "import imagecodecs, sys; sys.exit(imagecodecs.__version__ != '$IMAGECODECS_VERSION')" 2>/dev/null; then
+        py=$(find_python 3.11 || find_python 3.13 || find_python "$(python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])')") || return 1
+        rm -rf "$dir"
+        "$py" -m venv "$dir" >&2 && "$dir/bin/python" -m pip install -q --disable-pip-version-check "imagecodecs==$IMAGECODECS_VERSION" >&2 || return 1
+    fi
+}
+
 build() {
     local lib_cc
+    # without it the HTJ2K tests fail, naming the missing encoder
+    htj2k_encoder || echo "build.sh: pip's imagecodecs $IMAGECODECS_VERSION (the HTJ2K test encoder) is unavailable" >&2
     if ! lib_cc=$(portable_cc); then
         # still a working build for this machine; tests/cli/test_library_deps.py then fails
         echo "build.sh: zig (pip's ziglang $ZIG_VERSION) is unavailable: the library is built for this glibc only" >&2

@@ -1,7 +1,7 @@
 """Writes one Enhanced CT file (multi-frame, functional groups) with pydicom,
 a writer independent of the dcmtk we read with and of our C test writer.
 
-usage: make_enhanced_dicom.py OUT COLS ROWS SLICES TIMES IOP(6) ORIGIN(3) STEP(3) SEED [j2k|stacks]
+usage: make_enhanced_dicom.py OUT COLS ROWS SLICES TIMES IOP(6) ORIGIN(3) STEP(3) SEED [j2k|htj2k|stacks|rgb]
 
 Frame (k, t): slice k at ORIGIN + k * STEP, time point t; pixel (i, j) holds
 1000 t + 100 k + 10 j + i, as tests/test_dicom_frames.c's single-frame copy
@@ -12,6 +12,12 @@ With stacks, the TIMES groups are stacks instead (StackID t + 1, no
 temporal index): one file holding several volumes. With j2k, each frame is a JPEG 2000 codestream from Debian's opj_compress
 (lossless, 2 resolution levels: the frames are small), encapsulated with a basic offset table (transfer syntax
 1.2.840.10008.1.2.4.90): an encoder independent of our decoder.
+With htj2k, the same frames are lossless HTJ2K codestreams from pip's
+imagecodecs (OpenJPH; tests/pydicom_util.py) under transfer syntax
+1.2.840.10008.1.2.4.201 (HTJ2K Lossless Only).
+With rgb, the frames are 8-bit RGB (samples of a pixel together) whose
+pixel (i, j) of frame (k, t) is R = (10 j + i) mod 256, G = (40 k + 5) mod
+256, B = (90 t + 7 k) mod 256, as tests/test_dicom_frames.c computes them.
 """
 
 import random
@@ -22,7 +28,7 @@ from pydicom.dataset import Dataset, FileMetaDataset
 from pydicom.sequence import Sequence
 from pydicom.uid import ExplicitVRLittleEndian, generate_uid
 
-from pydicom_util import encapsulated, j2k_frame, save
+from pydicom_util import encapsulated, htj2k_frame, j2k_frame, save, save_htj2k
 
 
 def item(**kw):
@@ -60,9 +66,13 @@ def main(argv):
     ds.SeriesInstanceUID = generate_uid()
     ds.InstanceNumber = 1
     ds.Rows, ds.Columns = rows, cols
+    mode = argv[18] if len(argv) > 18 else ""
     ds.SamplesPerPixel = 1
     ds.PhotometricInterpretation = "MONOCHROME2"
     ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 0
+    if mode == "rgb":
+        ds.SamplesPerPixel, ds.PlanarConfiguration, ds.PhotometricInterpretation = 3, 0, "RGB"
+        ds.BitsAllocated, ds.BitsStored, ds.HighBit = 8, 8, 7
     ds.NumberOfFrames = len(frames)
     ds.SharedFunctionalGroupsSequence = Sequence([item(
         PlaneOrientationSequence=Sequence([item(ImageOrientationPatient=iop)]),
@@ -72,7 +82,6 @@ def main(argv):
     )])
     per_frame, pixels = [], []
     j, i = np.mgrid[0:rows, 0:cols]
-    mode = argv[18] if len(argv) > 18 else ""
     for k, t in frames:
         content = item(StackID=str(t + 1) if mode == "stacks" else "1", InStackPositionNumber=k + 1)
         if times > 1 and mode != "stacks":
@@ -81,8 +90,14 @@ def main(argv):
             PlanePositionSequence=Sequence([item(ImagePositionPatient=[origin[a] + k * step[a] for a in range(3)])]),
             FrameContentSequence=Sequence([content]),
         ))
-        pixels.append((1000 * t + 100 * k + 10 * j + i).astype("<u2"))
+        if mode == "rgb":
+            rgb = [(10 * j + i) % 256, np.full_like(i, (40 * k + 5) % 256), np.full_like(i, (90 * t + 7 * k) % 256)]
+            pixels.append(np.stack(rgb, -1).astype(np.uint8))
+        else:
+            pixels.append((1000 * t + 100 * k + 10 * j + i).astype("<u2"))
     ds.PerFrameFunctionalGroupsSequence = Sequence(per_frame)
+    if mode == "htj2k":
+        return save_htj2k(ds, [htj2k_frame(pgm(p)) for p in pixels], out)
     if mode == "j2k":  # JPEG 2000 Image Compression (Lossless Only)
         encapsulated(ds, [j2k_frame(pgm(p)) for p in pixels], "1.2.840.10008.1.2.4.90")
     else:

@@ -3,7 +3,8 @@
  * functional groups, 4D) written by pydicom; classic multi-frame files; every
  * transfer syntax dcmtk's tools and pydicom's reference files give us
  * (implicit/explicit/big endian, deflated, RLE, JPEG Lossless, JPEG-LS
- * lossless and near-lossless, JPEG Baseline and Extended). Each encoding
+ * lossless and near-lossless, JPEG Baseline and Extended), colour among
+ * them as colour volumes. Each encoding
  * must load voxel for voxel as the uncompressed volume, or within the
  * codec's own bound for the lossy ones. The writers (pydicom, dcmtk's
  * dcmcrle/dcmcjpeg/dcmcjpls/dcmconv) are independent of our decoders. */
@@ -60,8 +61,8 @@ static int write_reference(const char *dir, int t)
     return 0;
 }
 
-/* The enhanced file (tests/make_enhanced_dicom.py) at path; codec "" or
- * "j2k" (frames from opj_compress). */
+/* The enhanced file (tests/make_enhanced_dicom.py) at path; codec "",
+ * "j2k" (frames from opj_compress), "htj2k" (pip's imagecodecs) or "rgb". */
 static int write_enhanced(const char *path, int times, int seed, const char *codec)
 {
     char cmd[1024];
@@ -92,7 +93,8 @@ static int same_affine(const vxl_volume *a, const vxl_volume *b)
 /* An enhanced CT whose frames are stored shuffled loads in anatomical order
  * with the affine the same slices get as single-frame files; dcmtk's
  * encoders compress the multi-frame file (one or several fragments per
- * frame, with and without a basic offset table) and it still loads the same. */
+ * frame, with and without a basic offset table), OpenJPEG's and OpenJPH's
+ * (JPEG 2000, HTJ2K) encode its frames, and it still loads the same. */
 TEST(enhanced_frames_in_shuffled_order_come_out_in_anatomical_order)
 {
     char ref_dir[256], dir[256], path[512];
@@ -132,6 +134,15 @@ TEST(enhanced_frames_in_shuffled_order_come_out_in_anatomical_order)
     REQUIRE(write_enhanced(path, 1, 5, "j2k") == 0);
     v = load_dicom(path, NULL, 0);
     CHECKF(v && same_volume(ref, v) && same_affine(ref, v), "j2k: %s", v ? "voxels or affine differ" : vxl_last_error());
+    vxl_volume_destroy(v);
+    /* HTJ2K Lossless (.201; pip's imagecodecs encodes, OpenJPEG decodes):
+     * dcmtk 3.6.7 does not know the syntax, the reader knows it by UID */
+    dicom_folder(g_dir, dir, sizeof dir, "enhanced_htj2k");
+    snprintf(path, sizeof path, "%s/htj2k.dcm", dir);
+    REQUIRE(write_enhanced(path, 1, 3, "htj2k") == 0);
+    v = load_dicom(path, NULL, 0);
+    CHECKF(v && same_volume(ref, v) && same_affine(ref, v), "htj2k: %s",
+           v ? "voxels or affine differ" : vxl_last_error());
     vxl_volume_destroy(v);
     vxl_volume_destroy(ref);
 }
@@ -340,33 +351,107 @@ TEST(lossy_codecs_stay_within_their_bounds)
     }
 }
 
-/* Luminance (Rec. 709) of tests/make_colour_dicom.py's pattern at (i, j)
- * of frame k, as the reader rounds it. */
-static double colour_luminance(int i, int j, int k)
+/* Channel c (0 R, 1 G, 2 B) of tests/make_colour_dicom.py's pattern at
+ * (i, j) of frame k. */
+static int pattern(int i, int j, int k, int c)
 {
-    const double r = (40 * i + 10 * k) % 256, g = (50 * j + 30) % 256, b = (7 * i * j + k) % 256;
-    return (double)lround(0.2126 * r + 0.7152 * g + 0.0722 * b);
+    return c == 0 ? (40 * i + 10 * k) % 256 : c == 1 ? (50 * j + 30) % 256 : (7 * i * j + k) % 256;
+}
+
+/* Full-range YCbCr of the pattern's pixel (PS3.3 C.7.6.3.1.2), rounded to
+ * 8 bits as tests/make_colour_dicom.py rounds it (numpy's rint: half to
+ * even, as nearbyint). */
+static double ycbcr(int i, int j, int k, int c)
+{
+    const double r = pattern(i, j, k, 0), g = pattern(i, j, k, 1), b = pattern(i, j, k, 2);
+    const double v = c == 0 ? 0.299 * r + 0.587 * g + 0.114 * b
+                   : c == 1 ? -0.168736 * r - 0.331264 * g + 0.5 * b + 128
+                            : 0.5 * r - 0.418688 * g - 0.081312 * b + 128;
+    return fmin(255, fmax(0, nearbyint(v)));
+}
+
+/* What YBR_FULL_422 of the pattern holds, back in RGB as the reader turns
+ * it: the pixel's own Y with the chroma its pair of pixels shares (their
+ * mean, rounded as the writer does), then PS3.3's inverse, rounded and
+ * clamped to 8 bits. The reference for the subsampled encodings. */
+static int pattern_422(int i, int j, int k, int c)
+{
+    const int i0 = i & ~1;
+    const double y = ycbcr(i, j, k, 0);
+    const double cb = nearbyint((ycbcr(i0, j, k, 1) + ycbcr(i0 + 1, j, k, 1)) / 2) - 128;
+    const double cr = nearbyint((ycbcr(i0, j, k, 2) + ycbcr(i0 + 1, j, k, 2)) / 2) - 128;
+    const double v = c == 0 ? y + 1.402 * cr : c == 1 ? y - 0.344136 * cb - 0.714136 * cr : y + 1.772 * cb;
+    return (int)lround(fmin(255, fmax(0, v)));
+}
+
+/* Largest channel difference of v's colour from the pattern (or from its
+ * 4:2:2 subsampling, subsampled), and of its scalar from the luminance of
+ * v's own colour (the opacity source as vxl_volume_build_colour rounds
+ * it); -1 when v is not an 8x6 RGB colour volume. */
+static double colour_error(const vxl_volume *v, int subsampled, double *scalar_error)
+{
+    if (!v || v->dims[0] != 8 || v->dims[1] != 6 || !v->colour || v->components != 3) return -1;
+    double worst = 0;
+    *scalar_error = 0;
+    for (uint32_t k = 0; k < v->dims[2]; k++)
+        for (int j = 0; j < 6; j++)
+            for (int i = 0; i < 8; i++) {
+                const uint64_t at = (uint64_t)i + 8 * j + 48 * k;
+                const uint8_t *rgb = v->colour + 3 * at;
+                for (int c = 0; c < 3; c++) {
+                    const int want = subsampled ? pattern_422(i, j, (int)k, c) : pattern(i, j, (int)k, c);
+                    worst = fmax(worst, fabs((double)rgb[c] - want));
+                }
+                const double lum = floor(0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] + 0.5);
+                *scalar_error = fmax(*scalar_error, fabs(voxel(v, at) - lum));
+            }
+    return worst;
+}
+
+/* The volume at path with an opacity source; NULL on failure. */
+static vxl_volume *load_with_opacity(const char *path, uint32_t source, uint32_t channel)
+{
+    vxl_load_options opt = {.struct_size = sizeof opt, .opacity_source = source, .opacity_channel = channel};
+    vxl_volume *v = NULL;
+    return vxl_volume_load(path, &opt, &v) == VXL_OK ? v : NULL;
 }
 
 /* Colour DICOM (RGB by pixel and by plane, YBR_FULL, YBR_FULL_422, JPEG
- * 2000 with its colour transform, and dcmtk's RLE, lossless JPEG, JPEG-LS
- * and Baseline of the RGB file; PALETTE COLOR with 16-bit and packed 8-bit
- * tables, and its RLE) loads as its luminance, with a note saying
- * so: exact where the encoding is lossless and RGB; within 1 of the
- * YCbCr the writer rounded; within 12 for YBR_FULL_422, whose two pixels
- * share one averaged chroma (measured 10 on this sharp pattern); within 24
- * for Baseline at quality 90 (measured 12). */
-TEST(colour_in_every_encoding_reads_as_its_luminance)
+ * 2000 and HTJ2K (.203 and .202) with their colour transform, and dcmtk's
+ * RLE, lossless JPEG, JPEG-LS and Baseline of the RGB file; PALETTE COLOR with 16-bit and packed 8-bit
+ * tables, and its RLE) loads as a colour volume through the reader helper:
+ * its RGB8 colour is the pattern, exactly where the encoding is lossless
+ * and RGB or palette; within 2 of the YCbCr the writer rounded to 8 bits
+ * (half a step in Y and in Cr is 1.2 in red before the reader rounds;
+ * measured 1); YBR_FULL_422 exactly as its shared chroma gives it
+ * (pattern_422); Baseline at quality 90, which subsamples chroma the same
+ * way, within 40 of that (measured 23: the pattern jumps by up to 220 from
+ * one pixel to the next where it wraps). The scalar is the colour's
+ * luminance (the default opacity source) and the note says what was
+ * decided. */
+TEST(colour_in_every_encoding_loads_as_colour)
 {
     static const struct {
         const char *mode, *tool; /* tool: a dcmtk encoder run on the mode's file, or NULL */
         double bound;
+        int subsampled; /* the encoding shares chroma between two pixels: held against pattern_422 */
+        const char *note;
     } cases[] = {
-        {"rgb", NULL, 0},           {"rgb-planar", NULL, 0},     {"ybr", NULL, 1},
-        {"ybr422", NULL, 12},       {"j2k", NULL, 0},            {"rgb", "dcmcrle", 0},
-        {"rgb-planar", "dcmcrle", 0}, {"rgb", "dcmcjpeg", 0},    {"rgb", "dcmcjpls", 0},
-        {"rgb", "dcmcjpeg +eb", 24}, {"palette", NULL, 0},     {"palette8", NULL, 0},
-        {"palette", "dcmcrle", 0},
+        {"rgb", NULL, 0, 0, "DICOM RGB: colour from the data"},
+        {"rgb-planar", NULL, 0, 0, "DICOM RGB: colour from the data"},
+        {"ybr", NULL, 2, 0, "DICOM YBR_FULL: colour from the data"},
+        {"ybr422", NULL, 0, 1, "DICOM YBR_FULL_422: colour from the data"},
+        {"j2k", NULL, 0, 0, "DICOM YBR_RCT: colour from the data"},
+        {"htj2k", NULL, 0, 0, "DICOM YBR_RCT: colour from the data"},
+        {"htj2k-rpcl", NULL, 0, 0, "DICOM YBR_RCT: colour from the data"},
+        {"rgb", "dcmcrle", 0, 0, "DICOM RGB: colour"},
+        {"rgb-planar", "dcmcrle", 0, 0, "DICOM RGB: colour"},
+        {"rgb", "dcmcjpeg", 0, 0, "DICOM RGB: colour"},
+        {"rgb", "dcmcjpls", 0, 0, "DICOM RGB: colour"},
+        {"rgb", "dcmcjpeg +eb", 40, 1, "DICOM YBR_FULL_422: colour"},
+        {"palette", NULL, 0, 0, "DICOM PALETTE COLOR: colour from the data, opacity and gradients from luminance"},
+        {"palette8", NULL, 0, 0, "DICOM PALETTE COLOR: colour"},
+        {"palette", "dcmcrle", 0, 0, "DICOM PALETTE COLOR: colour"},
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         char dir[256], path[512], cmd[1024], name[64];
@@ -381,22 +466,123 @@ TEST(colour_in_every_encoding_reads_as_its_luminance)
             REQUIRE(convert(path, name, cases[c].tool, out, sizeof out) == 0);
             snprintf(path, sizeof path, "%s", out);
         }
+        const char *tool = cases[c].tool ? cases[c].tool : "";
         vxl_volume *v = load_dicom(path, NULL, 0);
-        CHECKF(v && v->dims[0] == 8 && v->dims[1] == 6 && v->dims[2] == 2, "%s %s: %s", cases[c].mode,
-               cases[c].tool ? cases[c].tool : "", v ? "wrong size" : vxl_last_error());
-        if (!v || v->dims[0] != 8 || v->dims[1] != 6 || v->dims[2] != 2) {
-            vxl_volume_destroy(v);
-            continue;
-        }
+        double scalar_error = 0;
+        const double worst = colour_error(v, cases[c].subsampled, &scalar_error);
+        CHECKF(v && v->dims[2] == 2 && worst >= 0, "%s %s: %s", cases[c].mode, tool,
+               v ? "not a 8x6x2 colour volume" : vxl_last_error());
+        CHECKF(worst <= cases[c].bound, "%s %s: colour off by %g (bound %g)", cases[c].mode, tool, worst,
+               cases[c].bound);
+        CHECKF(scalar_error == 0, "%s %s: scalar off the colour's luminance by %g", cases[c].mode, tool, scalar_error);
+        vxl_volume_info info;
+        CHECKF(v && contains(volume_notes(v, &info), cases[c].note), "%s %s: notes '%s'", cases[c].mode, tool,
+               v ? info.notes : "");
+        CHECK(v && info.components == 3 && info.color_bytes == 8 * 6 * 2 * 3);
+        vxl_volume_destroy(v);
+    }
+}
+
+/* The opacity source is the caller's: a channel's values exactly, and alpha
+ * of RGB data refused with the reason, through the helper as in process. */
+TEST(colour_dicom_opacity_source_is_the_load_option)
+{
+    char dir[256], path[512], cmd[1024];
+    dicom_folder(g_dir, dir, sizeof dir, "colour_opacity");
+    snprintf(path, sizeof path, "%s/c.dcm", dir);
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 tests/make_colour_dicom.py %s rgb-planar", path);
+    REQUIRE(system(cmd) == 0);
+    for (uint32_t ch = 0; ch < 3; ch++) {
+        vxl_volume *v = load_with_opacity(path, VXL_OPACITY_SOURCE_CHANNEL, ch);
+        REQUIRE(v);
         double worst = 0;
         for (int k = 0; k < 2; k++)
             for (int j = 0; j < 6; j++)
                 for (int i = 0; i < 8; i++)
-                    worst = fmax(worst, fabs(voxel(v, (uint64_t)(i + 8 * j + 48 * k)) - colour_luminance(i, j, k)));
+                    worst = fmax(worst, fabs(voxel(v, (uint64_t)(i + 8 * j + 48 * k)) - pattern(i, j, k, (int)ch)));
         vxl_volume_info info;
-        CHECKF(worst <= cases[c].bound + 1e-6, "%s %s: luminance off by %g (bound %g)", cases[c].mode,
-               cases[c].tool ? cases[c].tool : "", worst, cases[c].bound);
-        CHECK(contains(volume_notes(v, &info), "shown as its luminance"));
+        CHECKF(worst == 0, "channel %u: scalar off by %g", ch, worst);
+        CHECK(contains(volume_notes(v, &info), ch == 0 ? "from the red channel" : ch == 1 ? "from the green channel"
+                                                                                        : "from the blue channel"));
+        CHECK(info.opacity_source == VXL_OPACITY_SOURCE_CHANNEL && v->colour && v->colour[0] == pattern(0, 0, 0, 0));
+        vxl_volume_destroy(v);
+    }
+    CHECK(load_with_opacity(path, VXL_OPACITY_SOURCE_ALPHA, 0) == NULL);
+    CHECKF(contains(vxl_last_error(), "opacity source alpha needs RGBA data; this has 3 channels"), "%s",
+           vxl_last_error());
+    CHECK(load_with_opacity(path, VXL_OPACITY_SOURCE_CHANNEL, 3) == NULL);
+    CHECKF(contains(vxl_last_error(), "opacity channel 3: the data has channels 0..2"), "%s", vxl_last_error());
+    /* the colour's 3 bytes a voxel count against the budget: 8x6x2 RGB is
+     * 96 bytes of raw channels but 4 a voxel once built (the scalar and its
+     * colour), 384 */
+    vxl_load_options opt = {.struct_size = sizeof opt, .memory_budget_bytes = 300};
+    vxl_volume *v = NULL;
+    CHECK(vxl_volume_load(path, &opt, &v) == VXL_ERR_LIMIT && !v);
+    CHECKF(contains(vxl_last_error(), "colour volumes are read whole"), "%s", vxl_last_error());
+}
+
+/* A series of single-frame colour files, named and numbered out of order
+ * with a slice missing, goes through the slice plan as grey series do:
+ * sorted by position, the missing slice blended channel by channel from
+ * its two neighbours. */
+TEST(colour_series_is_sorted_and_its_missing_slice_blended)
+{
+    char dir[256], cmd[1024];
+    dicom_folder(g_dir, dir, sizeof dir, "colour_series");
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 tests/make_colour_dicom.py %s series", dir);
+    REQUIRE(system(cmd) == 0);
+    vxl_volume *v = load_dicom(dir, NULL, 0);
+    REQUIRE(v);
+    CHECKF(v->dims[0] == 8 && v->dims[1] == 6 && v->dims[2] == 5 && v->colour, "%ux%ux%u", v->dims[0], v->dims[1],
+           v->dims[2]);
+    double worst = 0;
+    for (int k = 0; k < 5 && v->dims[2] == 5 && v->colour; k++)
+        for (int j = 0; j < 6; j++)
+            for (int i = 0; i < 8; i++)
+                for (int c = 0; c < 3; c++) {
+                    /* slice 3 is missing: half of 2 and half of 4, as the plan rounds */
+                    const double want = k == 3 ? (double)lround(pattern(i, j, 2, c) +
+                                                                0.5 * (pattern(i, j, 4, c) - pattern(i, j, 2, c)))
+                                               : pattern(i, j, k, c);
+                    worst = fmax(worst, fabs((double)v->colour[3 * (i + 8 * j + 48 * k) + c] - want));
+                }
+    CHECKF(worst == 0, "colour off by %g", worst);
+    CHECK(fabs(v->spacing[2] - 2) < 1e-9 && fabs(v->affine[14] - 0) < 1e-9);
+    vxl_volume_destroy(v);
+}
+
+/* An enhanced multi-frame RGB file, frames shuffled, 2 time points: each
+ * time point a colour volume whose slices come out in the order (and with
+ * the affine) the grey file of the same geometry gets. */
+TEST(enhanced_colour_frames_follow_the_slice_plan)
+{
+    char dir[256], grey[512], rgb[512];
+    dicom_folder(g_dir, dir, sizeof dir, "enhanced_rgb");
+    snprintf(grey, sizeof grey, "%s/grey.dcm", dir);
+    snprintf(rgb, sizeof rgb, "%s/rgb.dcm", dir);
+    REQUIRE(write_enhanced(grey, 2, 11, "") == 0 && write_enhanced(rgb, 2, 13, "rgb") == 0);
+    for (uint32_t t = 0; t < 2; t++) {
+        vxl_volume *g = load_dicom(grey, NULL, t), *v = load_dicom(rgb, NULL, t);
+        CHECKF(g && v && v->colour && v->components == 3 && v->frame_count == 2, "time %u: %s", t,
+               v ? "not a colour volume of 2 frames" : vxl_last_error());
+        if (!g || !v || !v->colour) {
+            vxl_volume_destroy(g);
+            vxl_volume_destroy(v);
+            continue;
+        }
+        CHECK(!memcmp(v->dims, g->dims, sizeof v->dims) && same_affine(g, v));
+        double worst = 0;
+        for (uint32_t s = 0; s < v->dims[2]; s++)
+            for (int j = 0; j < R; j++)
+                for (int i = 0; i < C; i++) {
+                    const uint64_t at = (uint64_t)i + C * (j + (uint64_t)R * s);
+                    /* the grey file's value says which slice k landed here */
+                    const int k = (int)lround((voxel(g, at) + 1024 - 1000.0 * t - 10 * j - i) / 100);
+                    const int want[3] = {(10 * j + i) % 256, (40 * k + 5) % 256, (90 * (int)t + 7 * k) % 256};
+                    for (int c = 0; c < 3; c++) worst = fmax(worst, fabs((double)v->colour[3 * at + c] - want[c]));
+                }
+        CHECKF(worst == 0, "time %u: colour off by %g", t, worst);
+        vxl_volume_destroy(g);
         vxl_volume_destroy(v);
     }
 }
@@ -414,7 +600,10 @@ int main(void)
     RUN(damaged_offset_tables_are_clear_errors);
     RUN(reference_files_read_the_same_in_every_encoding);
     RUN(lossy_codecs_stay_within_their_bounds);
-    RUN(colour_in_every_encoding_reads_as_its_luminance);
+    RUN(colour_in_every_encoding_loads_as_colour);
+    RUN(colour_dicom_opacity_source_is_the_load_option);
+    RUN(colour_series_is_sorted_and_its_missing_slice_blended);
+    RUN(enhanced_colour_frames_follow_the_slice_plan);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

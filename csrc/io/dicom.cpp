@@ -11,6 +11,11 @@
 // the plan (a copy, or a blend where the spacing was uneven) ->
 // vxl_volume_build applies RescaleSlope/Intercept (CT lands in Hounsfield
 // units); slices with differing rescale values are converted to float first.
+// Colour (RGB, YBR_*, PALETTE COLOR, decoded to RGB) goes the same way with
+// three samples a pixel into vxl_volume_build_colour: a colour volume whose
+// scalar is the opacity source the options ask for (luminance by default);
+// colour has no rescale (the Modality LUT, PS3.3 C.11.1, is for grey
+// images only).
 // What the reader decided (a localizer left out, 1 mm assumed, slices
 // interpolated) goes to vxl_volume.notes.
 //
@@ -38,6 +43,7 @@
 #include <vector>
 
 extern "C" {
+#include "colour_volume.h"
 #include "helper_main.h"
 #include "loader_util.h"
 #include "threads.h"
@@ -297,16 +303,18 @@ int load_series(const Series &s, const char *path, const vxl_load_options *opt, 
     const bool resampled = m != k || std::any_of(s.plan.begin(), s.plan.end(),
                                                  [](const Sample &p) { return p.a != p.b; });
     const uint32_t dims[3] = {f.cols, f.rows, uint32_t(m)};
+    const unsigned comps = components_of(f); // 3: colour as RGB (read_frames)
     bool same_scale = true;
-    for (const Image *t : pos) same_scale = same_scale && t->slope == f.slope && t->inter == f.inter;
+    for (const Image *t : pos) same_scale = same_scale && (comps > 1 || (t->slope == f.slope && t->inter == f.inter));
     const uint32_t dtype = dtype_of(f);
     // per-slice rescale values (PET, some MR) need floats; checked against
     // the budget at the size they will be stored in, before any allocation,
     // with the decoded positions counted too when they are blended
-    const size_t per = size_t(f.rows) * f.cols, elem = f.bits_alloc / 8;
+    const size_t per = size_t(f.rows) * f.cols * comps, elem = f.bits_alloc / 8;
     const uint32_t whole[3] = {f.cols, f.rows, uint32_t(m + (resampled || !same_scale ? k : 0))};
     uint64_t nbytes;
-    int rc = vxl_plan_voxels(f.path.c_str(), whole, same_scale ? dtype : VXL_DTYPE_F32, opt, &nbytes, e);
+    int rc = comps > 1 ? vxl_plan_colour_voxels(f.path.c_str(), whole, dtype, comps, opt, &nbytes, e)
+                       : vxl_plan_voxels(f.path.c_str(), whole, same_scale ? dtype : VXL_DTYPE_F32, opt, &nbytes, e);
     if (rc) return rc;
     // decoded positions: straight into the output when the plan is a copy
     // with one scale, else into their own slices first
@@ -353,9 +361,12 @@ int load_series(const Series &s, const char *path, const vxl_load_options *opt, 
         }
     }
     vxl_err inner = {};
-    if (same_scale)
-        rc = vxl_volume_build(direct ? decoded.data() : blended.data(), dtype, dims, s.spacing, s.affine, f.slope,
-                              f.inter, opt, out, &inner);
+    const void *data = direct ? decoded.data() : blended.data();
+    if (comps > 1)
+        rc = vxl_volume_build_colour(data, dtype, comps, 0, dims, s.spacing, s.affine, 0, 0, opt,
+                                     format("DICOM %s", f.photometric.c_str()).c_str(), out, &inner);
+    else if (same_scale)
+        rc = vxl_volume_build(data, dtype, dims, s.spacing, s.affine, f.slope, f.inter, opt, out, &inner);
     else
         rc = vxl_volume_build(scaled.data(), VXL_DTYPE_F32, dims, s.spacing, s.affine, 0, 0, opt, out, &inner);
     if (rc) return vxl_fail_in(e, f.path.c_str(), &inner);

@@ -121,9 +121,6 @@ std::string check_pixels(std::vector<Image> &sl, std::vector<std::string> &notes
             s.ps[0] = s.ps[1] = 1;
             assumed++;
         }
-    if (is_colour(f) || is_palette(f))
-        notes.push_back(format("colour (%s) shown as its luminance (Rec. 709): colour volumes are not rendered yet",
-                               f.photometric.c_str()));
     if (assumed)
         notes.push_back(format("PixelSpacing missing or zero in %zu of %zu image(s): 1 mm assumed", assumed,
                                sl.size()));

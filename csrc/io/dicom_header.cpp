@@ -196,6 +196,17 @@ Parse read_header(const std::string &path, std::vector<Image> &out, std::string 
 #else
     s.encapsulated = x.isEncapsulated();
 #endif
+    // HTJ2K's frames are JPEG 2000 codestreams with the HT block coder,
+    // which OpenJPEG 2.5 decodes: known by the meta header's UID, since
+    // dcmtk 3.6.7 (Debian 12) does not know these syntaxes (it still reads
+    // the data set, explicit little endian, and the encapsulated PixelData)
+    const std::string uid = get_string(ff.getMetaInfo(), DCM_TransferSyntaxUID);
+    if (uid == "1.2.840.10008.1.2.4.201" || uid == "1.2.840.10008.1.2.4.202" || uid == "1.2.840.10008.1.2.4.203") {
+        s.htj2k = s.encapsulated = true;
+        s.xfer = uid == "1.2.840.10008.1.2.4.201" ? "HTJ2K Lossless" : uid == "1.2.840.10008.1.2.4.202"
+                                                                      ? "HTJ2K with RPCL Options Lossless"
+                                                                      : "HTJ2K";
+    }
     DcmItem *shared = nullptr;
     if (ds->findAndGetSequenceItem(DCM_SharedFunctionalGroupsSequence, shared, 0).bad()) shared = nullptr;
     DcmSequenceOfItems *per = nullptr;

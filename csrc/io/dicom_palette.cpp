@@ -1,8 +1,8 @@
 // dicom_palette.cpp - PALETTE COLOR images (PS3.3 C.7.6.3.1.5-6): each
 // stored value indexes three lookup tables, red, green and blue. The
 // pixels room reads the indices as it reads grey ones, and this room
-// turns them into the Rec. 709 luminance of their colours, as colour
-// images are turned (colour volumes are not rendered yet).
+// turns them into their colours, RGB, which load as a colour volume as the
+// other colour images do.
 //
 // A table's descriptor is (entries, first mapped value, bits per entry):
 // 0 entries means 65536; indices below the first mapped value take the
@@ -100,34 +100,31 @@ int read_palette(DcmItem *ds, const Image &im, Palette &pal, vxl_err *e)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the red, green and blue palettes disagree in size or first value",
                         im.path.c_str());
     pal.first = first[0];
-    // one luminance per entry, on the 16-bit scale of the entries
-    const size_t n = pal.rgb[0].size();
-    pal.luminance.resize(n);
-    for (size_t i = 0; i < n; i++)
-        pal.luminance[i] = 0.2126 * pal.rgb[0][i] + 0.7152 * pal.rgb[1][i] + 0.0722 * pal.rgb[2][i];
     return VXL_OK;
 }
 
 namespace {
 
-template <typename T> void indices_to_grey(const Palette &pal, size_t n, T *px)
+template <typename T> void indices_to_rgb(const Palette &pal, size_t n, T *px)
 {
-    // the output keeps the container's type: 8-bit indices give 8-bit luminance
+    // the output keeps the container's type: 8-bit indices give 8-bit colour
     const double scale = sizeof(T) == 1 ? 255.0 / 65535.0 : 1.0;
-    const long last = long(pal.luminance.size()) - 1;
-    for (size_t i = 0; i < n; i++) {
-        const long k = std::min(last, std::max(0L, long(px[i]) - pal.first));
-        px[i] = T(std::lround(pal.luminance[size_t(k)] * scale));
+    const long last = long(pal.rgb[0].size()) - 1;
+    // from the last pixel down: pixel i's colour lands at 3i..3i+2, over
+    // indices already turned, never over one still to read
+    for (size_t i = n; i-- > 0;) {
+        const size_t k = size_t(std::min(last, std::max(0L, long(px[i]) - pal.first)));
+        for (int c = 2; c >= 0; c--) px[3 * i + size_t(c)] = T(std::lround(pal.rgb[c][k] * scale));
     }
 }
 
 } // namespace
 
-void grey_of_palette(const Image &s, const Palette &pal, void *frame)
+void rgb_of_palette(const Image &s, const Palette &pal, void *frame)
 {
     const size_t n = size_t(s.rows) * s.cols;
-    if (s.bits_alloc == 8) indices_to_grey(pal, n, static_cast<uint8_t *>(frame));
-    else indices_to_grey(pal, n, static_cast<uint16_t *>(frame));
+    if (s.bits_alloc == 8) indices_to_rgb(pal, n, static_cast<uint8_t *>(frame));
+    else indices_to_rgb(pal, n, static_cast<uint16_t *>(frame));
 }
 
 } // namespace vxl_dicom

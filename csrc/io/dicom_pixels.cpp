@@ -1,4 +1,6 @@
-// dicom_pixels.cpp - one DICOM file's frames as grey pixels. A file is read
+// dicom_pixels.cpp - one DICOM file's frames as pixels: grey, or RGB for
+// colour and PALETTE COLOR (samples of a pixel together, YCbCr turned into
+// RGB, whatever the encoding's layout). A file is read
 // once whatever number of its frames are wanted (a multi-frame file of 1000
 // frames is one read, not 1000).
 //
@@ -44,7 +46,7 @@ Codec codec_of(const Image &im)
     // our lossless JPEG decoder is grey only; dcmtk's takes colour
     if (im.xs == EXS_JPEGProcess14 || im.xs == EXS_JPEGProcess14SV1)
         return im.samples == 1 ? Codec::jpeg_lossless : Codec::dcmtk;
-    if (im.xs == EXS_JPEG2000LosslessOnly || im.xs == EXS_JPEG2000) return Codec::j2k;
+    if (im.xs == EXS_JPEG2000LosslessOnly || im.xs == EXS_JPEG2000 || im.htj2k) return Codec::j2k;
     if (im.xs == EXS_JPEGProcess1 || im.xs == EXS_JPEGProcess2_4 || im.xs == EXS_JPEGLSLossless ||
         im.xs == EXS_JPEGLSLossy)
         return Codec::dcmtk;
@@ -89,36 +91,37 @@ enum class Layout { interleaved, planar, ybr422 };
 // dcmtk codec reports it decoded into).
 bool is_ybr_full(const std::string &model) { return model.compare(0, 8, "YBR_FULL") == 0; }
 
-// Luminance (Rec. 709 weights of RGB) of a colour frame of n pixels into
-// dst, the container's type kept; ybr: the samples are full-range YCbCr
-// (PS3.3 C.7.6.3.1.2), turned into RGB first.
-template <typename T> void colour_to_grey(const T *src, size_t n, Layout layout, bool ybr, unsigned bits, T *dst)
+// A colour frame of n pixels as RGB with the samples of a pixel together
+// into dst, the container's type kept; ybr: the samples are full-range
+// YCbCr (PS3.3 C.7.6.3.1.2), turned into RGB (rounded, clamped to the
+// stored bits); RGB is copied exactly.
+template <typename T> void colour_to_rgb(const T *src, size_t n, Layout layout, bool ybr, unsigned bits, T *dst)
 {
     const double half = double(1u << (bits - 1)), top = double((1ull << bits) - 1);
     for (size_t i = 0; i < n; i++) {
-        double a, b, c;
+        T a, b, c;
         if (layout == Layout::interleaved) { a = src[3 * i]; b = src[3 * i + 1]; c = src[3 * i + 2]; }
         else if (layout == Layout::planar) { a = src[i]; b = src[n + i]; c = src[2 * n + i]; }
         else { a = src[4 * (i / 2) + (i & 1)]; b = src[4 * (i / 2) + 2]; c = src[4 * (i / 2) + 3]; }
         if (ybr) {
             const double y = a, cb = b - half, cr = c - half;
-            a = y + 1.402 * cr;
-            b = y - 0.344136 * cb - 0.714136 * cr;
-            c = y + 1.772 * cb;
+            const double rgb[3] = {y + 1.402 * cr, y - 0.344136 * cb - 0.714136 * cr, y + 1.772 * cb};
+            for (int k = 0; k < 3; k++) dst[3 * i + k] = T(std::lround(std::min(top, std::max(0.0, rgb[k]))));
+        } else {
+            dst[3 * i] = a;
+            dst[3 * i + 1] = b;
+            dst[3 * i + 2] = c;
         }
-        const double l = 0.2126 * a + 0.7152 * b + 0.0722 * c;
-        dst[i] = T(std::lround(std::min(top, std::max(0.0, l))));
     }
 }
 
-void grey_of_colour(const Image &s, const void *src, Layout layout, bool ybr, void *dst)
+void rgb_of_colour(const Image &s, const void *src, Layout layout, bool ybr, void *dst)
 {
     const size_t n = size_t(s.rows) * s.cols;
     if (s.bits_alloc == 8)
-        colour_to_grey(static_cast<const uint8_t *>(src), n, layout, ybr, s.bits_stored, static_cast<uint8_t *>(dst));
+        colour_to_rgb(static_cast<const uint8_t *>(src), n, layout, ybr, s.bits_stored, static_cast<uint8_t *>(dst));
     else
-        colour_to_grey(static_cast<const uint16_t *>(src), n, layout, ybr, s.bits_stored,
-                       static_cast<uint16_t *>(dst));
+        colour_to_rgb(static_cast<const uint16_t *>(src), n, layout, ybr, s.bits_stored, static_cast<uint16_t *>(dst));
 }
 
 // The layout an uncompressed colour frame has.
@@ -140,8 +143,14 @@ int fragments_of(const Image &s, DcmElement *el, Fragments &fr, vxl_err *e)
 {
     const char *p = s.path.c_str();
     DcmPixelSequence *seq = nullptr;
+    // the fragments are kept under the syntax the data set was read with:
+    // for one dcmtk does not know (HTJ2K on 3.6.7), not s.xs
+    E_TransferSyntax held = s.xs;
+    const DcmRepresentationParameter *param = nullptr;
+    if (el->ident() == EVR_PixelData && s.htj2k)
+        static_cast<DcmPixelData *>(el)->getOriginalRepresentationKey(held, param);
     if (el->ident() != EVR_PixelData ||
-        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(s.xs, nullptr, seq).bad() || !seq ||
+        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(held, param, seq).bad() || !seq ||
         seq->card() < 1)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': compressed PixelData holds no fragments", p);
     uint64_t at = 0;
@@ -239,6 +248,8 @@ void prepare_decoders()
     });
 }
 
+unsigned components_of(const Image &im) { return is_colour(im) || is_palette(im) ? 3 : 1; }
+
 bool is_colour(const Image &im)
 {
     if (im.samples != 3) return false;
@@ -316,9 +327,9 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
         const unsigned f = which[i]->frame;
         if (codec == Codec::native) {
             const uint8_t *frame = static_cast<const uint8_t *>(all) + size_t(f) * stored;
-            if (colour) grey_of_colour(s, frame, native_layout(s), ybr, dst[i]);
+            if (colour) rgb_of_colour(s, frame, native_layout(s), ybr, dst[i]);
             else unpack_frame(s, frame, n, dst[i]);
-            if (is_palette(s)) grey_of_palette(s, palette, dst[i]);
+            if (is_palette(s)) rgb_of_palette(s, palette, dst[i]);
             continue;
         }
         Layout layout = Layout::interleaved;
@@ -355,9 +366,9 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
                 return vxl_fail(e, rc, "'%s': %s", p, codec_err.msg);
             }
         }
-        if (colour) grey_of_colour(s, raw.data(), layout, frame_ybr, dst[i]);
+        if (colour) rgb_of_colour(s, raw.data(), layout, frame_ybr, dst[i]);
         else unpack_frame(s, raw.data(), n, dst[i]);
-        if (is_palette(s)) grey_of_palette(s, palette, dst[i]);
+        if (is_palette(s)) rgb_of_palette(s, palette, dst[i]);
     }
     return VXL_OK;
 }

@@ -7,7 +7,7 @@
 //                     and the resampling plan for uneven spacing
 //   dicom_pixels.cpp  one file's frames -> pixels (dcmtk for the uncompressed
 //                     and the codecs it has, our C for RLE and lossless JPEG)
-//   dicom_palette.cpp PALETTE COLOR indices -> the luminance of their colours
+//   dicom_palette.cpp PALETTE COLOR indices -> their colours (RGB)
 //   dicom.cpp         folder scan, series choice, the parallel load
 // Only the helper process voxlight-read-dicom runs these: libvoxlight links
 // no C++.
@@ -49,6 +49,7 @@ struct Image {
     unsigned rows = 0, cols = 0, bits_alloc = 0, bits_stored = 0, pixel_rep = 0, samples = 1;
     unsigned planar = 0; // PlanarConfiguration of colour: 0 samples of a pixel together, 1 planes
     bool has_ipp = false, has_iop = false, has_spacing = false, encapsulated = false;
+    bool htj2k = false; // HTJ2K (1.2.840.10008.1.2.4.201-.203), known by its UID: dcmtk 3.6.7 does not know it
     E_TransferSyntax xs = EXS_Unknown;
     std::string xfer; // the transfer syntax's name, for messages
     double ipp[3] = {0, 0, 0}, iop[6] = {1, 0, 0, 0, 1, 0}, ps[2] = {1, 1};
@@ -95,22 +96,27 @@ void analyse(Series &s);
 // into colour (RGB, YBR_FULL, YBR_FULL_422, YBR_ICT, YBR_RCT).
 bool is_colour(const Image &im);
 
+// Samples a decoded pixel has (read_frames): 3 (RGB) for colour and
+// PALETTE COLOR, else 1.
+unsigned components_of(const Image &im);
+
 // One bits-stored index per pixel into red, green and blue lookup tables
 // (dicom_palette.cpp).
 bool is_palette(const Image &im);
 
-// A PALETTE COLOR image's tables, as 16-bit entries, and each entry's
-// Rec. 709 luminance on that scale.
+// A PALETTE COLOR image's tables, as 16-bit entries.
 struct Palette {
     std::vector<uint16_t> rgb[3];
-    std::vector<double> luminance;
     long first = 0; // the stored value of entry 0
 };
 // Reads the tables of a file's dataset; VXL_OK or a vxl_fail naming the file.
 int read_palette(DcmItem *ds, const Image &im, Palette &pal, vxl_err *e);
-// A frame of indices (as read_frames unpacks grey pixels), in place, into
-// the luminance of their colours, in the frame's own type.
-void grey_of_palette(const Image &s, const Palette &pal, void *frame);
+// A frame of indices (as read_frames unpacks grey pixels) in the first
+// rows*cols values of `frame`, in place, into their colours: 3 values a
+// pixel (R, G, B together) in the frame's own type, so `frame` has room for
+// 3 rows*cols; 8-bit indices give 8-bit colour (the entries rounded from 16
+// bits), 16-bit ones the entries as they are.
+void rgb_of_palette(const Image &s, const Palette &pal, void *frame);
 
 // Registers the decoders dcmtk keeps in a process-wide list: once, before
 // any thread reads, as dcmtk asks.
@@ -118,8 +124,9 @@ void prepare_decoders();
 // Whether the pixels of this image can be decoded here; "" or the reason.
 std::string decodable(const Image &im);
 // Reads the frames `which` of one file (all images share the path), each
-// into dst[i] (rows*cols values of bits_alloc, native byte order, masked to
-// BitsStored and sign-extended). VXL_OK or a vxl_fail naming the file.
+// into dst[i] (rows*cols*components_of values of bits_alloc, native byte
+// order, masked to BitsStored and sign-extended; colour as RGB, the samples
+// of a pixel together). VXL_OK or a vxl_fail naming the file.
 int read_frames(const std::vector<const Image *> &which, const std::vector<void *> &dst, vxl_err *e);
 
 } // namespace vxl_dicom

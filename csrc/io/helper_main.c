@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "colour_volume.h"
 #include "helper_self.h"
 #include "os.h"
 #include "reader_stream.h"
@@ -44,7 +45,7 @@ static int parse_double(const char *s, double *out)
 /* argv[3..] into options; 0 when malformed. */
 static int parse_options(char **argv, vxl_load_options *opt)
 {
-    unsigned long long max_dim, budget, frame;
+    unsigned long long max_dim, budget, frame, source, channel;
     memset(opt, 0, sizeof *opt);
     opt->struct_size = sizeof *opt;
     if (!parse_u64(argv[3], &max_dim) || max_dim > UINT32_MAX || !parse_u64(argv[4], &budget)) return 0;
@@ -55,6 +56,13 @@ static int parse_options(char **argv, vxl_load_options *opt)
     opt->memory_budget_bytes = budget;
     opt->frame = (uint32_t)frame;
     opt->series = argv[9][0] ? argv[9] : NULL;
+    /* checked by the colour reader itself (vxl_colour_opacity_source), as
+     * in process */
+    if (!parse_u64(argv[10], &source) || source > UINT32_MAX || !parse_u64(argv[11], &channel) ||
+        channel > UINT32_MAX)
+        return 0;
+    opt->opacity_source = (uint32_t)source;
+    opt->opacity_channel = (uint32_t)channel;
     return 1;
 }
 
@@ -104,6 +112,9 @@ static void volume_header(const vxl_volume *v, vxl_reader_header *h)
     h->inf_count = v->inf_count;
     h->storage_bytes = v->storage_bytes;
     h->nbytes = v->storage_bytes;
+    h->components = v->colour ? v->components : 1;
+    h->opacity_source = v->colour ? v->opacity_source : 0;
+    h->colour_bytes = vxl_volume_colour_bytes(v);
     /* a reader's notes are terminated; a full array is cut, not sent open */
     snprintf(h->notes, sizeof h->notes, "%s", v->notes);
 }
@@ -122,6 +133,7 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
     vxl_load_options opt;
     if (!cmd || !parse_options(argv, &opt)) {
         fprintf(stderr, "usage: %s COMMAND FILE MAX_DIM BUDGET_BYTES VOXEL_X VOXEL_Y VOXEL_Z FRAME SERIES "
+                "OPACITY_SOURCE OPACITY_CHANNEL "
                 "(started by libvoxlight; commands:", helper);
         for (int i = 0; i < n_cmds; i++) fprintf(stderr, " %s", cmds[i].name);
         fputs(")\n", stderr);
@@ -146,12 +158,13 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
     vxl_err e = {0};
     vxl_volume *v = NULL;
     vxl_dicom_series *list = NULL;
-    const void *body = NULL;
+    const void *body = NULL, *colour = NULL;
     if (cmd->read) {
         h.status = (uint32_t)cmd->read(path, &opt, &v, &e);
         if (h.status == VXL_OK) {
             volume_header(v, &h);
             body = v->texels;
+            colour = v->colour;
         }
     } else {
         uint32_t count = 0;
@@ -170,7 +183,10 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
         h.msg_len = (uint32_t)strnlen(e.msg, sizeof e.msg);
         rc = write_all(out, &h, sizeof h) || write_all(out, e.msg, h.msg_len) ? 3 : 1;
     } else {
-        rc = write_all(out, &h, sizeof h) || write_all(out, body, (size_t)h.nbytes) ? 3 : 0;
+        rc = write_all(out, &h, sizeof h) || write_all(out, body, (size_t)h.nbytes) ||
+                     (h.colour_bytes && write_all(out, colour, (size_t)h.colour_bytes))
+                 ? 3
+                 : 0;
     }
     vxl_volume_destroy(v);
     free(list);

@@ -9,8 +9,11 @@
 // (i, j) is pixel (x = i, y = height-1-j): files store the top row first,
 // our voxel j axis points up. Images carry no reliable geometry, so the
 // affine is diag(voxel size) from vxl_load_options.voxel_size (1 mm when
-// unset). Pixel types: 8/16/32-bit integers, half/float/double; colour
-// images are reduced to Rec. 709 luminance, grey+alpha to the grey channel.
+// unset). Pixel types: 8/16/32-bit integers, half/float/double. RGB and
+// RGBA images (3 or more channels: the first 3, or 4 when the 4th is alpha
+// or there are exactly 4; the rest left out with a note) make a colour volume
+// (colour_volume.h: the scalar is the opacity source, luminance by default,
+// beside the RGB8 colour), grey+alpha the grey channel.
 //
 // Hostile input: the first image's header sizes pass the memory budget
 // before any voxel is allocated, every other slice must match it exactly
@@ -32,6 +35,7 @@
 #include <vector>
 
 extern "C" {
+#include "colour_volume.h"
 #include "helper_main.h"
 #include "loader_util.h"
 }
@@ -179,42 +183,11 @@ uint32_t dtype_for(OIIO::TypeDesc t, OIIO::TypeDesc &read_as)
     }
 }
 
-template <typename T>
-void to_gray(const T *src, int nch, size_t w, size_t h, T *dst_slice)
+// One image's rows (top first, `row` bytes each) into a slice of the
+// volume (bottom first): the voxel j axis points up.
+void flip_rows(const unsigned char *src, size_t row, size_t h, unsigned char *dst_slice)
 {
-    // src: h rows top first, nch channels; dst: rows bottom first
-    for (size_t y = 0; y < h; y++) {
-        const T *row = src + y * w * static_cast<size_t>(nch);
-        T *out = dst_slice + (h - 1 - y) * w;
-        for (size_t x = 0; x < w; x++) {
-            const T *p = row + x * static_cast<size_t>(nch);
-            if (nch < 3) {
-                out[x] = p[0];
-            } else {
-                double v = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-                if (std::numeric_limits<T>::is_integer) {
-                    v = std::nearbyint(v);
-                    v = std::min<double>(std::max<double>(v, std::numeric_limits<T>::lowest()),
-                                         std::numeric_limits<T>::max());
-                }
-                out[x] = static_cast<T>(v);
-            }
-        }
-    }
-}
-
-void gray_slice(uint32_t dtype, const void *src, int nch, size_t w, size_t h, void *dst)
-{
-    switch (dtype) {
-    case VXL_DTYPE_U8: to_gray(static_cast<const uint8_t *>(src), nch, w, h, static_cast<uint8_t *>(dst)); break;
-    case VXL_DTYPE_I8: to_gray(static_cast<const int8_t *>(src), nch, w, h, static_cast<int8_t *>(dst)); break;
-    case VXL_DTYPE_U16: to_gray(static_cast<const uint16_t *>(src), nch, w, h, static_cast<uint16_t *>(dst)); break;
-    case VXL_DTYPE_I16: to_gray(static_cast<const int16_t *>(src), nch, w, h, static_cast<int16_t *>(dst)); break;
-    case VXL_DTYPE_U32: to_gray(static_cast<const uint32_t *>(src), nch, w, h, static_cast<uint32_t *>(dst)); break;
-    case VXL_DTYPE_I32: to_gray(static_cast<const int32_t *>(src), nch, w, h, static_cast<int32_t *>(dst)); break;
-    case VXL_DTYPE_F32: to_gray(static_cast<const float *>(src), nch, w, h, static_cast<float *>(dst)); break;
-    default: to_gray(static_cast<const double *>(src), nch, w, h, static_cast<double *>(dst)); break;
-    }
+    for (size_t y = 0; y < h; y++) std::memcpy(dst_slice + (h - 1 - y) * row, src + y * row, row);
 }
 
 // The slices of a numbered series that path belongs to; empty when path is
@@ -395,15 +368,18 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
                 dims[0] = static_cast<uint32_t>(spec.width);
                 dims[1] = static_cast<uint32_t>(spec.height);
                 nch = spec.nchannels;
-                nread = nch >= 3 ? 3 : 1;
+                // RGBA: 4 channels, or more whose 4th is the image's alpha;
+                // further channels (microscopy's) are left out with a note
+                nread = nch >= 3 ? (nch == 4 || spec.alpha_channel == 3 ? 4 : 3) : 1;
                 first = name;
                 uint64_t nbytes = 0;
-                rc = vxl_plan_voxels(path, dims, dtype, opt, &nbytes, e);
+                rc = nread > 1 ? vxl_plan_colour_voxels(path, dims, dtype, uint32_t(nread), opt, &nbytes, e)
+                               : vxl_plan_voxels(path, dims, dtype, opt, &nbytes, e);
                 if (rc) return rc;
                 es = vxl_dtype_size(dtype);
-                slice_bytes = static_cast<size_t>(dims[0]) * dims[1] * es;
+                slice_bytes = static_cast<size_t>(dims[0]) * dims[1] * es * static_cast<size_t>(nread);
                 raw.resize(static_cast<size_t>(nbytes));
-                tmp.resize(slice_bytes * static_cast<size_t>(nread));
+                tmp.resize(slice_bytes);
             } else if (static_cast<uint32_t>(spec.width) != dims[0] || static_cast<uint32_t>(spec.height) != dims[1] ||
                        spec.nchannels != nch) {
                 return vxl_fail(e, VXL_ERR_FORMAT,
@@ -423,15 +399,22 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
                 return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read pixels: %s", name.c_str(),
                                 msg.empty() ? "unknown error" : msg.c_str());
             }
-            gray_slice(dtype, tmp.data(), nread, dims[0], dims[1], raw.data() + k * slice_bytes);
+            flip_rows(tmp.data(), slice_bytes / dims[1], dims[1], raw.data() + k * slice_bytes);
         }
         if (in) in->close();
         double vs[3];
         vxl_load_voxel_size(opt, vs);
         std::vector<unsigned char>().swap(tmp);
         vxl_err inner = {};
-        rc = vxl_volume_build(raw.data(), dtype, dims, vs, nullptr, 0.0, 0.0, opt, out, &inner);
+        if (nread > 1)
+            rc = vxl_volume_build_colour(raw.data(), dtype, uint32_t(nread), 0, dims, vs, nullptr, 0.0, 0.0, opt,
+                                         nread == 3 ? "TIFF/PNG RGB" : "TIFF/PNG RGBA", out, &inner);
+        else
+            rc = vxl_volume_build(raw.data(), dtype, dims, vs, nullptr, 0.0, 0.0, opt, out, &inner);
         if (rc) return vxl_fail_in(e, path, &inner);
+        if (nread > 1 && nch == nread + 1) vxl_volume_note(*out, "channel %d of %d left out", nch, nch);
+        else if (nread > 1 && nch > nread)
+            vxl_volume_note(*out, "channels %d to %d of %d left out", nread + 1, nch, nch);
         return VXL_OK;
     } catch (const std::bad_alloc &) {
         // the helper's address-space cap (helper_main.c) turns an absurd

@@ -10,12 +10,17 @@
  * Geometry: MetaImage (as written by ITK) lives in LPS; each consecutive
  * triple of TransformMatrix is the direction of one voxel axis. The affine
  * is Offset + sum_i index_i * ElementSpacing_i * direction_i, then converted
- * to RAS (x and y negated) so MetaImage and NIfTI share one world frame. */
+ * to RAS (x and y negated) so MetaImage and NIfTI share one world frame.
+ *
+ * ElementNumberOfChannels 3 or 4 (each voxel's channels together, as MetaIO
+ * writes them) is RGB or RGBA: a colour volume read whole, as NRRD's colour
+ * axis is (colour_volume.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
+#include "colour_volume.h"
 #include "hash.h"
 #include "loader_util.h"
 #include "stream_load.h"
@@ -38,6 +43,7 @@ typedef struct mha_hdr {
     double matrix[MHA_MAX_DIM * MHA_MAX_DIM];
     int msb;          /* 1: big-endian data */
     int compressed;
+    uint32_t channels;   /* ElementNumberOfChannels: 1 (0 unset), 3 RGB, 4 RGBA */
     int64_t header_size; /* -1: raw data ends the file; 0 default */
     const char *data_file; /* NULL or "LOCAL" = follows the header */
     uint64_t data_offset;
@@ -118,9 +124,10 @@ static int parse_field(mha_hdr *h, const char *key, char *val, const char *path,
     } else if (!strcasecmp(key, "ElementNumberOfChannels")) {
         uint64_t c;
         if (vxl_parse_u64s(val, &c, 1, 1u << 20) != 1 || c < 1) return bad(e, path, line, key, "must be >= 1");
-        if (c != 1)
+        if (c != 1 && c != 3 && c != 4)
             return vxl_fail(e, VXL_ERR_FORMAT, "'%s': MetaImage with %llu channels per voxel is not supported "
-                            "(only scalar volumes)", path, (unsigned long long)c);
+                            "(1, or 3 and 4 as RGB and RGBA colour)", path, (unsigned long long)c);
+        h->channels = (uint32_t)c;
     } else if (!strcasecmp(key, "HeaderSize")) {
         uint64_t b;
         if (!strcmp(val, "-1")) h->header_size = -1;
@@ -245,8 +252,10 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
     if (!rc) rc = parse_header(text, len, file_size, path, &h, e);
     if (!rc) {
         for (int a = 0; a < 3; a++) dims[a] = a < h.ndims ? (uint32_t)h.dimsize[a] : 1;
-        /* zlib data streams through a bricked cache, inflated from where it starts */
-        rc = vxl_stream_plan(path, dims, h.dtype, opt, NULL, &stream, &nbytes, e);
+        /* zlib data streams through a bricked cache, inflated from where it
+         * starts; colour is read whole (colour_volume.h) */
+        if (h.channels > 1) rc = vxl_plan_colour_voxels(path, dims, h.dtype, h.channels, opt, &nbytes, e);
+        else rc = vxl_stream_plan(path, dims, h.dtype, opt, NULL, &stream, &nbytes, e);
     }
     if (!rc && h.data_file) {
         data_path = vxl_sibling_path(path, h.data_file);
@@ -301,9 +310,15 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
         rc = geometry(&h, sp, A, path, e);
         if (!rc) {
             vxl_err inner = {0};
-            rc = vxl_volume_build(raw, h.dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner);
+            if (h.channels > 1)
+                rc = vxl_volume_build_colour(raw, h.dtype, h.channels, 0, dims, sp, A, 0.0, 0.0, opt,
+                                             h.channels == 3 ? "MetaImage RGB" : "MetaImage RGBA", out, &inner);
+            else
+                rc = vxl_volume_build(raw, h.dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner);
             if (rc) rc = vxl_fail_in(e, path, &inner);
             else (*out)->affine_source = h.nmatrix || h.norigin ? 2 : 0;
+            if (!rc && h.channels > 1 && vxl_load_streaming(opt) == VXL_STREAMING_ON)
+                vxl_volume_note(*out, "read whole: a colour volume does not stream");
         }
     }
     free(raw);

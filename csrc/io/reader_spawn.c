@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "clock.h"
+#include "colour_volume.h"
 #include "dynlib.h"
 #include "files.h"
 #include "os.h"
@@ -87,6 +88,8 @@ typedef struct reply {
     size_t h_got;
     char *body;            /* the message or the body, once the header passed */
     uint64_t body_len, body_got;
+    uint8_t *colour;       /* a colour volume's RGB8, after the body */
+    uint64_t colour_len, colour_got;
     int extra;             /* bytes after the announced end */
     char err_tail[STDERR_KEEP + 1];
     size_t err_len;
@@ -131,9 +134,26 @@ static int check_volume_header(const vxl_reader *r, const char *path, const vxl_
     if (!vxl_dtype_size(h->src_dtype) || h->texture_bits != vxl_texture_bits_for(h->src_dtype))
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent data type %u with %u-bit texels", path,
                         r->name, h->src_dtype, h->texture_bits);
+    /* a colour volume: RGB or RGBA whose scalar is the opacity source asked
+     * for, and 3 bytes a voxel of colour, charged to the budget with the
+     * texels as vxl_volume_build_colour charges them in process */
+    const int colour = h->components != 1;
+    uint32_t source, channel;
+    vxl_load_opacity_source(opt, &source, &channel);
+    if (colour ? (h->components != 3 && h->components != 4) || h->opacity_source != source
+               : h->opacity_source != 0 || h->colour_bytes != 0)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent %u components with opacity source %u "
+                        "(asked for %u) and %llu colour bytes", path, r->name, h->components, h->opacity_source,
+                        source, (unsigned long long)h->colour_bytes);
     vxl_err inner = {0};
-    if (vxl_volume_check_limits(h->dims, h->texture_bits / 8, opt, &inner)) return vxl_fail_in(e, path, &inner);
-    const uint64_t nbytes = (uint64_t)h->dims[0] * h->dims[1] * h->dims[2] * (h->texture_bits / 8);
+    if (vxl_volume_check_limits(h->dims, h->texture_bits / 8 + (colour ? VXL_COLOUR_BYTES_PER_VOXEL : 0), opt,
+                                &inner))
+        return vxl_fail_in(e, path, &inner);
+    const uint64_t voxels = (uint64_t)h->dims[0] * h->dims[1] * h->dims[2];
+    const uint64_t nbytes = voxels * (h->texture_bits / 8);
+    if (colour && h->colour_bytes != voxels * VXL_COLOUR_BYTES_PER_VOXEL)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s announced %llu colour bytes for %ux%ux%u voxels",
+                        path, r->name, (unsigned long long)h->colour_bytes, h->dims[0], h->dims[1], h->dims[2]);
     if (h->nbytes != nbytes || h->storage_bytes != nbytes)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s announced %llu bytes for %ux%ux%u voxels of %u bits",
                         path, r->name, (unsigned long long)h->nbytes, h->dims[0], h->dims[1], h->dims[2],
@@ -171,6 +191,13 @@ static int accept_header(const vxl_reader *r, const char *path, reply *rp, uint3
         int rc = check_volume_header(r, path, h, opt, e);
         if (rc) return rc;
         rp->body_len = h->nbytes;
+        if (h->colour_bytes) {
+            rp->colour_len = h->colour_bytes;
+            rp->colour = malloc((size_t)rp->colour_len);
+            if (!rp->colour)
+                return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': out of memory for %llu bytes of colour",
+                                path, (unsigned long long)rp->colour_len);
+        }
     } else {
         if (h->record_size != sizeof(vxl_dicom_series) || h->count > MAX_SERIES ||
             h->nbytes != (uint64_t)h->count * sizeof(vxl_dicom_series))
@@ -226,6 +253,10 @@ static int read_data(const vxl_reader *r, const char *path, vxl_child *child, re
         dst = rp->body + rp->body_got;
         uint64_t left = rp->body_len - rp->body_got;
         want = left > (1u << 24) ? (1u << 24) : (size_t)left;
+    } else if (rp->colour_got < rp->colour_len) {
+        dst = rp->colour + rp->colour_got;
+        uint64_t left = rp->colour_len - rp->colour_got;
+        want = left > (1u << 24) ? (1u << 24) : (size_t)left;
     } else {
         dst = scratch;
         want = sizeof scratch;
@@ -240,7 +271,8 @@ static int read_data(const vxl_reader *r, const char *path, vxl_child *child, re
     else if (rp->h_got < sizeof rp->h) {
         rp->h_got += (size_t)n;
         if (rp->h_got == sizeof rp->h) return accept_header(r, path, rp, kind, opt, e);
-    } else rp->body_got += (uint64_t)n;
+    } else if (rp->body_got < rp->body_len) rp->body_got += (uint64_t)n;
+    else rp->colour_got += (uint64_t)n;
     return VXL_OK;
 }
 
@@ -248,7 +280,7 @@ static int read_data(const vxl_reader *r, const char *path, vxl_child *child, re
 static vxl_child *spawn_helper(const vxl_reader *r, const char *helper, const char *command, const char *path,
                                const vxl_load_options *opt, vxl_err *e)
 {
-    char max_dim[24], budget[24], vs[3][32], frame[16];
+    char max_dim[24], budget[24], vs[3][32], frame[16], source[16], channel[16];
     double voxel[3];
     vxl_load_voxel_size(opt, voxel);
     snprintf(max_dim, sizeof max_dim, "%u", opt && opt->max_dim ? opt->max_dim : VXL_DEFAULT_MAX_DIM);
@@ -257,8 +289,13 @@ static vxl_child *spawn_helper(const vxl_reader *r, const char *helper, const ch
     for (int a = 0; a < 3; a++) snprintf(vs[a], sizeof vs[a], "%.17g", voxel[a]);
     snprintf(frame, sizeof frame, "%u", vxl_load_frame(opt));
     const char *series = vxl_load_series(opt);
+    uint32_t src, ch;
+    vxl_load_opacity_source(opt, &src, &ch);
+    snprintf(source, sizeof source, "%u", src);
+    snprintf(channel, sizeof channel, "%u", ch);
     char *const argv[VXL_HELPER_ARGC + 1] = {(char *)helper, (char *)command, (char *)path, max_dim, budget,
-                                             vs[0], vs[1], vs[2], frame, (char *)(series ? series : ""), NULL};
+                                             vs[0], vs[1], vs[2], frame, (char *)(series ? series : ""),
+                                             source, channel, NULL};
     vxl_child *c = vxl_child_start(helper, argv);
     if (!c)
         vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot start %s (%s): %s", path, r->name, helper,
@@ -361,7 +398,8 @@ static int verdict(const vxl_reader *r, const char *path, const char *helper, co
                         "or unsupported%s%s%s", path, r->name, sig, abbrev ? abbrev : "?", *said ? " (" : "", said,
                         *said ? ")" : "");
     }
-    const int complete = rp->h_got == sizeof rp->h && rp->body && rp->body_got == rp->body_len;
+    const int complete = rp->h_got == sizeof rp->h && rp->body && rp->body_got == rp->body_len &&
+                         rp->colour_got == rp->colour_len;
     if (complete && rp->h.status != VXL_OK) {
         int code = rp->h.status >= VXL_ERR_INVALID_ARGUMENT && rp->h.status <= VXL_ERR_STATE ? (int)rp->h.status
                                                                                              : VXL_ERR_FORMAT;
@@ -372,17 +410,19 @@ static int verdict(const vxl_reader *r, const char *path, const char *helper, co
                         end->code, *said ? ": " : "", said);
     if (!complete)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': the output of %s was cut short (%llu of %llu bytes)",
-                        path, r->name, (unsigned long long)(rp->h_got + rp->body_got),
-                        (unsigned long long)(sizeof rp->h + rp->body_len));
+                        path, r->name, (unsigned long long)(rp->h_got + rp->body_got + rp->colour_got),
+                        (unsigned long long)(sizeof rp->h + rp->body_len + rp->colour_len));
     if (rp->extra)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent more than it announced", path, r->name);
     return check_body(r, path, rp, e);
 }
 
 int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, const vxl_load_options *opt,
-                   uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, vxl_err *e)
+                   uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, uint8_t **colour,
+                   vxl_err *e)
 {
     *body = NULL;
+    if (colour) *colour = NULL;
     char helper[4096];
     int rc = helper_path(r, path, helper, sizeof helper, e);
     if (rc) return rc;
@@ -397,11 +437,15 @@ int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, c
     vxl_child_end end;
     vxl_child_finish(child, &end); /* not reaped: the host reaps children itself, the stream alone decides */
     if (!rc) rc = verdict(r, path, helper, &end, timed_out, limit, &rp, e);
+    if (!rc && rp.colour && !colour) /* a caller that takes no colour never asked for a volume */
+        rc = vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent colour where none was expected", path, r->name);
     if (rc) {
         free(rp.body);
+        free(rp.colour);
         return rc;
     }
     *h = rp.h;
     *body = rp.body;
+    if (colour) *colour = rp.colour;
     return VXL_OK;
 }

@@ -24,12 +24,15 @@ typedef struct vxl_reader {
 /* Runs `helper command path options` and collects its reply of kind
  * VXL_REPLY_*. On success *h is the checked header and *body the malloc'd
  * body of h->nbytes (free() it): for a volume, texels that passed the
- * limits in opt (checked before allocating) and the value checks; for a
- * series list, records whose strings are NUL-terminated. input_bytes (what
+ * limits in opt (checked before allocating, with a colour volume's colour)
+ * and the value checks, and *colour a colour volume's malloc'd RGB8 of
+ * h->colour_bytes (NULL for grey; colour may be NULL for a series list);
+ * for a series list, records whose strings are NUL-terminated. input_bytes (what
  * the helper will read) scales the time limit. The helper is always reaped;
  * a crash, a hang, a missing library or a bad stream is an error. */
 int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, const vxl_load_options *opt,
-                   uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, vxl_err *e);
+                   uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, uint8_t **colour,
+                   vxl_err *e);
 
 /* 0 where r's library has no build for this OS (Windows and a linux_only
  * reader): vxl_reader_run then refuses its formats by name. */

@@ -37,20 +37,26 @@
 #define VXL_CMD_ZARR "zarr"                /* OME-Zarr level -> a volume */
 
 /* argv: HELPER COMMAND PATH MAX_DIM BUDGET_BYTES VOXEL_X VOXEL_Y VOXEL_Z
- * FRAME SERIES (SERIES may be ""): the load options, defaults resolved. */
-#define VXL_HELPER_ARGC 10
+ * FRAME SERIES OPACITY_SOURCE OPACITY_CHANNEL (SERIES may be ""): the load
+ * options, defaults resolved. The opacity source travels because it decides
+ * what a colour volume's scalar is, which the helper builds. */
+#define VXL_HELPER_ARGC 12
 
-/* 02: the header carries the volume's notes; a helper left over from an
- * older build is refused as sending no valid header, not misread. */
-#define VXL_READER_MAGIC "VXLRD02"
+/* 03: the header carries a colour volume's components and its RGB8 colour
+ * follows the texels (02 added the notes); a helper left over from an older
+ * build is refused as sending no valid header, not misread. */
+#define VXL_READER_MAGIC "VXLRD03"
 #define VXL_READER_MSG_MAX 1024 /* longest error message a helper may send */
 
 #define VXL_REPLY_VOLUME 1u /* body: the volume's texels */
 #define VXL_REPLY_SERIES 2u /* body: count vxl_dicom_series records */
 
 /* The helper writes this header to stdout, then either msg_len bytes of
- * error message (status != 0) or nbytes of body. For a volume the fields
- * are those of the vxl_volume the in-process reader built (volume.h). */
+ * error message (status != 0) or nbytes of body and colour_bytes of colour.
+ * For a volume the fields are those of the vxl_volume the in-process reader
+ * built (volume.h, colour_volume.h): a colour volume's texels are its
+ * opacity source's scalar, and its RGB8 colour (3 bytes a voxel, x fastest)
+ * follows them; a grey volume has components 1 and no colour. */
 typedef struct vxl_reader_header {
     char magic[8];          /* VXL_READER_MAGIC, NUL-padded */
     uint32_t status;        /* VXL_OK or the VXL_ERR_* of the failure */
@@ -61,12 +67,14 @@ typedef struct vxl_reader_header {
     uint32_t dims[3];
     uint32_t src_dtype, texture_bits, nifti_version, affine_source;
     uint32_t frame_count, frame;
-    uint32_t reserved[2];
+    uint32_t components;    /* 1 grey, 3 RGB, 4 RGBA (vxl_volume.components) */
+    uint32_t opacity_source; /* VXL_OPACITY_SOURCE_* of a colour volume's texels; 0 for grey */
     double tex_lo, tex_hi, value_min, value_max;
     double spacing[3];
     double affine[16];      /* column-major voxel -> world */
     uint64_t nan_count, inf_count, storage_bytes;
-    uint64_t nbytes;        /* body bytes that follow */
+    uint64_t nbytes;        /* body bytes that follow (a volume: its texels) */
+    uint64_t colour_bytes;  /* RGB8 colour bytes after the texels: 3 a voxel, or 0 for grey */
     /* vxl_volume.notes (VXL_REPLY_VOLUME): NUL-terminated inside the array,
      * one line of text; all zero otherwise. The receiver refuses anything
      * else. A fixed array keeps the stream one header and one body. */
@@ -74,6 +82,6 @@ typedef struct vxl_reader_header {
 } vxl_reader_header;
 
 /* tests/python/test_vdb_isolation.py packs this layout by hand. */
-_Static_assert(sizeof(vxl_reader_header) == 800, "vxl_reader_header layout changed: update the tests' format");
+_Static_assert(sizeof(vxl_reader_header) == 808, "vxl_reader_header layout changed: update the tests' format");
 
 #endif

@@ -65,12 +65,15 @@ static uint64_t input_bytes(const char *path, const vxl_path_info *st, int reads
     return st->size + folder_bytes(dir, 0, &entries);
 }
 
-/* The reply's volume, taking ownership of the texels. */
-static int volume_from(const vxl_reader_header *h, void *texels, vxl_volume **out, vxl_err *e)
+/* The reply's volume, taking ownership of the texels and colour: the same
+ * vxl_volume the helper's reader built (a colour volume's scalar and RGB8,
+ * colour_volume.h). */
+static int volume_from(const vxl_reader_header *h, void *texels, uint8_t *colour, vxl_volume **out, vxl_err *e)
 {
     vxl_volume *v = calloc(1, sizeof *v);
     if (!v) {
         free(texels);
+        free(colour);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the volume header");
     }
     memcpy(v->dims, h->dims, sizeof v->dims);
@@ -91,6 +94,9 @@ static int volume_from(const vxl_reader_header *h, void *texels, vxl_volume **ou
     v->frame_count = h->frame_count;
     v->frame = h->frame;
     memcpy(v->notes, h->notes, sizeof v->notes); /* terminated: checked on receipt */
+    v->colour = colour;
+    v->components = h->components;
+    v->opacity_source = h->opacity_source;
     *out = v;
     return VXL_OK;
 }
@@ -105,10 +111,11 @@ static int load_remote(const vxl_reader *r, const char *command, int reads_sibli
     if (vxl_path_stat(path, &st)) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
     vxl_reader_header h;
     void *body = NULL;
+    uint8_t *colour = NULL;
     int rc = vxl_reader_run(r, command, path, opt, VXL_REPLY_VOLUME, input_bytes(path, &st, reads_siblings, depth),
-                            &h, &body, e);
+                            &h, &body, &colour, e);
     if (rc) return rc;
-    return volume_from(&h, body, out, e);
+    return volume_from(&h, body, colour, out, e);
 }
 
 int vxl_image_stack_reader_runs_here(void) { return vxl_reader_runs_here(&stack_reader); }
@@ -149,10 +156,11 @@ int vxl_zarr_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
     if (vxl_path_stat(folder, &st)) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", folder, strerror(errno));
     vxl_reader_header h;
     void *body = NULL;
+    uint8_t *colour = NULL;
     int rc = vxl_reader_run(&zarr_reader, VXL_CMD_ZARR, path, opt, VXL_REPLY_VOLUME,
-                            input_bytes(folder, &st, 0, ZARR_DEPTH), &h, &body, e);
+                            input_bytes(folder, &st, 0, ZARR_DEPTH), &h, &body, &colour, e);
     if (rc) return rc;
-    return volume_from(&h, body, out, e);
+    return volume_from(&h, body, colour, out, e);
 }
 
 VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint32_t max, uint32_t *count)
@@ -174,7 +182,7 @@ VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint3
     vxl_reader_header h;
     void *body = NULL;
     int rc = vxl_reader_run(&dicom_reader, VXL_CMD_DICOM_SERIES, path, NULL, VXL_REPLY_SERIES,
-                            input_bytes(path, &st, 1, DICOM_DEPTH), &h, &body, NULL);
+                            input_bytes(path, &st, 1, DICOM_DEPTH), &h, &body, NULL, NULL);
     if (rc) return rc;
     const vxl_dicom_series *all = body;
     const size_t stride = max && out->struct_size ? out->struct_size : sizeof(vxl_dicom_series);

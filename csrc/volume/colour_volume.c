@@ -46,8 +46,7 @@ static void raw_put(void *raw, uint32_t dtype, uint64_t i, double v)
 #undef PUT
 }
 
-int vxl_colour_opacity_source(const vxl_load_options *opt, uint32_t components, uint32_t *source, uint32_t *channel,
-                              vxl_err *e)
+void vxl_load_opacity_source(const vxl_load_options *opt, uint32_t *source, uint32_t *channel)
 {
     *source = VXL_OPACITY_SOURCE_LUMINANCE;
     *channel = 0;
@@ -56,6 +55,12 @@ int vxl_colour_opacity_source(const vxl_load_options *opt, uint32_t components, 
         *source = opt->opacity_source;
         *channel = opt->opacity_channel;
     }
+}
+
+int vxl_colour_opacity_source(const vxl_load_options *opt, uint32_t components, uint32_t *source, uint32_t *channel,
+                              vxl_err *e)
+{
+    vxl_load_opacity_source(opt, source, channel);
     if (*source >= VXL_OPACITY_SOURCE_COUNT)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown opacity source %u (0 luminance, 1 channel, 2 alpha)",
                         *source);

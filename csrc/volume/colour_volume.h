@@ -26,6 +26,10 @@ int vxl_volume_build_colour(const void *raw, uint32_t dtype, uint32_t components
                             const double spacing[3], const double *affine, double slope, double inter,
                             const vxl_load_options *opt, const char *what, vxl_volume **out, vxl_err *e);
 
+/* The opacity source and channel of opt as given (struct_size covering
+ * them; else luminance, channel 0), unchecked: what a reader helper is told. */
+void vxl_load_opacity_source(const vxl_load_options *opt, uint32_t *source, uint32_t *channel);
+
 /* The opacity source and channel of opt (struct_size covering them; else
  * luminance), checked against `components`. */
 int vxl_colour_opacity_source(const vxl_load_options *opt, uint32_t components, uint32_t *source, uint32_t *channel,

@@ -101,6 +101,11 @@ int main(int argc, char **argv)
                             "NDims = 3\nDimSize = 4 3 2\nElementByteOrderMSB = True\nElementType = MET_SHORT\n"
                             "HeaderSize = -1\nElementDataFile = LOCAL\n", i16_be, sizeof i16, TW_RAW, NULL),
        "mha i16 msb");
+    /* colour: 3 channels a voxel (the colour volume's path) */
+    ok(tw_write_header_data(path("metaimage", "seed_rgb_zlib.mha"),
+                            "NDims = 3\nDimSize = 4 2 1\nElementNumberOfChannels = 3\nElementType = MET_UCHAR\n"
+                            "CompressedData = True\nElementDataFile = LOCAL\n", u8, sizeof u8, TW_ZLIB, NULL),
+       "mha rgb zlib");
 
     /* TIFF */
     ok(tw_write_tiff(path("tiff", "seed_u8_pages.tif"), 4, 3, 2, 1, 8, 1, u8), "tiff u8 pages");

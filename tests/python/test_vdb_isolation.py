@@ -6,6 +6,7 @@ no zombie and no descriptor behind, and never falls back to reading
 in-process. tests/cli/test_reader_helpers.py covers missing helpers and
 libraries per format."""
 
+import ctypes
 import os
 import stat
 import struct
@@ -15,18 +16,18 @@ import time
 import numpy as np
 import pytest
 
-from voxlight.core import native
+from voxlight.core import native, native_abi
 from vdb_write import write_vdb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ABORTS = os.path.join(ROOT, "tests", "fuzz", "upstream", "openvdb_delayed_load_mask_assert.vdb")
 # vxl_reader_header in csrc/io/reader_stream.h: magic; status, msg_len, kind,
 # count, record_size, dims[3], src_dtype, texture_bits, nifti_version,
-# affine_source, frame_count, frame, reserved[2]; tex_lo, tex_hi, value_min,
-# value_max; spacing[3]; affine[16]; nan_count, inf_count, storage_bytes,
-# nbytes; notes[512]
-HEADER = "=8s16I4d3d16d4Q512s"
-HEADER_SIZE = 800
+# affine_source, frame_count, frame, components, opacity_source; tex_lo, tex_hi,
+# value_min, value_max; spacing[3]; affine[16]; nan_count, inf_count,
+# storage_bytes, nbytes, colour_bytes; notes[512]
+HEADER = "=8s16I4d3d16d5Q512s"
+HEADER_SIZE = 808
 HELPER_ENV = "VOXLIGHT_READ_OIIO"
 TIMEOUT_ENV = "VOXLIGHT_READER_TIMEOUT"
 VXL_DTYPE_F32 = 7
@@ -84,12 +85,13 @@ def _fake_helper(tmp_path, body):
     return str(p)
 
 
-def _header(status=0, dims=(4, 3, 2), nbytes=None, msg_len=0, magic=b"VXLRD02\0", kind=1, affine=None,
-            notes=b""):
+def _header(status=0, dims=(4, 3, 2), nbytes=None, msg_len=0, magic=b"VXLRD03\0", kind=1, affine=None,
+            notes=b"", components=1, opacity_source=0, colour_bytes=None):
     n = dims[0] * dims[1] * dims[2] * 4 if nbytes is None else nbytes
+    c = (dims[0] * dims[1] * dims[2] * 3 if components > 1 else 0) if colour_bytes is None else colour_bytes
     a = np.eye(4).T.ravel() if affine is None else affine
-    return struct.pack(HEADER, magic, status, msg_len, kind, 0, 0, *dims, VXL_DTYPE_F32, 32, 0, 2, 1, 0, 0, 0,
-                       0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *a, 0, 0, n, n, notes)
+    return struct.pack(HEADER, magic, status, msg_len, kind, 0, 0, *dims, VXL_DTYPE_F32, 32, 0, 2, 1, 0,
+                       components, opacity_source, 0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *a, 0, 0, n, n, c, notes)
 
 
 assert struct.calcsize(HEADER) == HEADER_SIZE
@@ -98,9 +100,22 @@ assert struct.calcsize(HEADER) == HEADER_SIZE
 @pytest.mark.parametrize("body, needle", [
     # a header that claims 2^30 voxels: refused by the budget before allocating
     ("out.write(%r)" % _header(dims=(1024, 1024, 1024)), r"over the memory budget of 1\.0 MiB"),
-    ("out.write(%r + bytes(10))" % _header(), r"output of the OpenVDB reader was cut short \(810 of 896 bytes\)"),
-    # an older helper's header (magic 01, no notes) is refused, not misread
+    ("out.write(%r + bytes(10))" % _header(), r"output of the OpenVDB reader was cut short \(818 of 904 bytes\)"),
+    # an older helper's header (magic 01, no notes; 02, no colour) is refused, not misread
     ("out.write(%r + bytes(96))" % _header(magic=b"VXLRD01\0"), r"sent no valid header"),
+    ("out.write(%r + bytes(96))" % _header(magic=b"VXLRD02\0"), r"sent no valid header"),
+    # colour: 3 bytes a voxel after the texels, the opacity source asked for,
+    # charged to the budget with the texels, and all of it sent
+    ("out.write(%r + bytes(96) + bytes(72))" % _header(components=2), r"sent 2 components"),
+    ("out.write(%r + bytes(96))" % _header(colour_bytes=72), r"sent 1 components .* and 72 colour bytes"),
+    ("out.write(%r + bytes(96) + bytes(72))" % _header(components=3, opacity_source=2),
+     r"opacity source 2 \(asked for 0\)"),
+    ("out.write(%r + bytes(96) + bytes(70))" % _header(components=3, colour_bytes=70),
+     r"announced 70 colour bytes for 4x3x2 voxels"),
+    ("out.write(%r + bytes(96) + bytes(71))" % _header(components=3),
+     r"cut short \(975 of 976 bytes\)"),
+    ("out.write(%r + bytes(96) + bytes(73))" % _header(components=3), r"more than it announced"),
+    ("out.write(%r)" % _header(dims=(64, 64, 50), components=3), r"over the memory budget of 1\.0 MiB"),
     # notes: terminated inside their 512 bytes, one line of text
     ("out.write(%r + bytes(96))" % _header(notes=b"n" * 512), r"sent notes that are not one terminated line"),
     ("out.write(%r + bytes(96))" % _header(notes=b"two\nlines"), r"sent notes that are not one terminated line"),
@@ -134,6 +149,19 @@ def test_helper_notes_reach_the_volume_info(lib, small_vdb, tmp_path, monkeypatc
     monkeypatch.setenv(HELPER_ENV, _fake_helper(tmp_path, "out.write(%r + bytes(96))" % _header()))
     with native.Volume.load(small_vdb, lib=lib) as v:
         assert v.info["notes"] == ""
+    assert _children() == []
+
+
+def test_helper_colour_reaches_the_volume(lib, small_vdb, tmp_path, monkeypatch):
+    """A colour volume's RGB8 follows its texels (3 bytes a voxel), and the
+    opacity source the caller asked for is on the helper's command line."""
+    body = ("assert sys.argv[10:] == ['0', '0'], sys.argv\n"
+            "out.write(%r + bytes(96) + bytes(range(72)))" % _header(components=4))
+    monkeypatch.setenv(HELPER_ENV, _fake_helper(tmp_path, body))
+    with native.Volume.load(small_vdb, lib=lib) as v:
+        info = native_abi._sized(native_abi.VolumeInfo)
+        lib.check(lib.cdll.vxl_volume_get_info(v._handle, ctypes.byref(info)))
+        assert (info.components, info.opacity_source, info.color_bytes) == (4, 0, 72)
     assert _children() == []
 
 

@@ -108,7 +108,9 @@ float path_stratified(inout PathRng r, int k, int d)
 
 // ---- the medium -------------------------------------------------------------
 
-uint g_lookups = 0u; // density lookups, for the frame's statistics
+// The alpha march's samples, for the frame's statistics (within its bound,
+// as the ray caster's); the tracker's lookups are bounded by its own guards.
+uint g_lookups = 0u;
 
 float extinction(float a) { return a >= 1.0 ? u_path_max_sigma : min(-log(1.0 - a), u_path_max_sigma); }
 
@@ -139,7 +141,6 @@ bool track(vec3 o, vec3 d, float t, float t1, float u0, inout PathRng rng, out f
                 if (t >= t_exit) break;
                 vec3 q = o + t * d;
                 float v = sample_value(q);
-                g_lookups++;
                 if (path_white(rng) * smaj < extinction(classify(v).a)) {
                     tc = t;
                     vc = v;

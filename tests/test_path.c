@@ -2,8 +2,9 @@
  * csrc/render/path.c, shaders/render/path.frag): one bounce is scatter's
  * sum within the noise, more bounces only add light, the same seed gives
  * the same image bit for bit and another seed another one, k calls of one
- * sample merged with vxl_path_accumulate are one call of k samples, and
- * what PATH does not draw is refused by name.
+ * sample merged with vxl_path_accumulate are one call of k samples, the
+ * World alone lights it, bricked storage (the whole table's majorant)
+ * traces the same medium, and what PATH does not draw is refused by name.
  *
  * The scene: the two-blobs phantom at 24^3 voxels, 48 x 24 pixels, the
  * default camera (the +x blob on the left half, the -x blob on the right). */
@@ -185,6 +186,63 @@ TEST(k_calls_of_one_sample_merge_into_one_call_of_k)
     CHECK(memcmp(A, S, sizeof A) != 0);
 }
 
+/* An HDRI-only scene: no lamp, a uniform World; every collision gathers
+ * the World's irradiance, so the blobs are lit, and more bounces add to it. */
+TEST(the_world_alone_lights_the_volume)
+{
+    vxl_render_params p = scene(VXL_SHADING_PATH, 0.9f, 0.6f);
+    static const float grey[3] = {0.6f, 0.6f, 0.6f};
+    vxl_environment env = {.struct_size = sizeof env, .width = 1, .height = 1, .rgb = grey, .strength = 1};
+    p.environment = &env;
+    p.light_count = 0;
+    p.path_samples = 4;
+    p.path_bounces = 1;
+    REQUIRE(render(&p, A, NULL) == VXL_OK);
+    p.path_bounces = 4;
+    REQUIRE(render(&p, B, NULL) == VXL_OK);
+    double a = 0, lit1 = 0, lit4 = 0;
+    for (int i = 0; i < PX; i++) {
+        if (A[4 * i + 3] < 0.5f) continue;
+        a += A[4 * i + 3];
+        lit1 += A[4 * i];
+        lit4 += B[4 * i];
+    }
+    fprintf(stderr, "    straight red over the opaque pixels: %.4f (1 bounce), %.4f (4)\n", lit1 / a, lit4 / a);
+    CHECK(a > 10);
+    CHECKF(lit1 / a > 0.1, "%.4f", lit1 / a);
+    CHECKF(lit4 > lit1, "%.4f vs %.4f", lit4 / a, lit1 / a);
+}
+
+/* Bricked storage samples a pool the full-resolution min-max does not
+ * bound, so its bricks take the whole table's majorant: more null
+ * collisions, another noise, the same expectation. The images' means agree
+ * within 4 standard errors (from the two renders' difference) plus 1%. */
+TEST(bricked_storage_traces_the_same_medium)
+{
+    vxl_renderer_options o = {.struct_size = sizeof o, .backend = software_backend(), .storage = VXL_STORAGE_BRICKED,
+                              .page_brick = 16};
+    vxl_renderer *rb = NULL;
+    vxl_volume *v = blobs_volume();
+    REQUIRE(v && vxl_renderer_create(&o, &rb) == VXL_OK);
+    int rc = vxl_renderer_set_volume(rb, v);
+    vxl_volume_destroy(v);
+    vxl_render_params p = scene(VXL_SHADING_PATH, 0.8f, 0.5f);
+    p.path_samples = 32;
+    p.path_bounces = 2;
+    if (!rc) rc = vxl_render(rb, &p, B, NULL);
+    if (rc) fprintf(stderr, "    bricked: %s\n", vxl_renderer_error(rb));
+    vxl_renderer_destroy(rb);
+    REQUIRE(rc == VXL_OK);
+    REQUIRE(render(&p, A, NULL) == VXL_OK);
+    const double ma = mean_rgb(A), mb = mean_rgb(B), se = rms_rgb(A, B) / sqrt(3.0 * PX);
+    fprintf(stderr, "    dense %.5f, bricked %.5f, se of the difference %.5f\n", ma, mb, se);
+    CHECK(ma > 0.005);
+    CHECKF(fabs(ma - mb) <= 4 * se + 0.01 * ma, "%.5f vs %.5f", ma, mb);
+    double da = 0;
+    for (int i = 0; i < PX; i++) da = fmax(da, fabs(A[4 * i + 3] - B[4 * i + 3]));
+    CHECKF(da < 1e-3, "alpha differs by %.5f", da);
+}
+
 TEST(what_path_cannot_draw_is_refused_by_name)
 {
     vxl_render_params p = scene(VXL_SHADING_PATH, 0.8f, 0.5f);
@@ -231,6 +289,8 @@ int main(void)
     RUN(more_bounces_brighten_a_thick_white_volume_and_never_darken_it);
     RUN(the_same_seed_gives_the_same_image_and_another_seed_another);
     RUN(k_calls_of_one_sample_merge_into_one_call_of_k);
+    RUN(the_world_alone_lights_the_volume);
+    RUN(bricked_storage_traces_the_same_medium);
     RUN(what_path_cannot_draw_is_refused_by_name);
     vxl_renderer_destroy(R);
     return TEST_SUMMARY();

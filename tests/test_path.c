@@ -3,7 +3,7 @@
  * sum within the noise, more bounces only add light, the same seed gives
  * the same image bit for bit and another seed another one, k calls of one
  * sample merged with vxl_path_accumulate are one call of k samples, the
- * World alone lights it, bricked storage (the whole table's majorant)
+ * World alone lights it, a colour volume's colour is its albedo, bricked storage (the whole table's majorant)
  * traces the same medium, and what PATH does not draw is refused by name.
  *
  * The scene: the two-blobs phantom at 24^3 voxels, 48 x 24 pixels, the
@@ -243,6 +243,44 @@ TEST(bricked_storage_traces_the_same_medium)
     CHECKF(da < 1e-3, "alpha differs by %.5f", da);
 }
 
+/* A colour volume (a red ball in black): the voxels' colour replaces the
+ * table's white at every collision, so the light that comes back is red
+ * only, after any number of bounces. */
+TEST(a_colour_volumes_colour_is_the_albedo)
+{
+    enum { C = 12 };
+    static uint8_t rgb[C * C * C * 3];
+    for (int z = 0; z < C; z++)
+        for (int y = 0; y < C; y++)
+            for (int x = 0; x < C; x++) {
+                double d = sqrt((x - 5.5) * (x - 5.5) + (y - 5.5) * (y - 5.5) + (z - 5.5) * (z - 5.5));
+                rgb[3 * (x + C * (y + C * z))] = d < 4.5 ? 255 : 0;
+            }
+    vxl_volume_desc d = {.struct_size = sizeof d, .dtype = VXL_DTYPE_U8, .dims = {C, C, C}, .data = rgb,
+                         .components = 3};
+    vxl_volume *v = NULL;
+    vxl_renderer *rcol = make_renderer(software_backend());
+    REQUIRE(rcol && vxl_volume_create(&d, NULL, &v) == VXL_OK);
+    int rc = vxl_renderer_set_volume(rcol, v);
+    vxl_volume_destroy(v);
+    vxl_render_params p = scene(VXL_SHADING_PATH, 1.0f, 0.5f);
+    p.has_window = 0; /* the data's range: the ball's luminance at the table's top */
+    p.path_samples = 4;
+    p.path_bounces = 3;
+    if (!rc) rc = vxl_render(rcol, &p, A, NULL);
+    if (rc) fprintf(stderr, "    colour volume: %s\n", vxl_renderer_error(rcol));
+    vxl_renderer_destroy(rcol);
+    REQUIRE(rc == VXL_OK);
+    double red = 0, other = 0;
+    for (int i = 0; i < PX; i++) {
+        red += A[4 * i];
+        other += A[4 * i + 1] + A[4 * i + 2];
+    }
+    fprintf(stderr, "    red %.4f, green + blue %.4f\n", red, other);
+    CHECK(red > 0.5);
+    CHECK(other == 0);
+}
+
 TEST(what_path_cannot_draw_is_refused_by_name)
 {
     vxl_render_params p = scene(VXL_SHADING_PATH, 0.8f, 0.5f);
@@ -291,6 +329,7 @@ int main(void)
     RUN(k_calls_of_one_sample_merge_into_one_call_of_k);
     RUN(the_world_alone_lights_the_volume);
     RUN(bricked_storage_traces_the_same_medium);
+    RUN(a_colour_volumes_colour_is_the_albedo);
     RUN(what_path_cannot_draw_is_refused_by_name);
     vxl_renderer_destroy(R);
     return TEST_SUMMARY();

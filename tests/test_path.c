@@ -2,9 +2,10 @@
  * csrc/render/path.c, shaders/render/path.frag): one bounce is scatter's
  * sum within the noise, more bounces only add light, the same seed gives
  * the same image bit for bit and another seed another one, k calls of one
- * sample merged with vxl_path_accumulate are one call of k samples, the
- * World alone lights it, a colour volume's colour is its albedo, bricked storage (the whole table's majorant)
- * traces the same medium, and what PATH does not draw is refused by name.
+ * sample merged with vxl_path_accumulate are one call of k samples, a clip
+ * plane cuts the medium away, the World alone lights it, bricked storage
+ * (the whole table's majorant) traces the same medium, a colour volume's
+ * colour is its albedo, and what PATH does not draw is refused by name.
  *
  * The scene: the two-blobs phantom at 24^3 voxels, 48 x 24 pixels, the
  * default camera (the +x blob on the left half, the -x blob on the right). */
@@ -186,6 +187,26 @@ TEST(k_calls_of_one_sample_merge_into_one_call_of_k)
     CHECK(memcmp(A, S, sizeof A) != 0);
 }
 
+/* A clip plane keeping world x >= 0 removes the -x blob (the image's
+ * right half) from the primary rays and from every bounce: nothing is left
+ * there, and the +x blob still gets its light. */
+TEST(a_clip_plane_cuts_the_medium_away)
+{
+    vxl_render_params p = scene(VXL_SHADING_PATH, 0.8f, 0.5f);
+    p.path_samples = 4;
+    p.path_bounces = 3;
+    vxl_cutaway cut = {.struct_size = sizeof cut, .clip_plane_count = 1};
+    cut.clip_planes[0].plane[0] = 1;
+    p.cutaway = &cut;
+    REQUIRE(render(&p, A, NULL) == VXL_OK);
+    double left = 0, right = 0;
+    for (int i = 0; i < PX; i++)
+        for (int c = 0; c < 4; c++) *(i % W < W / 2 ? &left : &right) += A[4 * i + c];
+    fprintf(stderr, "    left half %.4f, right half %.4f\n", left, right);
+    CHECK(left > 1);
+    CHECK(right == 0);
+}
+
 /* An HDRI-only scene: no lamp, a uniform World; every collision gathers
  * the World's irradiance, so the blobs are lit, and more bounces add to it. */
 TEST(the_world_alone_lights_the_volume)
@@ -299,12 +320,12 @@ TEST(what_path_cannot_draw_is_refused_by_name)
     CHECK(vxl_render(R, &p, A, NULL) == VXL_ERR_INVALID_ARGUMENT);
     CHECK(strstr(vxl_renderer_error(R), "gradient_opacity") != NULL);
     p.gradient_opacity = 0;
-    vxl_cutaway cut = {.struct_size = sizeof cut, .clip_plane_count = 1};
-    cut.clip_planes[0].plane[0] = 1;
-    p.cutaway = &cut;
+    static const float grey[4] = {0.5f, 0.5f, 0.5f, 1};
+    vxl_matcap mc = {.struct_size = sizeof mc, .width = 1, .height = 1, .rgba = grey};
+    p.matcap = &mc;
     CHECK(vxl_render(R, &p, A, NULL) == VXL_ERR_INVALID_ARGUMENT);
-    CHECK(strstr(vxl_renderer_error(R), "cutaway") != NULL);
-    p.cutaway = NULL;
+    CHECK(strstr(vxl_renderer_error(R), "MatCap") != NULL);
+    p.matcap = NULL;
     CHECK(vxl_render(R, &p, A, NULL) == VXL_OK);
     /* the other models ignore the path fields */
     p.shading_model = VXL_SHADING_SCATTER;
@@ -327,6 +348,7 @@ int main(void)
     RUN(more_bounces_brighten_a_thick_white_volume_and_never_darken_it);
     RUN(the_same_seed_gives_the_same_image_and_another_seed_another);
     RUN(k_calls_of_one_sample_merge_into_one_call_of_k);
+    RUN(a_clip_plane_cuts_the_medium_away);
     RUN(the_world_alone_lights_the_volume);
     RUN(bricked_storage_traces_the_same_medium);
     RUN(a_colour_volumes_colour_is_the_albedo);

@@ -1,7 +1,8 @@
 /* frame_path.c - the PATH shading model's fields of vxl_render_params (the
  * sample range, the bounce limit, the seed) validated into the frame, and
  * the features PATH does not draw yet, refused by name instead of drawn
- * wrong. */
+ * wrong (clip planes and the crop box it draws: path.frag cuts every
+ * segment of a path by them). */
 #include "frame.h"
 
 int vxl_frame_resolve_path(vxl_frame *f, const vxl_render_params *p, vxl_err *e)
@@ -31,7 +32,7 @@ int vxl_frame_path_check(const vxl_frame *f, vxl_err *e)
                        : f->mode != VXL_MODE_DVR            ? "a mode other than DVR"
                        : f->technique != VXL_TECHNIQUE_RAYCAST ? "a slicing technique"
                        : f->matcap_rgba                     ? "a MatCap"
-                       : f->cut.any                         ? "a cutaway"
+                       : f->cut.cutter_count                ? "cutter meshes (clip planes and the crop box it does)"
                        : f->labels.on                       ? "labels"
                        : f->overlays.count                  ? "overlays"
                                                             : NULL;

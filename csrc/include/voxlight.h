@@ -448,9 +448,11 @@ typedef struct vxl_light_shape {
  *             same image bit for bit, and vxl_path_accumulate merges
  *             consecutive calls into the mean of all their samples (see
  *             there). PATH classifies after interpolation whatever
- *             `classify` says, and refuses gradient opacity, modes other than
- *             COMPOSITE, the slicing techniques, the MatCap, cutaways, label
- *             maps and overlays (VXL_ERR_INVALID_ARGUMENT, naming them).
+ *             `classify` says; clip planes and the crop box remove the medium
+ *             from every segment of a path (no caps); it refuses gradient
+ *             opacity, modes other than DVR, the slicing techniques, the
+ *             MatCap, cutter meshes, label maps and overlays
+ *             (VXL_ERR_INVALID_ARGUMENT, naming them).
  * "ambient" is the material's ambient * colour; each model's result is
  * clamped to [0, 1] per channel (PATH's sum is not). A sample whose gradient vanishes has no
  * normal: PHONG and SHADOWED leave it unlit (its colour, as today), SCATTER

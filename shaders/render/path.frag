@@ -34,6 +34,7 @@
 #include "lib/colour.glsl" // DATA_COLOUR: a colour volume's own colour
 #include "lib/shading.glsl"
 #include "lib/ray_box.glsl"
+#include "lib/cut.glsl" // CUT_CONVEX: clip planes and the crop box (cut_convex)
 
 uniform mat4 u_ray_near;  // as raycast.frag's
 uniform mat4 u_ray_far;
@@ -153,6 +154,20 @@ bool track(vec3 o, vec3 d, float t, float t1, float u0, inout PathRng rng, out f
     return false;
 }
 
+// The part of o + t d in [t0, t1] that the clip planes and the crop box
+// keep: a convex region, so one interval for every segment of a path, the
+// primary ray and each bounce alike (what is cut away is no medium; no
+// caps: a medium has no surface normal there). False when nothing is left.
+bool path_keep(vec3 o, vec3 d, inout float t0, inout float t1)
+{
+#ifdef CUT_CONVEX
+    vec3 cap = vec3(0.0);
+    return cut_convex(o, d, t0, t1, cap) && t0 < t1;
+#else
+    return t0 < t1;
+#endif
+}
+
 // ---- directions ---------------------------------------------------------------
 
 // A unit vector at angle acos(c) from unit axis n, azimuth 2 pi u.
@@ -211,8 +226,7 @@ vec3 path_sample(vec3 o, vec3 d, float t0, float t1, mat3 to_voxel, bool one_dir
         o = p;
         t0 = 0.0;
         t1 = PATH_INF;
-        float e0 = 0.0;
-        if (!box_clip(o, d, vec3(-0.5), u_dims - 0.5, e0, t1) || !(t1 > 0.0)) break;
+        if (!box_clip(o, d, vec3(-0.5), u_dims - 0.5, t0, t1) || !path_keep(o, d, t0, t1)) break;
     }
     return radiance;
 }
@@ -268,7 +282,7 @@ void main()
         float sd = texelFetch(u_scene_depth, ivec2(gl_FragCoord.xy), 0).r;
         if (!isnan(sd)) t1 = min(t1, (-sd - z0) / dz);
     }
-    if (!(t0 < t1)) { emit_nothing(); return; }
+    if (!path_keep(o, dir, t0, t1)) { emit_nothing(); return; }
 
     float depth;
     float alpha = path_alpha(o, dir, t0, t1, z0, dz, depth);

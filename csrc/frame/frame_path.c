@@ -12,6 +12,12 @@ int vxl_frame_resolve_path(vxl_frame *f, const vxl_render_params *p, vxl_err *e)
     f->path_bounces = p->path_bounces ? p->path_bounces : VXL_PATH_DEFAULT_BOUNCES;
     f->path_seed = p->path_seed;
     if (f->shading_model != VXL_SHADING_PATH) return VXL_OK;
+    /* the tracer classifies each lookup after interpolation and keeps no
+     * gradient from one collision to the next: nothing to build for those */
+    if (f->shading) {
+        f->classify = VXL_CLASSIFY_POST;
+        f->reuse = 0;
+    }
     if (f->path_samples > VXL_PATH_MAX_SAMPLES)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "path_samples = %u exceeds %u per call", f->path_samples,
                         VXL_PATH_MAX_SAMPLES);

@@ -176,9 +176,8 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     if (f->shading && f->env.on) flags |= VXL_FLAG_ENVIRONMENT; /* the World's light */
     uint32_t filter = vxl_frame_filter(f);
     const int path = f->shading && f->shading_model == VXL_SHADING_PATH; /* render/path.c's tracer */
-    if (path) flags &= ~(2u | (3u << 2)); /* it classifies after interpolation and reuses nothing: one program */
     rc = vxl_frame_path_check(f, &r->gpu.err);
-    if (!rc) rc = r->storage.ops->check_filter(&r->storage, filter, path ? VXL_CLASSIFY_POST : f->classify);
+    if (!rc) rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
     if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);
     if (!rc)
         rc = vxl_program_get(&r->gpu, path ? VXL_PROG_PATH : f->technique ? VXL_PROG_SLICES : VXL_PROG_RAYCAST, filter,

@@ -438,8 +438,8 @@ typedef struct vxl_light_shape {
  *             World, with w), unclamped, times the path's throughput, and the
  *             path goes on (up to path_bounces collisions) in a direction
  *             drawn from HG(g) (probability 1 - w, throughput * colour) or
- *             cosine-weighted about n (probability w, throughput * diffuse *
- *             colour). path_bounces 1 is SCATTER's sum without its clamp,
+ *             cosine-weighted about n (probability w, throughput * min(diffuse,
+ *             1) * colour). path_bounces 1 is SCATTER's sum without its clamp,
  *             integrated exactly along the ray instead of in steps. The alpha
  *             and depth are the ray's opacity as the emission-absorption
  *             march gives it (no noise). The image is the mean of samples

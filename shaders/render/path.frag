@@ -15,8 +15,10 @@
 //    `scatter`'s sum, integrated along the ray instead of in steps;
 //  - then, up to u_path_bounces collisions, a new direction: the surface
 //    lobe with probability w (cosine-weighted about the normal, throughput
-//    times diffuse * colour) or the Henyey-Greenstein lobe (throughput times
-//    the colour, the single-scattering albedo).
+//    times min(diffuse, 1) * colour: a material's diffuse above 1 brightens
+//    its direct light but may not multiply light bounce after bounce) or
+//    the Henyey-Greenstein lobe (throughput times the colour, the
+//    single-scattering albedo), so the throughput never exceeds 1.
 // A path that leaves the volume adds nothing more: the lamps and the World
 // were counted at every collision already. Alpha and depth come from a
 // deterministic emission-absorption march of the same opacity, so they are
@@ -216,7 +218,7 @@ vec3 path_sample(vec3 o, vec3 d, float t0, float t1, mat3 to_voxel, bool one_dir
             n /= len;
             if (dot(n, -travel) < 0.0) n = -n; // the side the path came from, as shading turns it
             next = around(n, sqrt(path_stratified(rng, k, 2)), path_stratified(rng, k, 3));
-            throughput *= SHADE_MATERIAL.y * rgb;
+            throughput *= min(SHADE_MATERIAL.y, 1.0) * rgb; // a surface reflects at most what it receives
         } else {
             next = around(travel, hg_cos(u_anisotropy, path_stratified(rng, k, 2)), path_stratified(rng, k, 3));
             throughput *= rgb;

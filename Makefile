@@ -80,7 +80,7 @@ STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlig
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
-all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/tests/render_scene $(BUILD)/tests/child_program $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(BUILD)/voxlight-sceneshadowbench $(BUILD)/voxlight-envbench $(STUDIES) $(TESTS)
+all: $(BUILD)/libvoxlight.so $(BUILD)/voxlight $(BUILD)/tests/render_scene $(BUILD)/tests/child_program $(HELPERS) $(BUILD)/voxlight-bench $(BUILD)/voxlight-skipbench $(BUILD)/voxlight-storagebench $(BUILD)/voxlight-lightbench $(BUILD)/voxlight-sceneshadowbench $(BUILD)/voxlight-envbench $(BUILD)/voxlight-pathbench $(STUDIES) $(TESTS)
 
 # Objects are rebuilt when LIB_CC changes (the stamp holds the last one).
 LIB_CC_STAMP := $(BUILD)/obj/lib_cc.txt
@@ -196,6 +196,10 @@ $(BUILD)/voxlight-modesbench: bench/modes_study.c bench/bench_util.h $(BUILD)/li
 
 # the World's light: its cost over a cached shadowed frame (docs/lighting.md)
 $(BUILD)/voxlight-envbench: bench/environment_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
+# the PATH model: time to the first frame and error against samples (docs/lighting.md)
+$(BUILD)/voxlight-pathbench: bench/path_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
 $(BUILD)/voxlight-sceneshadowbench: bench/scene_shadow_study.c bench/bench_util.h $(BUILD)/libvoxlight.so

@@ -822,6 +822,29 @@ VIEW(environment_uniform_shadowed)
     p->lights[0].position[2] = 1;
 }
 
+/* The path tracer (PATH) at its extremes, in one case (one program per
+ * filter): the World above, the largest material, a backward phase, a
+ * lamp far away and a directional one, the longest paths, two samples from
+ * the top of the index range. It refuses the gradient-opacity crossings
+ * and the modes by name (a clean refusal). */
+VIEW(path_extreme)
+{
+    environment_extreme(p, vc);
+    p->has_material = 1;
+    p->ambient = p->diffuse = p->specular = 100;
+    p->shininess = 1e4f;
+    p->shading_model = VXL_SHADING_PATH;
+    p->anisotropy = -0.99f;
+    p->light_count = 2;
+    p->lights[0].position[2] = 1;
+    p->lights[1].position[0] = 1e30f;
+    p->lights[1].position[3] = 1;
+    p->path_samples = 2;
+    p->path_sample_offset = 0xfffffff0u;
+    p->path_bounces = VXL_PATH_MAX_BOUNCES;
+    p->path_seed = 0xffffffffu;
+}
+
 /* deliberately invalid inputs: each must give its error code with a message */
 VIEW(bad_tf_size_zero) { sv_tf_table(p, vc, 256, 3); p->tf_size = 0; }
 VIEW(bad_tf_size_one) { sv_tf_table(p, vc, 2, 3); p->tf_size = 1; }
@@ -1134,6 +1157,7 @@ static const stress_case stress_cases[] = {
     {"material_zero", GROUP_lighting, BALL, material_zero, OK, 0, 0},
     {"environment_extreme", GROUP_lighting, BALL, environment_extreme, OK, F_VISIBLE | F_ONE_FILTER, 0},
     {"environment_uniform_shadowed", GROUP_lighting, BALL, environment_uniform_shadowed, OK, F_VISIBLE | F_ONE_FILTER, 0},
+    {"path_extreme", GROUP_lighting, BALL, path_extreme, OK, F_VISIBLE | F_ONE_FILTER, 1u << VXL_ERR_INVALID_ARGUMENT},
 
     /* deliberately invalid inputs */
     {"invalid_tf_size_zero", GROUP_invalid_inputs, BALL, bad_tf_size_zero, BAD, 0, 0},

@@ -20,6 +20,7 @@
 #include "cli_overlays.h" /* render --overlay ... (issue 20) */
 #include "cli_colour.h" /* --color-source, --opacity-source, the components line */
 #include "cli_stream.h" /* --streaming, --cache-dir, first-open progress, Ctrl-C, budget split (issue 21) */
+#include "cli_path.h" /* --samples, --sample-offset, --bounces, --seed: --shading path */
 #include "voxlight_dev.h" /* phantoms (phantom:NAME inputs) and --no-skip */
 
 /* The option values come from the library's name functions (vxl_*_name),
@@ -34,7 +35,8 @@ static const char usage_format[] =
     "                  [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID]\n"
     "                  [--storage %s] [--page-brick 8|16|32|64] [--renderer %s]\n"
     "                  [--light dir:X,Y,Z[,INTENSITY] | point:X,Y,Z[,INTENSITY]]... [--shading %s]\n"
-    "                  [--ambient-occlusion RADIUS] [--anisotropy G]\n"
+    "                  [--ambient-occlusion RADIUS] [--anisotropy G] [--samples N] [--sample-offset K]\n"
+    "                  [--bounces B] [--seed S]\n"
     "                  [--environment FILE.hdr|R,G,B[,STRENGTH]] [--environment-rotation DEG]\n"
     "                  [--mode %s] [--iso-value V] [--matcap FILE.png] [--ortho]\n"
     "                  [--view x|-x|y|-y|z|-z] [--streaming %s] [--cache-dir DIR]\n"
@@ -70,6 +72,9 @@ static const char usage_format[] =
     "         directional light, point: a point light's world position; INTENSITY > 0, default 1.\n"
     "         --shading phong: local lighting; shadowed: with shadows and --ambient-occlusion (voxels,\n"
     "         0 = off); scatter: also single scattering, forward for --anisotropy G > 0 (-0.99..0.99)\n"
+    "         path: multiple scattering by path tracing, the mean of --samples N (default 1) per pixel\n"
+    "         from sample --sample-offset K, up to --bounces B (default 4, 1 = single scattering) per\n"
+    "         path; --seed S picks the noise (the same seed, the same image) (docs/lighting.md)\n"
     "environment: --environment lights the volume from every side, as Blender's World: a Radiance .hdr\n"
     "         latitude-longitude map (Blender's equirectangular mapping) or a uniform linear colour, times\n"
     "         STRENGTH (default 1), turned by --environment-rotation DEG about world +Z (a Mapping node's Z\n"
@@ -506,6 +511,8 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (r < 0) return die("%s", err); /* colour volumes */
         } else if ((r = vxl_cli_environment_option(argc, argv, &i, &a->environment, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err);
+        } else if ((r = vxl_cli_path_option(argc, argv, &i, p, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err); /* --shading path */
         } else if (o[0] == '-' && o[1]) return die("unknown option '%s' (see voxlight --help)", o);
         else if (!a->input) a->input = o;
         else return die("unexpected argument '%s'", o);

@@ -356,6 +356,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     if (!rc) rc = vxl_frame_resolve_environment(f, p, e);
     if (!rc) rc = resolve_lights(f, p, e);
     if (!rc) rc = vxl_frame_resolve_lighting(f, p, e);
+    if (!rc) rc = vxl_frame_resolve_path(f, p, e);
     if (!rc) rc = vxl_frame_resolve_scene_shadows(f, p, e); /* issue 18 */
     if (!rc) rc = vxl_frame_cut_resolve(&f->cut, p, f->model, f->technique, e); /* issue 19 cutaways */
     if (!rc) rc = vxl_frame_resolve_labels(f, p, e); /* issue 20 labels */

@@ -67,6 +67,9 @@ typedef struct vxl_frame {
     float ao_strength;          /* occlusion_strength, 0 resolved to 1 */
     float anisotropy;           /* Henyey-Greenstein g, [-0.99, 0.99] */
     uint32_t illumination_size; /* cells along the longest side; 0 = automatic (the GL side decides) */
+    /* PATH (frame_path.c): samples offset .. offset + samples - 1 of every
+     * pixel, at most `bounces` collisions per path, the seed; 0s resolved. */
+    uint32_t path_samples, path_offset, path_bounces, path_seed;
     float light_world[VXL_MAX_LIGHTS][4];     /* world space, w 0 or 1; a direction (w = 0) is unit
                                                  length; the headlight's is the eye's direction */
     float light_spot_dir[VXL_MAX_LIGHTS][3];  /* view space unit vector the spot points along */
@@ -176,6 +179,11 @@ int vxl_frame_resolve_lighting(vxl_frame *f, const vxl_render_params *p, vxl_err
  * f->env. Before the lights: an environment with light_count 0 means no
  * lamps, not the headlight. Part of vxl_frame_resolve (frame_environment.c). */
 int vxl_frame_resolve_environment(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+/* PATH's fields of p (frame_path.c): the sample range, bounces and seed. */
+int vxl_frame_resolve_path(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
+/* What PATH cannot draw yet, refused with a message (called once the whole
+ * frame, overlays included, is resolved); VXL_OK for the other models. */
+int vxl_frame_path_check(const vxl_frame *f, vxl_err *e);
 
 /* Whether mode (VXL_MODE_*) shades: DVR and ISO do, the projections have no surface. */
 static inline int vxl_mode_shades(uint32_t mode) { return mode == VXL_MODE_DVR || mode == VXL_MODE_ISO; }

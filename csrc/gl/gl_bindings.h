@@ -38,6 +38,7 @@
 #define VXL_OVERLAY_TF_UNIT 35       /* raycast: overlay k's transfer function on unit 35 + k */
 #define VXL_OVERLAY_DISTANCE_UNIT 38 /* raycast: overlay k's brick distance map (empty-space skipping) on unit 38 + k */
 #define VXL_BRICK_MINMAX_UNIT 17  /* raycast: the brick min-max grid the modes skip by (issue 19, render/mode_bricks.c) */
+#define VXL_MAJORANT_UNIT 24      /* path.frag: the extinction majorant per skipping brick (render/path.c) */
 
 /* The ray caster reads every unit above at once, so no two may share a
  * number: with distinct units the sum of their bits equals their union
@@ -52,6 +53,7 @@
      VXL_UNIT_BIT_(VXL_SHADOW_MAP_UNIT) + VXL_UNIT_BIT_(VXL_MATCAP_UNIT) + VXL_UNIT_BIT_(VXL_LABELS_UNIT) +           \
      VXL_UNIT_BIT_(VXL_LABEL_TABLE_UNIT) + VXL_UNIT_BIT_(VXL_ENVIRONMENT_UNIT) + VXL_UNIT_BIT_(VXL_LABEL_MARGIN_UNIT) + \
      VXL_UNIT_BIT_(VXL_COLOUR_UNIT) + VXL_UNIT_BIT_(VXL_LABEL_BRICKS_UNIT) + VXL_UNIT_BIT_(VXL_BRICK_MINMAX_UNIT) +    \
+     VXL_UNIT_BIT_(VXL_MAJORANT_UNIT) +    \
      (7ull << VXL_OVERLAY_VOLUME_UNIT) + (7ull << VXL_OVERLAY_TF_UNIT) + (7ull << VXL_OVERLAY_DISTANCE_UNIT))
 #define VXL_UNITS_UNION_                                                                                             \
     (VXL_UNIT_BIT_(VXL_VOLUME_UNIT) | VXL_UNIT_BIT_(VXL_DERIVED_UNIT) | VXL_UNIT_BIT_(VXL_TF_UNIT) |                  \
@@ -62,6 +64,7 @@
      VXL_UNIT_BIT_(VXL_SHADOW_MAP_UNIT) | VXL_UNIT_BIT_(VXL_MATCAP_UNIT) | VXL_UNIT_BIT_(VXL_LABELS_UNIT) |           \
      VXL_UNIT_BIT_(VXL_LABEL_TABLE_UNIT) | VXL_UNIT_BIT_(VXL_ENVIRONMENT_UNIT) | VXL_UNIT_BIT_(VXL_LABEL_MARGIN_UNIT) | \
      VXL_UNIT_BIT_(VXL_COLOUR_UNIT) | VXL_UNIT_BIT_(VXL_LABEL_BRICKS_UNIT) | VXL_UNIT_BIT_(VXL_BRICK_MINMAX_UNIT) |    \
+     VXL_UNIT_BIT_(VXL_MAJORANT_UNIT) |    \
      (7ull << VXL_OVERLAY_VOLUME_UNIT) | (7ull << VXL_OVERLAY_TF_UNIT) | (7ull << VXL_OVERLAY_DISTANCE_UNIT))
 _Static_assert(VXL_UNITS_SUM_ == VXL_UNITS_UNION_, "two texture units share a number (gl_bindings.h)");
 

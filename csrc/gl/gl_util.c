@@ -116,6 +116,19 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
             return rc;
         }
         return link(g, a, b, out);
+    case VXL_PROG_PATH: /* the PATH model: scatter's lighting (SHADING_MODEL 2) at every collision */
+        snprintf(defines, sizeof defines, "%s%s#define SHADING 1\n#define SHADING_MODEL 2\n%s%s%s", paged, fdef,
+                 (flags & VXL_FLAG_DATA_COLOUR) ? "#define DATA_COLOUR 1\n" : "",
+                 (flags & VXL_FLAG_ENVIRONMENT) ? "#define ENVIRONMENT 1\n" : "",
+                 (flags & VXL_FLAG_CUT_CONVEX) ? "#define CUT_CONVEX 1\n" : "");
+        rc = compile(g, GL_VERTEX_SHADER, "render/raycast.vert", NULL, &a);
+        if (rc) return rc;
+        rc = compile(g, GL_FRAGMENT_SHADER, "render/path.frag", defines, &b);
+        if (rc) {
+            g->gl.DeleteShader(a);
+            return rc;
+        }
+        return link(g, a, b, out);
     case VXL_PROG_PROBE:
         snprintf(defines, sizeof defines, "%s%s", paged, fdef);
         rc = compile(g, GL_COMPUTE_SHADER, "compute/probe.comp", defines, &a);

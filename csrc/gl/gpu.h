@@ -38,6 +38,7 @@
 /* kinds take 5 bits of the program cache's key (gl_util.c): at most 31 */
 #define VXL_PROG_SHADOW_MAP 20 /* light/shadow_maps.c (issue 18): occluders rasterised from a light (depth only) */
 #define VXL_PROG_SCENE_TRANSMITTANCE 21 /* light/transmittance.c (issue 18): scene points' transmittance to a light */
+#define VXL_PROG_PATH 25 /* render/path.c: the PATH shading model's tracer (render/path.frag); flags as RAYCAST */
 #define VXL_PROG_SLICE_PLANE 16 /* render/slice_plane.c (issue 19): flags & 3 the interpolation, plus the sample flags */
 
 /* Program flags the storage sets on shaders that sample the volume. */

@@ -32,6 +32,7 @@
 #ifndef VOXLIGHT_H
 #define VOXLIGHT_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #ifdef __cplusplus
@@ -428,16 +429,41 @@ typedef struct vxl_light_shape {
  *             angle between the light's travel and the direction to the eye
  *             (g > 0 scatters forward, towards a viewer facing the light):
  *             4 pi HG = (1 - g^2) / (1 + g^2 - 2 g cos t)^1.5, 1 for g = 0.
+ *   PATH      multiple scattering by Monte Carlo volume path tracing of the
+ *             medium of docs/physical_model.md: from the eye, delta tracking
+ *             against a majorant per skipping brick finds where the path
+ *             collides (extinction -ln(1 - a) per voxel of path, a the
+ *             table's opacity times opacity_scale); every collision adds
+ *             SCATTER's terms there (lamps times T_i, the ambient or the
+ *             World, with w), unclamped, times the path's throughput, and the
+ *             path goes on (up to path_bounces collisions) in a direction
+ *             drawn from HG(g) (probability 1 - w, throughput * colour) or
+ *             cosine-weighted about n (probability w, throughput * min(diffuse,
+ *             1) * colour). path_bounces 1 is SCATTER's sum without its clamp,
+ *             integrated exactly along the ray instead of in steps. The alpha
+ *             and depth are the ray's opacity as the emission-absorption
+ *             march gives it (no noise). The image is the mean of samples
+ *             path_sample_offset .. + path_samples - 1, each a function of
+ *             (path_seed, pixel, sample index) only: the same call gives the
+ *             same image bit for bit, and vxl_path_accumulate merges
+ *             consecutive calls into the mean of all their samples (see
+ *             there). PATH classifies after interpolation whatever
+ *             `classify` says; clip planes and the crop box remove the medium
+ *             from every segment of a path (no caps); it refuses gradient
+ *             opacity, modes other than DVR, the slicing techniques, the
+ *             MatCap, cutter meshes, label maps and overlays
+ *             (VXL_ERR_INVALID_ARGUMENT, naming them).
  * "ambient" is the material's ambient * colour; each model's result is
- * clamped to [0, 1] per channel. A sample whose gradient vanishes has no
+ * clamped to [0, 1] per channel (PATH's sum is not). A sample whose gradient vanishes has no
  * normal: PHONG and SHADOWED leave it unlit (its colour, as today), SCATTER
- * keeps only its ambient and phase terms (w = 0).
+ * and PATH keep only their ambient and phase terms (w = 0).
  * shading_off still gives pure emission-absorption. */
 #define VXL_SHADING_PHONG 0
 #define VXL_SHADING_SHADOWED 1
 #define VXL_SHADING_SCATTER 2
-#define VXL_SHADING_COUNT 3
-VXL_API const char *vxl_shading_model_name(uint32_t model); /* "phong", "shadowed", "scatter" */
+#define VXL_SHADING_PATH 3
+#define VXL_SHADING_COUNT 4
+VXL_API const char *vxl_shading_model_name(uint32_t model); /* "phong", "shadowed", "scatter", "path" */
 VXL_API int vxl_shading_model_from_name(const char *name, uint32_t *out);
 
 /* Rendering techniques (issue 16), params.technique. The slice-based ones are
@@ -813,7 +839,32 @@ typedef struct vxl_render_params {
      * struct_size covers it. NULL: no environment (the lamps and the
      * ambient term only, as before). */
     const vxl_environment *environment;
+    /* Appended (shading model PATH); read only when struct_size covers them,
+     * ignored by the other models. A call renders samples path_sample_offset
+     * .. path_sample_offset + path_samples - 1 of every pixel and returns
+     * their mean. F12: one call with N samples. The viewport: call with
+     * offset 0, then offsets 1, 2, ... (path_samples 1 each) while nothing
+     * changes, merging each image with vxl_path_accumulate, and start again
+     * at offset 0 on any change. Both give the same image within float
+     * rounding. */
+    uint32_t path_samples;       /* samples per pixel in this call; 0 = 1, at most VXL_PATH_MAX_SAMPLES */
+    uint32_t path_sample_offset; /* index of this call's first sample */
+    uint32_t path_bounces;       /* collisions per path (1 = single scattering); 0 = VXL_PATH_DEFAULT_BOUNCES,
+                                    at most VXL_PATH_MAX_BOUNCES */
+    uint32_t path_seed;          /* another seed, another (equally good) noise; the same seed, the same image */
 } vxl_render_params;
+
+#define VXL_PATH_MAX_SAMPLES 65536u
+#define VXL_PATH_DEFAULT_BOUNCES 4u
+#define VXL_PATH_MAX_BOUNCES 64u
+
+/* Merges one PATH call's image into a running mean: acc (n floats, the mean
+ * of samples 0 .. offset - 1, anything when offset is 0) becomes the mean of
+ * samples 0 .. offset + samples - 1, given img, the call's image of samples
+ * offset .. offset + samples - 1 (rgba, or depth: any n floats). Depth and
+ * alpha are the same in every call, so they stay. VXL_ERR_INVALID_ARGUMENT
+ * for NULL arrays or samples 0. */
+VXL_API int vxl_path_accumulate(float *acc, const float *img, size_t n, uint32_t offset, uint32_t samples);
 
 #define VXL_COLOR_SOURCE_AUTO 0
 #define VXL_COLOR_SOURCE_DATA 1

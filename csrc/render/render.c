@@ -6,6 +6,7 @@
 #include "frame.h"
 #include "illumination.h"
 #include "mat4.h"
+#include "path.h"
 #include "renderer_internal.h"
 #include "slices.h"
 
@@ -175,16 +176,20 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     flags |= colour_flags;
     if (f->shading && f->env.on) flags |= VXL_FLAG_ENVIRONMENT; /* the World's light */
     uint32_t filter = vxl_frame_filter(f);
-    rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
+    const int path = f->shading && f->shading_model == VXL_SHADING_PATH; /* render/path.c's tracer */
+    rc = vxl_frame_path_check(f, &r->gpu.err);
+    if (!rc) rc = r->storage.ops->check_filter(&r->storage, filter, f->classify);
     if (!rc && f->technique != VXL_TECHNIQUE_RAYCAST) rc = vxl_slices_check(r, f);
-    if (!rc) rc = vxl_program_get(&r->gpu, f->technique ? VXL_PROG_SLICES : VXL_PROG_RAYCAST, filter, flags, &prog);
+    if (!rc)
+        rc = vxl_program_get(&r->gpu, path ? VXL_PROG_PATH : f->technique ? VXL_PROG_SLICES : VXL_PROG_RAYCAST, filter,
+                             flags, &prog);
     if (!rc) rc = ensure_framebuffer(r, f->width, f->height);
     if (rc) return rc;
     gl->GetError();
     vxl_upload_tf(r, f);
     if (f->scene_depth) upload_scene_depth(r, f);
     /* bricked storage derives its resident set from the skipping grid */
-    if ((f->skip || r->storage.ops->needs_occupancy) && (rc = vxl_skipping_prepare(&r->skipping, f))) return rc;
+    if ((f->skip || path || r->storage.ops->needs_occupancy) && (rc = vxl_skipping_prepare(&r->skipping, f))) return rc;
     if ((rc = r->storage.ops->prepare(&r->storage, f))) return rc;
     if ((rc = vxl_classification_prepare(&r->classification, f))) return rc;
     if ((rc = vxl_illumination_prepare(&r->illumination, f))) return rc; /* shadows, occlusion (issue 17) */
@@ -195,6 +200,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     vxl_illumination_bind(&r->illumination, prog, f);
     vxl_cut_bind(&r->cut, prog, f); /* issue 19 */
     vxl_colour_bind(&r->colour, flags, prog);
+    if (path && (rc = vxl_path_bind(&r->path, f, prog))) return rc;
     if ((rc = vxl_labels_prepare(&r->labels, f, prog, r->storage.geom.affine))) return rc; /* issue 20 */
     if ((rc = vxl_overlays_prepare(&r->overlays, f, prog))) return rc; /* issue 20 */
     if ((rc = vxl_modes_bind(&r->modes, f, prog)) || (rc = vxl_matcap_prepare(&r->matcap, f, prog))) return rc; /* issue 19 */

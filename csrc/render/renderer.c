@@ -68,6 +68,7 @@ static void release_volume(vxl_renderer *r)
     vxl_classification_release(&r->classification);
     vxl_illumination_release(&r->illumination);
     vxl_modes_release(&r->modes);
+    vxl_path_release(&r->path);
     vxl_colour_release(&r->colour);
     if (r->storage.ops) r->storage.ops->release(&r->storage);
     r->storage.ops = NULL;
@@ -120,6 +121,7 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     vxl_illumination_init(&r->illumination, &r->gpu, &r->storage);
     vxl_cut_init(&r->cut, &r->gpu); /* issue 19 cutaways */
     vxl_modes_init(&r->modes, &r->gpu, &r->skipping, &r->storage);
+    vxl_path_init(&r->path, &r->gpu, &r->skipping, &r->storage);
     vxl_matcap_init(&r->matcap, &r->gpu);
     vxl_labels_init(&r->labels, &r->gpu); /* issue 20 label maps */
     r->illumination.bind_labels = bind_labels_for_shadows; /* hidden labels cast no shadow */

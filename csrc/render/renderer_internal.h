@@ -19,6 +19,7 @@
 #include "matcap.h"
 #include "modes.h"
 #include "overlays.h"
+#include "path.h"
 #include "skipping.h"
 #include "storage.h"
 #include "voxlight.h"
@@ -47,6 +48,7 @@ struct vxl_renderer {
     vxl_labels_state labels;                 /* labels.h: issue 20 label volume and table */
     vxl_overlays_state overlays;             /* overlays.h: issue 20 overlay volumes */
     vxl_colour_state colour;                 /* colour.h: a colour volume's own colour (RGB8) */
+    vxl_path_state path;                     /* path.h: the PATH model's majorant grid */
 
     GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex;
     uint32_t fb_w, fb_h;

@@ -25,7 +25,7 @@ BACKENDS = ("auto", "osmesa", "egl", "wgl")
 STORAGES = ("auto", "dense", "bricked", "sparse", "compressed")  # VXL_STORAGE_*
 CLASSIFY_MODES = ("post", "pre", "preint")  # VXL_CLASSIFY_*
 GRADIENT_OPACITY_MODES = ("off", "boundary", "iso")  # VXL_GOPACITY_*
-SHADING_MODELS = ("phong", "shadowed", "scatter")  # VXL_SHADING_*
+SHADING_MODELS = ("phong", "shadowed", "scatter", "path")  # VXL_SHADING_*
 MODES = ("dvr", "mip", "minip", "average", "iso")  # VXL_MODE_*
 INTERPOLATIONS = ("nearest", "linear", "cubic")  # VXL_INTERP_*
 LABEL_MODES = ("surface", "mask", "tint")  # VXL_LABEL_MODE_*
@@ -362,7 +362,11 @@ class RenderParams(ctypes.Structure):
                 ("minip_floor", ctypes.c_float),
                 ("color_source", ctypes.c_uint32),       # appended: colour volumes
                 ("color_space", ctypes.c_uint32),        # VXL_COLOR_SPACE_* (COLOR_SPACES)
-                ("environment", ctypes.POINTER(Environment))]  # appended: the World's light
+                ("environment", ctypes.POINTER(Environment)),  # appended: the World's light
+                ("path_samples", ctypes.c_uint32),       # appended: the path shading model
+                ("path_sample_offset", ctypes.c_uint32),
+                ("path_bounces", ctypes.c_uint32),
+                ("path_seed", ctypes.c_uint32)]
 
 
 class RenderStats(ctypes.Structure):

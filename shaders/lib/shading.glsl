@@ -133,8 +133,10 @@ vec3 lit_term(int i, vec3 rgb, vec3 n, bool has_normal, float w, vec3 l, vec3 h,
 }
 
 // shade() with shadows, occlusion and (SCATTER) the phase function: p is the
-// sample's voxel position, where the illumination volumes are read.
-vec3 shade_lit(vec3 rgb, vec3 g, vec3 pos, vec3 p, RayLighting r, bool one_directional)
+// sample's voxel position, where the illumination volumes are read. The sum
+// before shade_lit's clamp: render/path.frag adds it, unclamped, at every
+// collision of a path.
+vec3 shade_lit_sum(vec3 rgb, vec3 g, vec3 pos, vec3 p, RayLighting r, bool one_directional)
 {
     vec3 n = u_normal_matrix * g;
     float len = length(n);
@@ -167,6 +169,11 @@ vec3 shade_lit(vec3 rgb, vec3 g, vec3 pos, vec3 p, RayLighting r, bool one_direc
                 acc += mask * light_transmittance(i, p) * lit_term(i, rgb, n, has_normal, w, l, normalize(l + r.v), r.v);
         }
     }
-    return clamp_colour(acc);
+    return acc;
+}
+
+vec3 shade_lit(vec3 rgb, vec3 g, vec3 pos, vec3 p, RayLighting r, bool one_directional)
+{
+    return clamp_colour(shade_lit_sum(rgb, g, pos, p, r, one_directional));
 }
 #endif

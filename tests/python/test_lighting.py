@@ -50,7 +50,7 @@ def test_fallback_models_are_the_headers():
     with open(ROOT + "/csrc/include/voxlight.h") as f:
         header = f.read()
     defines = dict((n.lower(), int(v)) for n, v in
-                   re.findall(r"#define VXL_SHADING_(PHONG|SHADOWED|SCATTER) (\d+)", header))
+                   re.findall(r"#define VXL_SHADING_(PHONG|SHADOWED|SCATTER|PATH) (\d+)", header))
     assert tuple(sorted(defines, key=defines.get)) == native.SHADING_MODELS
     assert lighting.DEFAULT_MODEL in native.SHADING_MODELS
     assert lighting.LEGACY_MODEL == native.SHADING_MODELS[0]  # phong: today's look

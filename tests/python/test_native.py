@@ -374,9 +374,11 @@ def test_render_params_tail_matches_header():
     # overlays' pointer, which keeps it on its 8-byte alignment; MinIP's
     # floor (flag and value) follows it, then colour volumes' colour source (and a reserved word)
     assert P.labels.offset == 688 and P.overlays.offset == 704 and P.minip_floor.offset == 716
-    # and the World's light (a pointer on its alignment)
+    # and the World's light (a pointer on its alignment), then the path
+    # model's four words (samples, offset, bounces, seed), ending on the alignment
     assert P.color_source.offset == 720 and P.environment.offset == 728
-    assert ctypes.sizeof(P) == 736
+    assert P.path_samples.offset == 736 and P.path_seed.offset == 748
+    assert ctypes.sizeof(P) == 752
     assert P.labels.offset == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
     names = [n for n, _t in P._fields_]

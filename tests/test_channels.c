@@ -6,11 +6,16 @@
  * time, lit and unlit, with two texture groups (six channels); a channel's
  * window changes only its own pixels; skipping over the union changes
  * nothing; the scalar is the chosen channel, bit for bit a one-channel
- * volume; what cannot go with channels is refused with a message. */
+ * volume; what cannot go with channels is refused with a message; NIfTI
+ * 5D (dim[5] channels, dim[4] frames) and NRRD channel axes load as
+ * channels by the channels mode and render as the same voxels in memory. */
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "harness.h"
+#include "nifti_writer.h"
 #include "test_util.h"
 
 #define N 24
@@ -379,8 +384,126 @@ TEST(interleaved_and_planar_layouts_agree)
     vxl_volume_destroy(vp);
 }
 
+static char g_dir[64];
+
+/* Renders v's channels (all listed, lit) into out. */
+static int render_channels(vxl_renderer *r, const vxl_volume *v, uint32_t count, float *out)
+{
+    vxl_channel_style st[VXL_MAX_CHANNELS];
+    styles(st, count);
+    vxl_render_params p = base_params();
+    p.shading_off = 0;
+    p.channel_count = count;
+    p.channels = st;
+    if (vxl_renderer_set_volume(r, v) != VXL_OK) return -1;
+    return render(r, &p, out);
+}
+
+static vxl_volume_info info_of(const vxl_volume *v)
+{
+    vxl_volume_info in;
+    memset(&in, 0, sizeof in);
+    in.struct_size = sizeof in;
+    vxl_volume_get_info(v, &in);
+    return in;
+}
+
+TEST(nifti_5d_and_nrrd_channel_axes_load_as_channels)
+{
+    const size_t V = (size_t)N * N * N;
+    char path[256];
+    vxl_renderer *r = make_renderer(software_backend());
+    REQUIRE(r);
+    /* NIfTI: dim[4] 2 frames, dim[5] 3 channels; frame t of channel c is
+     * six-ball plane c + 3 t, stored at (t + 2 c) volumes in */
+    static uint16_t file[6 * N * N * N], mem[3 * N * N * N];
+    for (int c = 0; c < 3; c++)
+        for (int t = 0; t < 2; t++) memcpy(file + (size_t)(t + 2 * c) * V, g_six + (size_t)(c + 3 * t) * V, V * 2);
+    memcpy(mem, g_six + 3 * V, 3 * V * 2);
+    tnw_header h;
+    tnw_init(&h, 1, 512, N, N, N);
+    h.dim[0] = 5;
+    h.dim[4] = 2;
+    h.dim[5] = 3;
+    snprintf(path, sizeof path, "%s/five.nii.gz", g_dir);
+    REQUIRE(tnw_write(path, &h, file, sizeof file) == 0);
+    vxl_load_options lo = {.struct_size = sizeof lo, .frame = 1};
+    vxl_volume *v = NULL, *ref = channels_volume(mem, 3, 0);
+    CHECKF(vxl_volume_load(path, &lo, &v) == VXL_OK, "five.nii.gz: %s", vxl_last_error());
+    REQUIRE(v && ref);
+    vxl_volume_info in = info_of(v);
+    CHECKF(in.channel_count == 3 && in.frame_count == 2 && in.frame == 1, "channels %u frames %u", in.channel_count,
+           in.frame_count);
+    CHECKF(strstr(in.notes, "NIfTI dim[5]: 3 channels (channel 0 is the scalar)") != NULL, "notes '%s'", in.notes);
+    REQUIRE(render_channels(r, v, 3, A) == VXL_OK && render_channels(r, ref, 3, B) == VXL_OK);
+    CHECK(memcmp(A, B, sizeof A) == 0 && alpha_sum(A, NPIX) > 1);
+    vxl_volume_destroy(v);
+    /* channels off: every volume a frame, as before channels */
+    lo.channels = VXL_CHANNELS_OFF;
+    lo.frame = 0;
+    v = NULL;
+    CHECK(vxl_volume_load(path, &lo, &v) == VXL_OK && v);
+    if (v) {
+        in = info_of(v);
+        CHECK(in.channel_count == 0 && in.frame_count == 6);
+        vxl_volume_destroy(v);
+    }
+    vxl_volume_destroy(ref);
+
+    /* NRRD: a fastest axis of 5 (vector) interleaves 5 channels */
+    static uint16_t inter[5 * N * N * N];
+    for (size_t i = 0; i < V; i++)
+        for (int c = 0; c < 5; c++) inter[5 * i + (size_t)c] = g_six[(size_t)c * V + i];
+    char hdr[256];
+    int n = snprintf(hdr, sizeof hdr,
+                     "NRRD0004\ntype: uint16\ndimension: 4\nsizes: 5 %d %d %d\nkinds: vector domain domain domain\n"
+                     "endian: little\nencoding: raw\n\n", N, N, N);
+    snprintf(path, sizeof path, "%s/five.nrrd", g_dir);
+    FILE *f = fopen(path, "wb");
+    REQUIRE(f);
+    CHECK(fwrite(hdr, 1, (size_t)n, f) == (size_t)n && fwrite(inter, 1, sizeof inter, f) == sizeof inter);
+    fclose(f);
+    v = NULL;
+    ref = channels_volume(g_six, 5, 0);
+    CHECKF(vxl_volume_load(path, NULL, &v) == VXL_OK, "five.nrrd: %s", vxl_last_error());
+    REQUIRE(v && ref);
+    in = info_of(v);
+    CHECKF(in.channel_count == 5 && strstr(in.notes, "NRRD channel axis: 5 channels"), "notes '%s'", in.notes);
+    REQUIRE(render_channels(r, v, 5, A) == VXL_OK && render_channels(r, ref, 5, B) == VXL_OK);
+    CHECK(memcmp(A, B, sizeof A) == 0);
+    vxl_volume_destroy(v);
+    vxl_volume_destroy(ref);
+    unlink(path);
+    /* a 3-entry axis is colour unless channels are asked for */
+    n = snprintf(hdr, sizeof hdr,
+                 "NRRD0004\ntype: uint16\ndimension: 4\nsizes: 3 %d %d %d\nkinds: RGB-color domain domain domain\n"
+                 "endian: little\nencoding: raw\n\n", N, N, N);
+    snprintf(path, sizeof path, "%s/three.nrrd", g_dir);
+    f = fopen(path, "wb");
+    REQUIRE(f);
+    CHECK(fwrite(hdr, 1, (size_t)n, f) == (size_t)n && fwrite(inter, 1, 3 * V * 2, f) == 3 * V * 2);
+    fclose(f);
+    v = NULL;
+    CHECK(vxl_volume_load(path, NULL, &v) == VXL_OK && v && info_of(v).components == 3 && info_of(v).channel_count == 0);
+    vxl_volume_destroy(v);
+    v = NULL;
+    vxl_load_options on = {.struct_size = sizeof on, .channels = VXL_CHANNELS_ON, .scalar_channel = 2};
+    CHECK(vxl_volume_load(path, &on, &v) == VXL_OK && v && info_of(v).channel_count == 3 &&
+          info_of(v).scalar_channel == 2 && info_of(v).components == 1);
+    vxl_volume_destroy(v);
+    unlink(path);
+    snprintf(path, sizeof path, "%s/five.nii.gz", g_dir);
+    unlink(path);
+    vxl_renderer_destroy(r);
+}
+
 int main(void)
 {
+    snprintf(g_dir, sizeof g_dir, "/tmp/vxl_test_channels_XXXXXX");
+    if (!mkdtemp(g_dir)) {
+        fprintf(stderr, "mkdtemp: %s\n", strerror(errno));
+        return 1;
+    }
     ball(g_two, 7, 12, 12, 4.5, 40000);
     ball(g_two + N * N * N, 17, 12, 12, 4.5, 30000);
     ball(g_over, 10, 12, 12, 6, 40000);
@@ -399,5 +522,7 @@ int main(void)
     RUN(the_scalar_is_the_chosen_channel);
     RUN(what_cannot_go_with_channels_is_refused);
     RUN(interleaved_and_planar_layouts_agree);
+    RUN(nifti_5d_and_nrrd_channel_axes_load_as_channels);
+    rmdir(g_dir);
     return TEST_SUMMARY();
 }

@@ -303,12 +303,20 @@ TEST(what_cannot_go_with_channels_is_refused)
 {
     vxl_volume *v = channels_volume(g_two, 2, 0);
     REQUIRE(v);
-    /* paged storage cannot hold channels yet */
-    vxl_renderer *rb = make_stored_renderer(VXL_STORAGE_BRICKED, 0, 0, 0);
-    REQUIRE(rb);
-    CHECK(vxl_renderer_set_volume(rb, v) == VXL_ERR_INVALID_ARGUMENT);
-    CHECK(strstr(vxl_renderer_error(rb), "dense storage") != NULL);
-    vxl_renderer_destroy(rb);
+    /* paged storage holds the scalar, and refuses drawing the channels */
+    vxl_channel_style st2[2];
+    styles(st2, 2);
+    vxl_render_params q = base_params();
+    for (uint32_t mode = VXL_STORAGE_BRICKED; mode <= VXL_STORAGE_COMPRESSED; mode++) {
+        vxl_renderer *rb = make_stored_renderer(mode, 0, 0, 0);
+        REQUIRE(rb);
+        q.channel_count = 0;
+        CHECK(vxl_renderer_set_volume(rb, v) == VXL_OK && render(rb, &q, A) == VXL_OK);
+        q.channel_count = 2;
+        q.channels = st2;
+        CHECK(render(rb, &q, A) == VXL_ERR_INVALID_ARGUMENT && strstr(vxl_renderer_error(rb), "needs dense storage"));
+        vxl_renderer_destroy(rb);
+    }
 
     vxl_renderer *r = make_renderer(software_backend());
     REQUIRE(r && vxl_renderer_set_volume(r, v) == VXL_OK);

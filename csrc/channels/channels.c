@@ -41,14 +41,9 @@ void vxl_channels_release(vxl_channels_state *s)
 
 int vxl_channels_plan(vxl_channels_state *s, const vxl_volume *v, uint32_t storage_mode, uint64_t storage_bytes)
 {
-    if (!v->channels) return VXL_OK;
+    /* paged storage holds the scalar only: drawing channels is refused then */
+    if (!v->channels || storage_mode != VXL_STORAGE_DENSE) return VXL_OK;
     vxl_gpu *g = s->gpu;
-    if (storage_mode != VXL_STORAGE_DENSE)
-        return vxl_fail(&g->err, VXL_ERR_INVALID_ARGUMENT,
-                        "a multi-channel volume needs dense storage: its %u channels are whole 3D textures, which %s "
-                        "storage cannot page, compress or stream yet (ask for storage dense, or load one channel "
-                        "with channels off)",
-                        v->channel_count, vxl_storage_name(storage_mode) ? vxl_storage_name(storage_mode) : "this");
     for (int a = 0; a < 3; a++)
         if (v->dims[a] > (uint32_t)g->info.max_3d_texture_size)
             return vxl_fail(&g->err, VXL_ERR_LIMIT,
@@ -91,16 +86,14 @@ static int channel_minmax(vxl_gpu *g, const vxl_volume *v, uint32_t c, vxl_brick
 static const GLenum group_formats[4] = {GL_R16, GL_RG16, GL_RGB16, GL_RGBA16};
 static const GLenum group_layouts[4] = {GL_RED, GL_RG, GL_RGB, GL_RGBA};
 
-int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v)
+int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, uint32_t storage_mode)
 {
     vxl_channels_release(s);
     if (!v || !v->channels) return VXL_OK;
     vxl_gpu *g = s->gpu;
     vxl_gl *gl = &g->gl;
-    int rc = VXL_OK;
-    for (uint32_t c = 0; c < v->channel_count && !rc; c++) rc = channel_minmax(g, v, c, &s->bricks[c]);
     s->count = v->channel_count;
-    s->groups = vxl_channel_groups(v);
+    s->storage_mode = storage_mode;
     for (uint32_t c = 0; c < v->channel_count; c++) {
         s->geom[c] = vxl_volume_geom_of(v);
         s->geom[c].tex_lo = v->ch_tex_lo[c];
@@ -108,6 +101,10 @@ int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v)
         s->geom[c].value_min = v->ch_min[c];
         s->geom[c].value_max = v->ch_max[c];
     }
+    if (storage_mode != VXL_STORAGE_DENSE) return VXL_OK; /* the scalar alone (vxl_channels_flags says why) */
+    int rc = VXL_OK;
+    for (uint32_t c = 0; c < v->channel_count && !rc; c++) rc = channel_minmax(g, v, c, &s->bricks[c]);
+    s->groups = vxl_channel_groups(v);
     gl->GetError();
     for (uint32_t grp = 0; grp < s->groups && !rc; grp++) {
         const uint32_t w = vxl_channel_group_width(v, grp);
@@ -136,6 +133,11 @@ int vxl_channels_flags(const vxl_channels_state *s, const vxl_frame *f, uint32_t
         return vxl_fail(&s->gpu->err, VXL_ERR_STATE,
                         "params.channels lists %u channels, but the volume has none (it is not multi-channel)",
                         f->channels.listed);
+    if (s->storage_mode != VXL_STORAGE_DENSE)
+        return vxl_fail(&s->gpu->err, VXL_ERR_INVALID_ARGUMENT,
+                        "drawing channels needs dense storage: this renderer holds the volume in %s storage, which "
+                        "cannot page, compress or stream its %u channels yet (create the renderer with storage dense)",
+                        vxl_storage_name(s->storage_mode) ? vxl_storage_name(s->storage_mode) : "paged", s->count);
     for (uint32_t k = 0; k < f->channels.count; k++)
         if (f->channels.ch[k].channel >= s->count)
             return vxl_fail(&s->gpu->err, VXL_ERR_STATE, "params.channels names channel %u: the volume has channels 0..%u",

@@ -8,7 +8,10 @@
  * (empty-space skipping over the union), re-derived only when a drawn
  * channel's classification key or the set of drawn channels changes.
  * Everything is one budget holding (VXL_HOLD_CHANNELS). Set with the volume
- * (vxl_renderer_set_volume); a volume without channels removes them. */
+ * (vxl_renderer_set_volume); a volume without channels removes them. Only
+ * dense storage draws channels: in the paged modes (bricked, sparse,
+ * compressed, streamed) the volume's scalar renders as any volume's, and a
+ * frame that draws channels is refused with why (no silent fallback). */
 #ifndef VXL_CHANNELS_H
 #define VXL_CHANNELS_H
 
@@ -23,7 +26,8 @@
 
 typedef struct vxl_channels_state {
     vxl_gpu *gpu;
-    uint32_t count, groups;                 /* the volume's channels; 0 without */
+    uint32_t count, groups;                 /* the volume's channels; 0 without (groups 0 in paged storage) */
+    uint32_t storage_mode;                  /* the volume's VXL_STORAGE_*: only dense draws channels */
     GLuint tex[VXL_CHANNEL_GROUPS_MAX];     /* group g: channels 4g.. */
     GLuint tf_tex[VXL_MAX_CHANNELS];        /* channel c's table of the last frame that drew it */
     uint64_t tf_key[VXL_MAX_CHANNELS];
@@ -42,16 +46,18 @@ typedef struct vxl_channels_state {
 void vxl_channels_init(vxl_channels_state *s, vxl_gpu *g);
 /* Whether v's channels can be held beside `storage_bytes` of the volume
  * that comes with it, stored in `storage_mode` (VXL_STORAGE_*, resolved):
- * only dense storage takes channels (VXL_ERR_INVALID_ARGUMENT naming why
- * otherwise); the texture limit; the budget. Changes nothing; OK for a
- * volume without channels. */
+ * the texture limit and the budget. Changes nothing; OK for a volume
+ * without channels, and for paged storage, which holds the scalar only. */
 int vxl_channels_plan(vxl_channels_state *s, const vxl_volume *v, uint32_t storage_mode, uint64_t storage_bytes);
 /* Uploads v's channels and builds their min-max grids (after
- * vxl_channels_plan); a volume without channels removes them. */
-int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v);
+ * vxl_channels_plan) when storage_mode is dense; in paged storage only
+ * what a frame needs to refuse drawing them is kept. A volume without
+ * channels removes them. */
+int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, uint32_t storage_mode);
 /* The program flags of frame f (the group count in CHANNEL_GROUPS) into
  * *flags: VXL_ERR_STATE when f draws channels of a volume without them or
- * names a channel it does not have. */
+ * names a channel it does not have; VXL_ERR_INVALID_ARGUMENT, naming why,
+ * when the volume is in paged storage. */
 int vxl_channels_flags(const vxl_channels_state *s, const vxl_frame *f, uint32_t *flags);
 /* Uploads what f's channels need (tables, the union map when f->skip),
  * binds the textures and sets prog's channel uniforms. Nothing when f draws

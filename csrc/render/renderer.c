@@ -229,7 +229,7 @@ static int job_set_volume(void *p)
     if (rc) return rc;
     rc = vxl_storage_ops_for_volume(v, asked)->plan(&r->storage, v, asked, &plan);
     if (rc) return rc;
-    /* a multi-channel volume's channels: dense storage only, within the budget */
+    /* a multi-channel volume's channels: with dense storage, within the budget */
     if ((rc = vxl_channels_plan(&r->channels, v, plan.mode, plan.mode == VXL_STORAGE_DENSE ? v->storage_bytes : 0))) {
         vxl_bricks_free(&plan.bricks);
         return rc;
@@ -240,7 +240,7 @@ static int job_set_volume(void *p)
     r->storage.ops = ops;
     rc = ops->install(&r->storage, v, &plan);
     if (!rc) rc = vxl_colour_set(&r->colour, v);
-    if (!rc) rc = vxl_channels_set(&r->channels, v);
+    if (!rc) rc = vxl_channels_set(&r->channels, v, plan.mode);
     if (rc) {
         vxl_bricks_free(&plan.bricks);
         ops->release(&r->storage);

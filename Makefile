@@ -76,7 +76,8 @@ HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/vox
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
 STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlight-slicingbench $(BUILD)/voxlight-modesbench \
-           $(BUILD)/voxlight-labelsbench $(BUILD)/voxlight-streambench $(BUILD)/voxlight-overlaysbench
+           $(BUILD)/voxlight-labelsbench $(BUILD)/voxlight-streambench $(BUILD)/voxlight-overlaysbench \
+           $(BUILD)/voxlight-channelsbench
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
@@ -188,6 +189,10 @@ $(BUILD)/voxlight-streambench: bench/stream_study.c bench/bench_util.h $(BUILD)/
 
 # issue 20: frame time against the number of overlays (docs/overlays.md)
 $(BUILD)/voxlight-overlaysbench: bench/overlays_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
+# multi-channel volumes: frame time against channels, against overlays of the same data (docs/channels.md)
+$(BUILD)/voxlight-channelsbench: bench/channels_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
 # issue 19: the render modes' run time against error (docs/modes.md, docs/benchmark.md)

@@ -94,7 +94,8 @@ int vxl_volume_build_channels(const void *raw, uint32_t dtype, uint32_t channels
     /* one channel's raw values (interleaved input is gathered) and texels */
     void *plane = interleaved ? malloc((size_t)(n * size)) : NULL;
     void *texels = malloc((size_t)(n * (bits / 8)));
-    uint16_t *packed = malloc((size_t)(n * VXL_CHANNELS_PER_GROUP * ((channels + 3) / 4) * VXL_CHANNEL_BYTES));
+    /* groups of four then the rest: exactly 2 bytes a channel a voxel */
+    uint16_t *packed = malloc((size_t)(n * channels * VXL_CHANNEL_BYTES));
     vxl_volume *v = NULL;
     if ((interleaved && !plane) || !texels || !packed) {
         rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for %u channels of %llu voxels", channels,

@@ -5,7 +5,8 @@
  * only one; additive blending equals the sum of the channels drawn one at a
  * time, lit and unlit, with two texture groups (six channels); a channel's
  * window changes only its own pixels; skipping over the union changes
- * nothing; the scalar is the chosen channel, bit for bit a one-channel
+ * nothing; a clip plane cuts every channel; the scalar is the chosen
+ * channel, bit for bit a one-channel
  * volume; what cannot go with channels is refused with a message; NIfTI
  * 5D (dim[5] channels, dim[4] frames) and NRRD channel axes load as
  * channels by the channels mode and render as the same voxels in memory. */
@@ -167,6 +168,42 @@ TEST(additive_blending_is_the_sum_of_the_channels)
     check_additive(T_, g_over, 2, 0);
     check_additive(T_, g_over, 2, 1);
     check_additive(T_, g_six, 6, 1); /* two texture groups */
+}
+
+TEST(a_clip_plane_cuts_every_channel)
+{
+    vxl_volume *v = channels_volume(g_two, 2, 0);
+    vxl_renderer *r = make_renderer(software_backend());
+    REQUIRE(v && r);
+    REQUIRE(vxl_renderer_set_volume(r, v) == VXL_OK);
+    vxl_channel_style st[2];
+    styles(st, 2);
+    vxl_render_params p = base_params();
+    p.shading_off = 0;
+    p.channel_count = 2;
+    p.channels = st;
+    st[1].solo = 1;
+    REQUIRE(render(r, &p, C) == VXL_OK); /* channel 1 alone, uncut */
+    st[1].solo = 0;
+    st[1].hidden = 1;
+    REQUIRE(render(r, &p, B) == VXL_OK); /* channel 0 alone, uncut */
+    st[1].hidden = 0;
+    /* keep x <= 12 (identity affine: world = voxel): channel 1's blob (x 12.5..21.5) is cut away */
+    vxl_cutaway cut = {.struct_size = sizeof cut, .clip_plane_count = 1};
+    cut.clip_planes[0].plane[0] = -1;
+    cut.clip_planes[0].plane[3] = 12;
+    p.cutaway = &cut;
+    REQUIRE(render(r, &p, A) == VXL_OK);
+    int left = 0, bad = 0;
+    for (int i = 0; i < NPIX; i++) {
+        if (C[4 * i + 3] > 0 && B[4 * i + 3] == 0) bad += A[4 * i + 3] != 0;
+        left += A[4 * i + 3] > 0;
+    }
+    CHECKF(bad == 0, "%d pixels of the cut channel remain", bad);
+    CHECKF(left > 20, "channel 0's blob: %d pixels", left);
+    CHECK(image_is_sane(A, NULL, NPIX));
+    vxl_renderer_destroy(r);
+    vxl_volume_destroy(v);
 }
 
 TEST(a_channels_window_changes_only_that_channel)
@@ -525,6 +562,7 @@ int main(void)
     RUN(hiding_a_channel_removes_exactly_its_blob);
     RUN(additive_blending_is_the_sum_of_the_channels);
     RUN(a_channels_window_changes_only_that_channel);
+    RUN(a_clip_plane_cuts_every_channel);
     RUN(skipping_over_the_union_changes_nothing);
     RUN(max_blend_takes_the_dominant_channel);
     RUN(the_scalar_is_the_chosen_channel);

@@ -6,8 +6,8 @@
  * time, lit and unlit, with two texture groups (six channels); a channel's
  * window changes only its own pixels; skipping over the union changes
  * nothing; a clip plane cuts every channel; the scalar is the chosen
- * channel, bit for bit a one-channel
- * volume; what cannot go with channels is refused with a message; NIfTI
+ * channel, bit for bit a one-channel volume; what cannot go with channels
+ * is refused with a message; NIfTI
  * 5D (dim[5] channels, dim[4] frames) and NRRD channel axes load as
  * channels by the channels mode and render as the same voxels in memory. */
 #include <errno.h>

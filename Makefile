@@ -70,13 +70,14 @@ OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_
 # The platform room's files for this OS (csrc/platform/), for whatever links
 # library objects without the library.
 PLATFORM := dynlib dynlib_posix threads_posix files files_posix process_posix clock_posix os_posix
-HELPER_CORE_NAMES := helper_main volume colour_volume brick_source error loader_util zlib_api
+HELPER_CORE_NAMES := helper_main volume colour_volume channel_volume brick_source error loader_util zlib_api
 HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,$(HELPER_CORE_NAMES) helper_self_posix $(PLATFORM))
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr $(BUILD)/voxlight-write-vdb
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
 STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlight-slicingbench $(BUILD)/voxlight-modesbench \
-           $(BUILD)/voxlight-labelsbench $(BUILD)/voxlight-streambench $(BUILD)/voxlight-overlaysbench
+           $(BUILD)/voxlight-labelsbench $(BUILD)/voxlight-streambench $(BUILD)/voxlight-overlaysbench \
+           $(BUILD)/voxlight-channelsbench
 TESTS_SRC := $(wildcard tests/test_*.c)
 TESTS := $(TESTS_SRC:tests/%.c=$(BUILD)/tests/%)
 
@@ -190,6 +191,10 @@ $(BUILD)/voxlight-streambench: bench/stream_study.c bench/bench_util.h $(BUILD)/
 $(BUILD)/voxlight-overlaysbench: bench/overlays_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
+# multi-channel volumes: frame time against channels, against overlays of the same data (docs/channels.md)
+$(BUILD)/voxlight-channelsbench: bench/channels_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
+	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
+
 # issue 19: the render modes' run time against error (docs/modes.md, docs/benchmark.md)
 $(BUILD)/voxlight-modesbench: bench/modes_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
@@ -208,7 +213,7 @@ $(BUILD)/voxlight-sceneshadowbench: bench/scene_shadow_study.c bench/bench_util.
 # test_brick_cache calls the cache's internals (csrc/io/brick_cache.h), so it
 # links their objects and those its checks compare against, as well as the library.
 BRICK_CACHE_TEST_OBJ := $(patsubst %,$(BUILD)/obj/%.o,brick_cache brick_cache_read brick_cache_write \
-	brick_cache_format brick_source brick_levels bricks volume colour_volume error paging lod brick_loader loader_util zlib_api \
+	brick_cache_format brick_source brick_levels bricks volume colour_volume channel_volume error paging lod brick_loader loader_util zlib_api \
 	$(PLATFORM) crc32)
 $(BUILD)/tests/test_brick_cache: tests/test_brick_cache.c tests/harness.h $(wildcard tests/*.h) $(BRICK_CACHE_TEST_OBJ) \
 		$(BUILD)/libvoxlight.so | $(BUILD)/tests
@@ -390,7 +395,7 @@ FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc
 	$(shell pkg-config --cflags OpenImageIO)
 # the core's loaders and dispatch (the helper-run readers are called
 # in-process by their targets: libFuzzer sees coverage in its own process only)
-FUZZ_LIB_C := volume.c colour_volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
+FUZZ_LIB_C := volume.c colour_volume.c channel_volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
 	reader_spawn.c remote_readers.c label_table.c zarr_detect.c $(notdir $(ZARR_C)) zarr_source.c brick_source.c
 # the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout; the Radiance reader of World maps, read by fuzz_hdr

@@ -79,10 +79,15 @@ typedef struct stress_vol {
     double slope, inter;
     /* 0: grey; 3 or 4: a colour volume whose channel c is fill times
      * sv_channel_gain[c] (so NaN, Inf and extremes reach every channel) */
+    /* or SV_CHANNELS(n): a multi-channel volume of n (2..8) channels
+     * (docs/channels.md), interleaved, channel c fill times sv_channel_gain[c] */
     uint32_t components;
 } stress_vol;
 
-static const double sv_channel_gain[4] = {1.0, 0.5, -1.0, 0.25};
+#define SV_CHANNELS(n) (0x100u | (n))
+static inline uint32_t sv_channels(const stress_vol *s) { return s->components & 0x100u ? s->components & 0xffu : 0; }
+
+static const double sv_channel_gain[8] = {1.0, 0.5, -1.0, 0.25, 2.0, -0.5, 0.75, 1.5};
 
 static inline double sv_centre(const uint32_t d[3], int a) { return (d[a] - 1) / 2.0; }
 
@@ -180,7 +185,7 @@ static inline int stress_make_volume(const stress_vol *s, const stress_env *e, v
     uint32_t d[3];
     for (int a = 0; a < 3; a++) d[a] = s->dims[a] == BIG_N ? e->big_n : s->dims[a] ? s->dims[a] : e->n;
     uint64_t n = (uint64_t)d[0] * d[1] * d[2];
-    const uint32_t comp = s->components ? s->components : 1;
+    const uint32_t comp = sv_channels(s) ? sv_channels(s) : s->components ? s->components : 1;
     void *raw = malloc(n * comp * sv_dtype_size(s->dtype));
     if (!raw) return VXL_ERR_NO_MEMORY;
     for (uint32_t k = 0; k < d[2]; k++)
@@ -199,7 +204,9 @@ static inline int stress_make_volume(const stress_vol *s, const stress_env *e, v
     desc.data = raw;
     desc.scl_slope = s->slope;
     desc.scl_inter = s->inter;
-    desc.components = s->components;
+    desc.components = sv_channels(s) ? 0 : s->components;
+    desc.channels = sv_channels(s);
+    desc.channels_interleaved = 1;
     double *A = desc.affine;
     desc.has_affine = 1;
     switch (s->affine) {
@@ -1000,6 +1007,13 @@ static const stress_case stress_cases[] = {
      view_default, OK, F_ONE_FILTER, 0},
     {"colour_rgb_f64_max_and_nan", GROUP_dtypes_and_scaling, {VXL_DTYPE_F64, N3, fill_f64_max_and_nan, AFF_ROT_SHEAR, 0, 0, 3},
      view_default, OK, F_ONE_FILTER, 0},
+    /* multi-channel volumes: the scalar (channel 0) through the matrix, and
+     * every channel drawn in one march (test_stress.c, render_channels):
+     * two texture groups lit, one group of float channels with NaN and Inf */
+    {"channels_u16_ball_6", GROUP_dtypes_and_scaling, {VXL_DTYPE_U16, N3, fill_u16_max_ball, AFF_NONE, 0, 0, SV_CHANNELS(6)},
+     view_default, OK, 0, 0},
+    {"channels_f32_nan_inf_mix_3", GROUP_dtypes_and_scaling, {F32, N3, fill_nan_inf_mix, AFF_ROT_SHEAR, 0, 0, SV_CHANNELS(3)},
+     view_default, OK, 0, 0},
     {"i32_extremes_checker", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_I32, fill_i32_checker), view_default, OK, 0, 0},
     {"u32_full_range_ball", GROUP_dtypes_and_scaling, VOL(VXL_DTYPE_U32, fill_u32_max_ball), view_default, OK,
      F_VISIBLE, 0},

@@ -34,16 +34,19 @@ static float *make_frames(void)
     return d;
 }
 
-static vxl_volume *load_frame(const char *path, uint32_t frame)
+/* channels: VXL_CHANNELS_*, how a 5D file's dim[5] is read (docs/channels.md) */
+static vxl_volume *load_frame_as(const char *path, uint32_t frame, uint32_t channels)
 {
-    vxl_load_options opt = {.struct_size = sizeof opt, .frame = frame};
+    vxl_load_options opt = {.struct_size = sizeof opt, .frame = frame, .channels = channels};
     vxl_volume *v = NULL;
     return vxl_volume_load(path, &opt, &v) == VXL_OK ? v : NULL;
 }
 
-static void check_frame(vxl_test_ctx *T_, const char *path, uint32_t f)
+static vxl_volume *load_frame(const char *path, uint32_t frame) { return load_frame_as(path, frame, VXL_CHANNELS_AUTO); }
+
+static void check_frame_as(vxl_test_ctx *T_, const char *path, uint32_t f, uint32_t channels)
 {
-    vxl_volume *v = load_frame(path, f);
+    vxl_volume *v = load_frame_as(path, f, channels);
     CHECKF(v != NULL, "%s frame %u: %s", path, f, vxl_last_error());
     if (!v) return;
     vxl_volume_info info = {.struct_size = sizeof info};
@@ -56,6 +59,8 @@ static void check_frame(vxl_test_ctx *T_, const char *path, uint32_t f)
                f, (unsigned long long)probes[p]);
     vxl_volume_destroy(v);
 }
+
+static void check_frame(vxl_test_ctx *T_, const char *path, uint32_t f) { check_frame_as(T_, path, f, VXL_CHANNELS_AUTO); }
 
 TEST(frame_n_of_a_4d_file_is_that_volume)
 {
@@ -103,7 +108,7 @@ TEST(later_frames_are_never_read_so_a_cut_file_opens)
     free(d);
 }
 
-TEST(dim5_counts_frames_and_3d_files_have_one)
+TEST(dim5_counts_frames_with_channels_off_and_3d_files_have_one)
 {
     float *d = make_frames();
     REQUIRE(d);
@@ -115,7 +120,12 @@ TEST(dim5_counts_frames_and_3d_files_have_one)
     h.dim[4] = 8;
     h.dim[5] = 5; /* 8 x 5 = 40 volumes, in file order */
     REQUIRE(tnw_write(p, &h, d, sizeof(float) * PER * FRAMES) == 0);
-    check_frame(T_, p, 39);
+    check_frame_as(T_, p, 39, VXL_CHANNELS_OFF); /* as before channels */
+    /* by default dim[5] is 5 channels of 8 frames (tests/test_channels.c) */
+    vxl_volume *c = load_frame(p, 7);
+    vxl_volume_info ci = {.struct_size = sizeof ci};
+    CHECK(c && vxl_volume_get_info(c, &ci) == VXL_OK && ci.channel_count == 5 && ci.frame_count == 8 && ci.frame == 7);
+    vxl_volume_destroy(c);
     snprintf(p, sizeof p, "%s/3d.nii", g_dir);
     tnw_init(&h, 1, 16, N, N, N);
     REQUIRE(tnw_write(p, &h, d, sizeof(float) * PER) == 0);
@@ -147,7 +157,7 @@ int main(void)
     }
     RUN(frame_n_of_a_4d_file_is_that_volume);
     RUN(later_frames_are_never_read_so_a_cut_file_opens);
-    RUN(dim5_counts_frames_and_3d_files_have_one);
+    RUN(dim5_counts_frames_with_channels_off_and_3d_files_have_one);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

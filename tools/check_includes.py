@@ -40,7 +40,7 @@ import tempfile
 LAYERS = [
     ["cli", "helpers"],               # executables: voxlight, voxlight-read-*
     ["render"],                       # frames, the renderer object, the API
-    ["classify", "gradients", "skip", "light", "cut", "labels", "overlay", "colour"],  # derived volumes, cutaways, labels, overlays, a colour volume's colour: what the ray caster reads
+    ["classify", "gradients", "skip", "light", "cut", "labels", "overlay", "colour", "channels"],  # derived volumes, cutaways, labels, overlays, a colour volume's colour, a multi-channel volume's channels: what the ray caster reads
     ["storage"],                      # dense/bricked/sparse/compressed
     ["gl", "io", "frame"],            # GL services; file readers; render parameters
     ["volume"],                       # CPU volumes, phantoms

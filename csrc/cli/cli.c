@@ -18,6 +18,7 @@
 #include "cli_labels.h" /* the labels command (issue 20) */
 #include "cli_labels_render.h" /* render --labels ... (issue 20) */
 #include "cli_overlays.h" /* render --overlay ... (issue 20) */
+#include "cli_channels.h" /* --channel, --channels, --channel-color, --channel-window, --channel-blend */
 #include "cli_colour.h" /* --color-source, --opacity-source, the components line */
 #include "cli_stream.h" /* --streaming, --cache-dir, first-open progress, Ctrl-C, budget split (issue 21) */
 #include "cli_path.h" /* --samples, --sample-offset, --bounces, --seed: --shading path */
@@ -46,8 +47,10 @@ static const char usage_format[] =
     "                  [--overlay FILE[:PRESET][:LO:HI] [--overlay-blend over|add|max] [--overlay-opacity X]]...\n"
     "                  [--color-source auto|data|tf] [--opacity-source luminance|alpha|channel:N]\n"
     "                  [--color-space display|linear]\n"
+    "                  [--channel N] [--channel-axis auto|on|off] [--channels all|I,J,...\n"
+    "                   [--channel-color I:R,G,B]... [--channel-window I:LO:HI]... [--channel-blend add|max]]\n"
     "  voxlight info INPUT [--voxel-size X[,Y,Z]] [--frame N] [--series N|UID] [--streaming MODE] [--cache-dir DIR]\n"
-    "                  [--opacity-source luminance|alpha|channel:N]\n"
+    "                  [--opacity-source luminance|alpha|channel:N] [--channel N] [--channel-axis auto|on|off]\n"
     "  voxlight labels FILE   (a label lookup table: FreeSurfer LUT, ITK-SNAP, Slicer .ctbl, MRIcron .lut/.txt)\n"
     "INPUT: a file, a folder of images or DICOM slices, a DICOMDIR; --frame picks a volume of a 4D file,\n"
     "--series a series of a DICOM folder (index or SeriesInstanceUID, as `info` lists them);\n"
@@ -62,6 +65,12 @@ static const char usage_format[] =
     "colour (RGB, RGBA: NIfTI RGB24/RGBA32, vector NIfTI): rendered in the data's colour (--color-source\n"
     "         auto or data; tf: the transfer function's), opacity from the transfer function of the\n"
     "         --opacity-source scalar (luminance by default, alpha, or channel:N, 0 red .. 3 alpha)\n"
+    "channels (NIfTI dim[5], an NRRD channel axis; docs/channels.md): --channel N renders channel N alone\n"
+    "         (default 0); --channels all or I,J,... draws those in one pass, each in its colour (default red,\n"
+    "         green, blue, magenta, cyan, yellow, orange, white; --channel-color, linear 0..1) through a grey\n"
+    "         ramp over its window (default its data range; --channel-window in its data units), blended\n"
+    "         add (default: the sum of the channels) or max (the most opaque channel at each step);\n"
+    "         --channel-axis on reads a 3-4 entry axis as channels rather than colour, off never as channels\n"
     "filters: %s; presets: %s\n"
     "storage: auto = one texture when it fits the texture limit and --memory-budget, else bricked;\n"
     "         sparse keeps only the bricks the transfer function can show; compressed holds every brick\n"
@@ -344,7 +353,8 @@ static int cmd_info(int argc, char **argv)
         if (r < 0) return 1;
         if (r) continue;
         if ((r = vxl_cli_stream_option(argc, argv, &i, &stream, serr, sizeof serr)) != 0 ||
-            (r = vxl_cli_colour_option(argc, argv, &i, NULL, &lo, serr, sizeof serr)) != 0) {
+            (r = vxl_cli_colour_option(argc, argv, &i, NULL, &lo, serr, sizeof serr)) != 0 ||
+            (r = vxl_cli_channels_option(argc, argv, &i, NULL, &lo, serr, sizeof serr)) != 0) {
             if (r < 0) return die("%s", serr);
             continue;
         }
@@ -382,6 +392,7 @@ static int cmd_info(int argc, char **argv)
     printf("data type:   %s (stored as %u-bit %s)\n", dtype ? dtype : "?", in.texture_bits,
            in.texture_bits == 32 ? "float" : "normalised");
     vxl_cli_colour_print_info(&in, stdout);
+    vxl_cli_channels_print_info(&in, stdout);
     printf("value range: %g .. %g\n", in.value_min, in.value_max);
     printf("nan voxels:  %llu\n", (unsigned long long)in.nan_count);
     printf("inf voxels:  %llu\n", (unsigned long long)in.inf_count);
@@ -403,6 +414,7 @@ typedef struct render_args {
     vxl_cli_cut cut;     /* issue 19 cutaways */
     vxl_cli_labels labels; /* issue 20 label maps */
     vxl_cli_overlays overlays; /* issue 20 overlays */
+    vxl_cli_channels channels; /* multi-channel volumes */
     vxl_cli_stream stream; /* issue 21 streaming */
     vxl_cli_environment environment; /* the World's light */
 } render_args;
@@ -509,6 +521,8 @@ static int parse_render(int argc, char **argv, render_args *a)
             if (r < 0) return die("%s", err); /* issue 21 */
         } else if ((r = vxl_cli_colour_option(argc, argv, &i, p, &a->lo, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err); /* colour volumes */
+        } else if ((r = vxl_cli_channels_option(argc, argv, &i, &a->channels, &a->lo, err, sizeof err)) != 0) {
+            if (r < 0) return die("%s", err); /* multi-channel volumes */
         } else if ((r = vxl_cli_environment_option(argc, argv, &i, &a->environment, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err);
         } else if ((r = vxl_cli_path_option(argc, argv, &i, p, err, sizeof err)) != 0) {
@@ -534,6 +548,7 @@ static int cmd_render(int argc, char **argv)
     vxl_cli_cut_init(&a.cut);
     vxl_cli_labels_init(&a.labels);
     vxl_cli_overlays_init(&a.overlays);
+    vxl_cli_channels_init(&a.channels);
     vxl_cli_stream_init(&a.stream);
     vxl_cli_environment_init(&a.environment);
     if (parse_render(argc, argv, &a)) return 1;
@@ -561,6 +576,7 @@ static int cmd_render(int argc, char **argv)
     if (vxl_cli_labels_apply(&a.labels, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; } /* issue 20 */
     if (vxl_cli_overlays_apply(&a.overlays, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_environment_apply(&a.environment, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
+    if (vxl_cli_channels_apply(&a.channels, &a.lo, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     vxl_volume_destroy(v);
     v = NULL;
     rgba = malloc((size_t)w * h * 4 * sizeof *rgba);

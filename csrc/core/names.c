@@ -21,6 +21,8 @@ static const char *const streaming_names[VXL_STREAMING_COUNT] = {"auto", "off", 
 static const char *const blend_names[VXL_BLEND_COUNT] = {"over", "add", "max"};
 static const char *const opacity_source_names[VXL_OPACITY_SOURCE_COUNT] = {"luminance", "channel", "alpha"};
 static const char *const color_source_names[VXL_COLOR_SOURCE_COUNT] = {"auto", "data", "tf"};
+static const char *const channels_mode_names[VXL_CHANNELS_COUNT] = {"auto", "on", "off"};
+static const char *const channel_blend_names[VXL_CHANNEL_BLEND_COUNT] = {"add", "max"};
 static const char *const backend_names[VXL_BACKEND_COUNT] = {"auto", "osmesa", "egl", "wgl"};
 static const char *const dtype_names[VXL_DTYPE_COUNT] = {NULL,    "uint8", "int8",    "uint16", "int16",
                                                          "uint32", "int32", "float32", "float64"};
@@ -57,6 +59,8 @@ VXL_NAMES(streaming, streaming_names, VXL_STREAMING_COUNT, "streaming mode")
 VXL_NAMES(blend, blend_names, VXL_BLEND_COUNT, "blend")
 VXL_NAMES(opacity_source, opacity_source_names, VXL_OPACITY_SOURCE_COUNT, "opacity source")
 VXL_NAMES(color_source, color_source_names, VXL_COLOR_SOURCE_COUNT, "color source")
+VXL_NAMES(channels_mode, channels_mode_names, VXL_CHANNELS_COUNT, "channels mode")
+VXL_NAMES(channel_blend, channel_blend_names, VXL_CHANNEL_BLEND_COUNT, "channel blend")
 
 
 const char *vxl_dtype_name(uint32_t dtype) { return dtype < VXL_DTYPE_COUNT ? dtype_names[dtype] : NULL; }

@@ -370,6 +370,7 @@ void vxl_frame_free(vxl_frame *f)
     free(f->tf_copy);
     f->tf_copy = NULL;
     vxl_frame_overlays_free(f); /* issue 20 */
+    vxl_frame_channels_free(f);
 }
 
 uint64_t vxl_classification_key(const vxl_frame *f)

@@ -37,6 +37,19 @@ typedef struct vxl_frame_overlay {
     float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
 } vxl_frame_overlay;
 
+/* One drawn channel of a multi-channel volume (frame_channels.c), resolved
+ * against that channel's value mapping. */
+typedef struct vxl_frame_channel {
+    uint32_t channel;           /* the volume's channel index */
+    float color[3];
+    const float *tf;            /* tf_size straight RGBA, clamped to [0,1]: tf_copy or preset_tf */
+    uint32_t tf_size;
+    float window_offset, window_scale, opacity_scale; /* on the channel's normalised texels */
+    uint64_t key;               /* vxl_classification_key of the above: the GL side's table and occupancy cache */
+    float *tf_copy;             /* owned when the caller gave a table */
+    float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
+} vxl_frame_channel;
+
 typedef struct vxl_frame {
     uint32_t width, height;
     uint32_t filter, shading, reuse, store, jitter, seed;
@@ -124,6 +137,13 @@ typedef struct vxl_frame {
         uint32_t count;
         vxl_frame_overlay ov[VXL_MAX_OVERLAYS];
     } overlays;
+    /* multi-channel drawing (frame_channels.c): on is 0 without params.channels;
+     * ch[0..count) are the drawn ones (listed, not hidden, solo when any is). */
+    struct {
+        int on;
+        uint32_t listed, count, blend; /* VXL_CHANNEL_BLEND_* */
+        vxl_frame_channel ch[VXL_MAX_CHANNELS];
+    } channels;
 } vxl_frame;
 
 /* The frame's transfer function at normalised value vn, as the GPU reads
@@ -221,6 +241,21 @@ int vxl_frame_resolve_overlays(vxl_frame *f, const vxl_render_params *p, const v
                                const vxl_volume_geom *base, vxl_err *e);
 /* Frees what vxl_frame_resolve_overlays allocated (part of vxl_frame_free). */
 void vxl_frame_overlays_free(vxl_frame *f);
+
+/* Multi-channel drawing: validates p->channels (count <= VXL_MAX_CHANNELS,
+ * the stride, each channel < n_channels and listed once, colours in [0, 1],
+ * blend, reserved; the ray caster's DVR mode with post classification,
+ * PHONG shading or none, no gradient opacity, labels, overlays or World's
+ * light) into f->channels, each table and window resolved against its own
+ * channel's value mapping geoms[c] (vxl_frame_resolve_tf). n_channels 0
+ * with a nonzero channel_count is VXL_ERR_STATE. After vxl_frame_resolve
+ * and vxl_frame_resolve_overlays; frame_channels.c. */
+int vxl_frame_resolve_channels(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *geoms,
+                               uint32_t n_channels, vxl_err *e);
+/* Frees what vxl_frame_resolve_channels allocated (part of vxl_frame_free). */
+void vxl_frame_channels_free(vxl_frame *f);
+/* The default colour of channel c when its style gives none. */
+void vxl_channel_default_color(uint32_t c, float rgb[3]);
 
 /* The transfer function, window and opacity scale of p (preset or table,
  * resampled to at most 4096 entries and clamped) against volume g into

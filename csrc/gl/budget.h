@@ -34,6 +34,7 @@ typedef enum vxl_holder {
     VXL_HOLD_OVERLAYS,   /* issue 20: the overlay volumes (dense), their transfer functions and skipping maps */
     VXL_HOLD_COLOUR,     /* a colour volume's own colour (RGB8, dense, 3 bytes a voxel: colour/colour.c) */
     VXL_HOLD_PATH_MAJORANT, /* the PATH model's extinction majorant per skipping brick (R32F, render/path.c) */
+    VXL_HOLD_CHANNELS,   /* a multi-channel volume's channels (16 bits each, dense), tables and union skip map: channels/channels.c */
     VXL_HOLD_COUNT
 } vxl_holder;
 

@@ -105,6 +105,9 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
         if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* issue 20: label mode + 1 */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABELS %u\n%s",
                      (flags >> VXL_FLAG_LABELS_SHIFT) & 3, (flags & VXL_FLAG_LABEL_VOXELS) ? "#define LABEL_VOXELS 1\n" : "");
+        if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_CHANNELS_SHIFT) & 3) /* a multi-channel volume's texture groups */
+            snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define CHANNEL_GROUPS %u\n",
+                     (flags >> VXL_FLAG_CHANNELS_SHIFT) & 3);
         if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3) /* issue 20: the number of overlays */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define OVERLAYS %u\n",
                      (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3);

@@ -65,13 +65,16 @@
 /* The World's light: the ray caster's shading adds it (ENVIRONMENT), and
  * the illumination program with it is the environment pass (PASS 4). */
 #define VXL_FLAG_ENVIRONMENT (1u << 23)
+/* Ray caster program flag (channels/channels.c): bits 24-25 hold the number of
+ * a multi-channel volume's texture groups drawn (CHANNEL_GROUPS, 1 or 2); 0 none. */
+#define VXL_FLAG_CHANNELS_SHIFT 24u
 /* The ray caster's flags are one key: no two may share a bit (the sum of
  * the fields equals their union; two rooms added on separate branches once
  * took the same bit). */
 #define VXL_RAYCAST_FLAG_FIELDS_(op)                                                                                 \
     (VXL_FLAG_PAGED op VXL_FLAG_COMPRESSED_DOMAIN op (7u << VXL_FLAG_MODE_SHIFT) op VXL_FLAG_MATCAP op                \
      VXL_FLAG_CUT_CONVEX op VXL_FLAG_CUT_CUTTERS op (3u << VXL_FLAG_LABELS_SHIFT) op (3u << VXL_FLAG_OVERLAYS_SHIFT) op \
-     VXL_FLAG_PAGED_MIXED op VXL_FLAG_LABEL_VOXELS op VXL_FLAG_DATA_COLOUR op VXL_FLAG_ENVIRONMENT)
+     VXL_FLAG_PAGED_MIXED op VXL_FLAG_LABEL_VOXELS op VXL_FLAG_DATA_COLOUR op VXL_FLAG_ENVIRONMENT op (3u << VXL_FLAG_CHANNELS_SHIFT))
 _Static_assert(VXL_RAYCAST_FLAG_FIELDS_(+) == VXL_RAYCAST_FLAG_FIELDS_(|), "two program flags share a bit (gpu.h)");
 /* Direction cells the World's map is reduced to (light/environment_map.h);
  * the environment pass's ENV_CELLS. */

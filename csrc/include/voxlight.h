@@ -213,7 +213,31 @@ typedef struct vxl_load_options {
      * Grey volumes ignore both. docs/colour.md. */
     uint32_t opacity_source;      /* VXL_OPACITY_SOURCE_* */
     uint32_t opacity_channel;     /* CHANNEL: 0..components-1 */
+    /* Appended (multi-channel volumes, docs/channels.md); read only when
+     * struct_size covers them. A multi-channel volume holds up to
+     * VXL_MAX_CHANNELS scalars on one grid (fluorescence: nuclei, membranes,
+     * a protein), each classified on its own when params.channels lists it;
+     * its scalar (what everything else renders, `info` and the histogram
+     * report) is channel scalar_channel. Which inputs load as channels:
+     *   AUTO (0)  an axis that cannot be colour: NIfTI 5D whose dim[5] > 1
+     *             is not an RGB(A) vector (dim[4] counts the frames), NRRD
+     *             whose component axis has more than 4 entries
+     *   ON        also a 2..4-entry axis that AUTO leaves as it was (colour,
+     *             or a 5D NIfTI's frames)
+     *   OFF       none: NIfTI 5D counts every volume as a frame and NRRD
+     *             refuses a component axis over 4, as before channels
+     * The volume's notes say which was chosen and why. */
+    uint32_t channels;            /* VXL_CHANNELS_* */
+    uint32_t scalar_channel;      /* which channel is the scalar; 0 = the first */
 } vxl_load_options;
+
+#define VXL_CHANNELS_AUTO 0
+#define VXL_CHANNELS_ON 1
+#define VXL_CHANNELS_OFF 2
+#define VXL_CHANNELS_COUNT 3
+#define VXL_MAX_CHANNELS 8 /* channels of one volume, sampled in one ray march */
+VXL_API const char *vxl_channels_mode_name(uint32_t mode); /* "auto", "on", "off" */
+VXL_API int vxl_channels_mode_from_name(const char *name, uint32_t *out);
 
 #define VXL_OPACITY_SOURCE_LUMINANCE 0
 #define VXL_OPACITY_SOURCE_CHANNEL 1
@@ -247,6 +271,14 @@ typedef struct vxl_volume_desc {
      * scalar is chosen by vxl_load_options.opacity_source. */
     uint32_t components;
     uint32_t reserved;     /* must be 0 */
+    /* Appended (multi-channel volumes, docs/channels.md); read only when
+     * struct_size covers them. 0 or 1: one scalar; 2..VXL_MAX_CHANNELS:
+     * that many scalars of dtype on the grid (components must then be 0 or
+     * 1), planar (channel slowest: index = voxel + n_voxels * c, as NIfTI 5D
+     * and a numpy (C, Z, Y, X) array store them) or interleaved
+     * (index = c + channels * voxel). scl_slope/scl_inter apply to all. */
+    uint32_t channels;
+    uint32_t channels_interleaved; /* 1: interleaved; 0: planar */
 } vxl_volume_desc;
 
 #define VXL_NOTES_MAX 512 /* vxl_volume_info.notes, its NUL included */
@@ -284,6 +316,12 @@ typedef struct vxl_volume_info {
     uint32_t components;        /* 1 grey, 3 RGB, 4 RGBA: what the source holds */
     uint32_t opacity_source;    /* VXL_OPACITY_SOURCE_* the scalar came from (colour volumes; 0 grey) */
     uint64_t color_bytes;       /* bytes of the voxels' own colour (RGB8, 3 a voxel; 0 grey) */
+    /* Appended (multi-channel volumes): written only when struct_size covers them. */
+    uint32_t channel_count;     /* 0: not a multi-channel volume; else 2..VXL_MAX_CHANNELS */
+    uint32_t scalar_channel;    /* the channel the scalar is */
+    double channel_min[VXL_MAX_CHANNELS]; /* each channel's finite data range (after scaling) */
+    double channel_max[VXL_MAX_CHANNELS];
+    uint64_t channel_bytes;     /* bytes of the channels on the GL side (16 bits a channel a voxel) */
 } vxl_volume_info;
 
 VXL_API int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **out);
@@ -675,6 +713,46 @@ typedef struct vxl_overlay_style {
     uint32_t reserved;          /* must be 0 */
 } vxl_overlay_style;
 
+/* One channel of a multi-channel volume in params.channels. Its sample's
+ * straight colour is color * the table's rgb at the windowed value, its
+ * opacity the table's alpha (per voxel of path) * opacity_scale, lit (the
+ * frame's Phong shading and lights) with the channel's own gradient.
+ * How the channels combine, params.channel_blend:
+ *   ADD (0)  each channel is composited along the ray on its own, and the
+ *            pixel is the sum of the channels' images (clamped to 1):
+ *            channels glow through each other, as napari's and Imaris's
+ *            additive blending; the image equals the sum of the channels
+ *            drawn one at a time
+ *   MAX      at each step the channel with the largest opacity is the
+ *            sample, composited front to back as one medium: the dominant
+ *            channel hides what lies behind it
+ * A channel not listed, hidden, or (when any listed channel has solo 1)
+ * not solo is not drawn and does not count for empty-space skipping, which
+ * skips where every drawn channel is empty (the union of their occupancy).
+ * Multi-channel drawing takes the ray caster's DVR mode, post
+ * classification, dense storage and PHONG shading (or none); anything
+ * else is VXL_ERR_INVALID_ARGUMENT naming what. */
+typedef struct vxl_channel_style {
+    uint32_t struct_size;
+    uint32_t channel;           /* < the volume's channel_count; listed once */
+    uint32_t hidden;            /* 1: not drawn (stays listed, so a UI can toggle it) */
+    uint32_t solo;              /* 1: while any listed channel is solo, only solo ones are drawn */
+    uint32_t has_color;         /* 0: the default colour of its index (docs/channels.md) */
+    float color[3];             /* linear RGB, each in [0, 1] */
+    uint32_t has_window;        /* 0: the channel's data range */
+    float window_low, window_high; /* data units of the channel */
+    uint32_t preset;            /* VXL_PRESET_* when tf_rgba is NULL; AUTO (0) = GRAY, a ramp */
+    uint32_t tf_size;           /* entries in tf_rgba (>= 2) */
+    const float *tf_rgba;       /* straight RGBA, opacity per voxel of path */
+    float opacity_scale;        /* 0 = 1 */
+    uint32_t reserved;          /* must be 0 */
+} vxl_channel_style;
+#define VXL_CHANNEL_BLEND_ADD 0
+#define VXL_CHANNEL_BLEND_MAX 1
+#define VXL_CHANNEL_BLEND_COUNT 2
+VXL_API const char *vxl_channel_blend_name(uint32_t blend); /* "add", "max" */
+VXL_API int vxl_channel_blend_from_name(const char *name, uint32_t *out);
+
 /* The World's light, params.environment: a linear-RGB latitude-longitude
  * map (equirectangular, as Blender's Environment Texture), times strength,
  * turned about world +Z by rotation_deg, lighting every sample from every
@@ -852,6 +930,14 @@ typedef struct vxl_render_params {
     uint32_t path_bounces;       /* collisions per path (1 = single scattering); 0 = VXL_PATH_DEFAULT_BOUNCES,
                                     at most VXL_PATH_MAX_BOUNCES */
     uint32_t path_seed;          /* another seed, another (equally good) noise; the same seed, the same image */
+    /* Appended (multi-channel volumes, docs/channels.md); read only when
+     * struct_size covers them. channel_count > 0 draws the listed channels
+     * of a multi-channel volume in one ray march (one sample of every
+     * channel per step) instead of its scalar; the frame's own table and
+     * window are then unused. 0: the scalar alone, as before. */
+    uint32_t channel_count;     /* <= VXL_MAX_CHANNELS entries in channels */
+    uint32_t channel_blend;     /* VXL_CHANNEL_BLEND_* */
+    const vxl_channel_style *channels; /* stride channels[0].struct_size */
 } vxl_render_params;
 
 #define VXL_PATH_MAX_SAMPLES 65536u

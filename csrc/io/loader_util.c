@@ -1,5 +1,6 @@
 /* loader_util.c - see loader_util.h. */
 #include "loader_util.h"
+#include "channel_volume.h"
 #include "colour_volume.h"
 #include "files.h"
 
@@ -202,6 +203,23 @@ int vxl_plan_colour_voxels(const char *path, const uint32_t dims[3], uint32_t dt
         return vxl_fail_in(e, path, &inner);
     }
     *nbytes = (uint64_t)dims[0] * dims[1] * dims[2] * raw;
+    return VXL_OK;
+}
+
+int vxl_plan_channel_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, uint32_t channels,
+                            const vxl_load_options *opt, uint64_t *nbytes, vxl_err *e)
+{
+    const uint32_t raw = vxl_dtype_size(dtype) * channels,
+                   texture = vxl_texture_bits_for(dtype) / 8 + VXL_CHANNEL_BYTES * channels;
+    vxl_err inner = {0};
+    if (vxl_volume_check_limits(dims, raw > texture ? raw : texture, opt, &inner)) {
+        if (inner.code == VXL_ERR_LIMIT)
+            return vxl_fail(e, VXL_ERR_LIMIT,
+                            "'%s': %s (multi-channel volumes are read whole: streaming is not available for them)", path,
+                            inner.msg);
+        return vxl_fail_in(e, path, &inner);
+    }
+    *nbytes = (uint64_t)dims[0] * dims[1] * dims[2] * vxl_dtype_size(dtype); /* one channel */
     return VXL_OK;
 }
 

@@ -77,6 +77,12 @@ int vxl_plan_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, co
 int vxl_plan_colour_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, uint32_t components,
                            const vxl_load_options *opt, uint64_t *nbytes, vxl_err *e);
 
+/* The same for a multi-channel file of `channels` planes of dtype, read
+ * whole: the budget takes the raw channels or the scalar's texture with its
+ * 16-bit channels, whichever is larger. *nbytes: one channel's raw bytes. */
+int vxl_plan_channel_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, uint32_t channels,
+                            const vxl_load_options *opt, uint64_t *nbytes, vxl_err *e);
+
 /* Wraps an error from a helper with the file name, keeping its code. */
 int vxl_fail_in(vxl_err *e, const char *path, const vxl_err *inner);
 

@@ -16,6 +16,7 @@
 #include "loaders.h"
 #include "stream_load.h"
 #include "gz_reader.h"
+#include "channel_volume.h"
 #include "colour_volume.h"
 
 #include <errno.h>
@@ -647,6 +648,66 @@ static nii_colour colour_of(const nii_header *h)
     return c;
 }
 
+/* Multi-channel NIfTI (docs/channels.md): dim[5] (NIfTI's vector axis) as
+ * channels, stored one whole volume after another, each frame of dim[4]
+ * inside each channel. AUTO takes 2..VXL_MAX_CHANNELS channels where the
+ * file is not colour and dim[6..7] are 1; ON also takes an RGB(A) vector
+ * file's 3-4 as channels; OFF none (dim[5] counts frames, as before). 0: not
+ * a multi-channel read. */
+static int channels_of(const nii_header *h, const nii_colour *colour, const char *path, const vxl_load_options *opt,
+                       uint32_t *count, vxl_err *e)
+{
+    *count = 0;
+    uint32_t mode, scalar;
+    int rc = vxl_load_channels_mode(opt, &mode, &scalar, e);
+    if (rc || mode == VXL_CHANNELS_OFF || h->dim[0] < 5 || h->dim[5] <= 1) return rc;
+    if (colour->components && !(colour->planar && mode == VXL_CHANNELS_ON)) return VXL_OK; /* colour */
+    const int fits = h->dim[5] <= VXL_MAX_CHANNELS && (h->dim[0] < 6 || h->dim[6] <= 1) && (h->dim[0] < 7 || h->dim[7] <= 1);
+    if (!fits) {
+        if (mode == VXL_CHANNELS_ON)
+            return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT,
+                            "'%s': channels on, but dim[5..7] = %lld, %lld, %lld: a multi-channel volume has 2 to %d "
+                            "channels along dim[5] only",
+                            path, (long long)h->dim[5], (long long)(h->dim[0] >= 6 ? h->dim[6] : 1),
+                            (long long)(h->dim[0] >= 7 ? h->dim[7] : 1),
+                            VXL_MAX_CHANNELS);
+        return VXL_OK; /* frames, as before */
+    }
+    *count = (uint32_t)h->dim[5];
+    return VXL_OK;
+}
+
+/* Channel c of frame `frame` of a multi-channel file lies at
+ * offset + (frame + dim[4] * c) * nbytes: the channels' planes of that
+ * frame read into one planar buffer (forward seeks only, so .nii.gz
+ * inflates each byte once). */
+static int read_channel_voxels(vxl_gz *f, const char *path, uint64_t offset, uint64_t nbytes, uint32_t channels,
+                               uint32_t frame, uint32_t frames, void **out, vxl_err *e)
+{
+    *out = NULL;
+    const uint64_t last = offset + ((uint64_t)frame + (uint64_t)frames * (channels - 1)) * nbytes;
+    int rc = precheck_size(f, path, last, nbytes, e);
+    if (rc) return rc;
+    char *buf = malloc((size_t)(nbytes * channels));
+    if (!buf)
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for %u channels of %llu bytes", path, channels,
+                        (unsigned long long)nbytes);
+    for (uint32_t c = 0; c < channels && !rc; c++) {
+        rc = vxl_gz_seek(f, offset + ((uint64_t)frame + (uint64_t)frames * c) * nbytes, e);
+        uint64_t got = 0;
+        if (!rc) rc = read_bytes(f, buf + c * nbytes, nbytes, &got, e);
+        if (!rc && got < nbytes)
+            rc = vxl_fail(e, VXL_ERR_FORMAT, "'%s': truncated file: channel %u has %llu of %llu bytes", path, c,
+                          (unsigned long long)got, (unsigned long long)nbytes);
+    }
+    if (rc) {
+        free(buf);
+        return rc;
+    }
+    *out = buf;
+    return VXL_OK;
+}
+
 /* Validates the header and works out what to read: whole (today's checks
  * against the budget, before anything is allocated) or streamed (issue 21:
  * *stream = 1, stream_load.h). */
@@ -741,6 +802,44 @@ static int stream_volume(const nii_header *h, const char *data_path, const uint3
     return vxl_stream_load(&l, opt, out, e);
 }
 
+/* A multi-channel file (channels_of): frame vxl_load_frame(opt) of dim[4],
+ * every channel, read whole and built by vxl_volume_build_channels. */
+static int load_channels(nii_load *L, const nii_header *h, vxl_gz *data, const char *data_path, uint32_t channels,
+                         const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
+{
+    uint32_t dims[3];
+    uint64_t offset = 0, nbytes = 0;
+    int rc = check_dims(h, dims, L->hdr_path, e);
+    if (rc) return rc;
+    const uint32_t dtype = vxl_dtype_from_nifti(h->datatype);
+    if (!dtype || h->datatype == 128 || h->datatype == 2304)
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': datatype %d (%s) cannot hold channels", L->hdr_path, h->datatype,
+                        datatype_name(h->datatype));
+    if ((rc = check_vox_offset(h, &offset, L->hdr_path, e))) return rc;
+    if ((rc = vxl_plan_channel_voxels(L->hdr_path, dims, dtype, channels, opt, &nbytes, e))) return rc;
+    const uint32_t frames = h->dim[4] > 1 ? (uint32_t)h->dim[4] : 1, frame = vxl_load_frame(opt);
+    if (frame >= frames)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %u requested, the file has %u (0..%u)", L->hdr_path,
+                        frame, frames, frames - 1);
+    if ((rc = read_channel_voxels(data, data_path, offset, nbytes, channels, frame, frames, &L->raw, e))) return rc;
+    if (h->swapped) swap_voxels(L->raw, nbytes * channels / vxl_dtype_size(dtype), vxl_dtype_size(dtype));
+    double sp[3], A[16], slope, inter;
+    spacing_from(h, sp);
+    const uint32_t source = choose_affine(h, sp, A);
+    scaling_from(h, &slope, &inter);
+    vxl_err inner = {0};
+    rc = vxl_volume_build_channels(L->raw, dtype, channels, 0, dims, sp, A, slope, inter, opt, "NIfTI dim[5]", out,
+                                   &inner);
+    if (rc) return fail_with_path(e, L->hdr_path, &inner);
+    (*out)->nifti_version = (uint32_t)h->version;
+    (*out)->affine_source = source;
+    (*out)->frame_count = frames;
+    (*out)->frame = frame;
+    if (vxl_load_streaming(opt) == VXL_STREAMING_ON)
+        vxl_volume_note(*out, "read whole: a multi-channel volume does not stream");
+    return VXL_OK;
+}
+
 int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     if (!out) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "out is NULL");
@@ -756,7 +855,14 @@ int vxl_nifti_load(const char *path, const vxl_load_options *opt, vxl_volume **o
     uint64_t offset = 0, nbytes = 0;
     int stream = 0;
     int rc = open_files(&L, &h, &data, &data_path, e);
-    const nii_colour colour = colour_of(&h);
+    nii_colour colour = colour_of(&h);
+    uint32_t channels = 0;
+    if (!rc) rc = channels_of(&h, &colour, L.hdr_path, opt, &channels, e);
+    if (!rc && channels) {
+        rc = load_channels(&L, &h, data, data_path, channels, opt, out, e);
+        load_cleanup(&L);
+        return rc;
+    }
     if (!rc) rc = plan_read(&h, &colour, L.hdr_path, opt, dims, &dtype, &offset, &nbytes, &stream, e);
     if (!rc && colour.planar && vxl_load_frame(opt) != 0) /* dim[4] is 1: one volume of channels */
         rc = vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %u requested, the vector file has one volume",

@@ -26,6 +26,7 @@
 #include "loader_util.h"
 #include "loaders.h"
 #include "stream_load.h"
+#include "channel_volume.h"
 #include "colour_volume.h"
 
 #define NRRD_MAX_DIM 16
@@ -332,16 +333,26 @@ static int parse_header(char *text, size_t len, uint64_t file_size, int detached
  * volume is read. A non-spatial fastest axis of 3 or 4 (RGB-color,
  * RGBA-color, 3-vector: each sample's channels, interleaved) makes a colour
  * volume of that many *components (1 otherwise). */
-static int choose_axes(const nrrd_hdr *h, int axes[3], int *nax, uint32_t dims[3], uint64_t *block_count,
-                       uint32_t *components, const char *path, vxl_err *e)
+/* A multi-channel read (docs/channels.md) takes that fastest axis as
+ * *channels instead, by channels_mode (VXL_CHANNELS_*): AUTO where it
+ * cannot be colour (2, or 5..VXL_MAX_CHANNELS), ON for any 2..8, OFF never. */
+static int choose_axes(const nrrd_hdr *h, uint32_t channels_mode, int axes[3], int *nax, uint32_t dims[3],
+                       uint64_t *block_count, uint32_t *components, uint32_t *channels, const char *path, vxl_err *e)
 {
     int ns = 0;
     *components = 1;
+    *channels = 0;
     for (int i = 0; i < h->dimension; i++) {
         int nonspatial = (h->nkinds && h->component_kind[i]) || (h->ndirs && h->dir_none[i]);
         int last = i == h->dimension - 1;
         if (nonspatial && h->sizes[i] == 1) continue;
-        if (nonspatial && i == 0 && !last && (h->sizes[0] == 3 || h->sizes[0] == 4)) {
+        const int colour = h->sizes[0] == 3 || h->sizes[0] == 4;
+        if (nonspatial && i == 0 && !last && channels_mode != VXL_CHANNELS_OFF && h->sizes[0] >= 2 &&
+            h->sizes[0] <= VXL_MAX_CHANNELS && (!colour || channels_mode == VXL_CHANNELS_ON)) {
+            *channels = (uint32_t)h->sizes[0];
+            continue;
+        }
+        if (nonspatial && i == 0 && !last && colour) {
             *components = (uint32_t)h->sizes[0];
             continue;
         }
@@ -349,7 +360,7 @@ static int choose_axes(const nrrd_hdr *h, int axes[3], int *nax, uint32_t dims[3
             if (last) continue; /* only its first index is read */
             return vxl_fail(e, VXL_ERR_FORMAT,
                             nonspatial ? "'%s': NRRD axis %d is not spatial (size %llu; only a fastest axis of 3 or "
-                                         "4 colour components is supported)"
+                                         "4 colour components or 2 to 8 channels is supported)"
                                        : "'%s': NRRD axis %d: more than 3 spatial axes (size %llu)",
                             path, i, (unsigned long long)h->sizes[i]);
         }
@@ -452,11 +463,15 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
     uint64_t block = 0, nbytes = 0, offset = 0, skip_after = 0;
     const char *dpath = path;
     int stream = 0;
-    uint32_t components = 1;
-    if (!rc) rc = choose_axes(&h, axes, &nax, dims, &block, &components, path, e);
+    uint32_t components = 1, channels = 0, channels_mode = 0, scalar_channel = 0;
+    if (!rc) rc = vxl_load_channels_mode(opt, &channels_mode, &scalar_channel, e);
+    if (!rc) rc = choose_axes(&h, channels_mode, axes, &nax, dims, &block, &components, &channels, path, e);
     /* gzip data, attached or detached, streams through a bricked cache that inflates from its start;
-     * colour is read whole (colour_volume.h) */
-    if (!rc && components > 1) rc = vxl_plan_colour_voxels(path, dims, h.dtype, components, opt, &nbytes, e);
+     * colour and channels are read whole (colour_volume.h, channel_volume.h) */
+    if (!rc && channels) {
+        rc = vxl_plan_channel_voxels(path, dims, h.dtype, channels, opt, &nbytes, e);
+        nbytes *= channels; /* interleaved: every channel's samples */
+    } else if (!rc && components > 1) rc = vxl_plan_colour_voxels(path, dims, h.dtype, components, opt, &nbytes, e);
     else if (!rc) rc = vxl_stream_plan(path, dims, h.dtype, opt, NULL, &stream, &nbytes, e);
     if (!rc && h.data_file) {
         data_path = vxl_sibling_path(path, h.data_file);
@@ -522,7 +537,10 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
         rc = geometry(&h, axes, nax, sp, A, path, e);
         if (!rc) {
             vxl_err inner = {0};
-            if (components > 1)
+            if (channels)
+                rc = vxl_volume_build_channels(raw, h.dtype, channels, 1, dims, sp, A, 0.0, 0.0, opt,
+                                               "NRRD channel axis", out, &inner);
+            else if (components > 1)
                 rc = vxl_volume_build_colour(raw, h.dtype, components, 0, dims, sp, A, 0.0, 0.0, opt,
                                              components == 3 ? "NRRD RGB" : "NRRD RGBA", out, &inner);
             else
@@ -531,6 +549,8 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
             else (*out)->affine_source = h.ndirs ? 2 : 0;
             if (!rc && components > 1 && vxl_load_streaming(opt) == VXL_STREAMING_ON)
                 vxl_volume_note(*out, "read whole: a colour volume does not stream");
+            if (!rc && channels && vxl_load_streaming(opt) == VXL_STREAMING_ON)
+                vxl_volume_note(*out, "read whole: a multi-channel volume does not stream");
         }
     }
     free(raw);

@@ -174,6 +174,9 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     int rc = vxl_colour_flags(&r->colour, f, &colour_flags); /* a colour volume's own colour */
     if (rc) return rc;
     flags |= colour_flags;
+    uint32_t channel_flags;
+    if ((rc = vxl_channels_flags(&r->channels, f, &channel_flags))) return rc; /* a multi-channel volume's channels */
+    flags |= channel_flags;
     if (f->shading && f->env.on) flags |= VXL_FLAG_ENVIRONMENT; /* the World's light */
     uint32_t filter = vxl_frame_filter(f);
     const int path = f->shading && f->shading_model == VXL_SHADING_PATH; /* render/path.c's tracer */
@@ -189,7 +192,10 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     vxl_upload_tf(r, f);
     if (f->scene_depth) upload_scene_depth(r, f);
     /* bricked storage derives its resident set from the skipping grid */
-    if ((f->skip || path || r->storage.ops->needs_occupancy) && (rc = vxl_skipping_prepare(&r->skipping, f))) return rc;
+    /* drawn channels skip by their own union map (channels.c), not the scalar's */
+    if (((f->skip && !f->channels.on) || path || r->storage.ops->needs_occupancy) &&
+        (rc = vxl_skipping_prepare(&r->skipping, f)))
+        return rc;
     if ((rc = r->storage.ops->prepare(&r->storage, f))) return rc;
     if ((rc = vxl_classification_prepare(&r->classification, f))) return rc;
     if ((rc = vxl_illumination_prepare(&r->illumination, f))) return rc; /* shadows, occlusion (issue 17) */
@@ -203,6 +209,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     if (path && (rc = vxl_path_bind(&r->path, f, prog))) return rc;
     if ((rc = vxl_labels_prepare(&r->labels, f, prog, r->storage.geom.affine))) return rc; /* issue 20 */
     if ((rc = vxl_overlays_prepare(&r->overlays, f, prog))) return rc; /* issue 20 */
+    if ((rc = vxl_channels_prepare(&r->channels, f, prog))) return rc;
     if ((rc = vxl_modes_bind(&r->modes, f, prog)) || (rc = vxl_matcap_prepare(&r->matcap, f, prog))) return rc; /* issue 19 */
     vxl_uniform_i(&r->gpu, prog, "u_skip", f->skip);
     vxl_uniform_i(&r->gpu, prog, "u_brick_size", (int)(r->skipping.bricks.size ? r->skipping.bricks.size : VXL_DEFAULT_BRICK));
@@ -263,6 +270,11 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
         r->stats.bricks_total = r->skipping.bricks.dims[0] * r->skipping.bricks.dims[1] * r->skipping.bricks.dims[2];
         r->stats.bricks_occupied = r->skipping.bricks.occupied;
         r->stats.brick_size = r->skipping.bricks.size;
+        if (f->channels.on) { /* the drawn channels' union */
+            r->stats.bricks_total = r->channels.bricks_total;
+            r->stats.bricks_occupied = r->channels.occupied;
+            r->stats.brick_size = r->channels.bricks[0].size;
+        }
     }
     r->stats.storage = r->storage.mode;
     r->stats.resident_bytes = r->storage.ops->resident_bytes(&r->storage);
@@ -284,6 +296,7 @@ static int job_render(void *p)
     const vxl_volume_geom *ov_geoms[VXL_MAX_OVERLAYS];
     vxl_overlays_geoms(&r->overlays, ov_geoms);
     rc = vxl_frame_resolve_overlays(&f, j->p, ov_geoms, &g, &r->gpu.err); /* issue 20 */
+    if (!rc) rc = vxl_frame_resolve_channels(&f, j->p, r->channels.geom, r->channels.count, &r->gpu.err);
     if (!rc) rc = draw(r, &f, j->rgba, j->depth);
     vxl_frame_free(&f);
     return rc;

@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "classification.h"
+#include "channels.h"
 #include "colour.h"
 #include "context.h"
 #include "cutaway.h"
@@ -49,6 +50,7 @@ struct vxl_renderer {
     vxl_overlays_state overlays;             /* overlays.h: issue 20 overlay volumes */
     vxl_colour_state colour;                 /* colour.h: a colour volume's own colour (RGB8) */
     vxl_path_state path;                     /* path.h: the PATH model's majorant grid */
+    vxl_channels_state channels;             /* channels.h: a multi-channel volume's channels (16-bit, dense) */
 
     GLuint vao, fbo, color_tex, depth_tex, scene_depth_tex, tf_tex;
     uint32_t fb_w, fb_h;

@@ -12,6 +12,8 @@ int vxl_volume_downsample2(const vxl_volume *v, vxl_volume **out, vxl_err *e)
     if (!d) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for a coarser level");
     *d = *v;
     d->colour = NULL; /* a coarser level is of the scalar: the colour texture stays at full resolution */
+    d->channels = NULL; /* and so are a multi-channel volume's channels */
+    d->channel_count = 0;
     for (int a = 0; a < 3; a++) {
         d->dims[a] = (v->dims[a] + 1) / 2;
         d->spacing[a] = v->spacing[a] * 2;

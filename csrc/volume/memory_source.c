@@ -94,6 +94,8 @@ int vxl_volume_stream_copy(const vxl_volume *whole, uint32_t n_levels, vxl_volum
     v->texels = NULL;
     v->source = NULL;
     v->colour = NULL;
+    v->channels = NULL; /* channels do not stream: the copy is of the scalar (docs/channels.md) */
+    v->channel_count = 0;
     /* a colour volume streams its scalar; its colour stays whole in memory */
     const size_t colour_bytes = whole->colour ? (size_t)vxl_volume_colour_bytes(whole) : 0;
     if (colour_bytes && !(v->colour = malloc(colour_bytes))) {

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "channel_volume.h"
 #include "colour_volume.h"
 #include "voxlight_dev.h" /* vxl_volume_add_note */
 
@@ -275,10 +276,28 @@ void vxl_volume_set_values(vxl_volume *v, const vxl_texel_map *m)
 int vxl_volume_create(const vxl_volume_desc *d, const vxl_load_options *opt, vxl_volume **out)
 {
     if (!d) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "volume description is NULL");
-    uint32_t components = 1;
+    uint32_t components = 1, channels = 1, interleaved = 0;
     if (d->struct_size == 0 || d->struct_size >= offsetof(vxl_volume_desc, reserved) + sizeof d->reserved) {
         if (d->reserved) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "desc.reserved is %u: it must be 0", d->reserved);
         components = d->components ? d->components : 1;
+    }
+    if (d->struct_size == 0 ||
+        d->struct_size >= offsetof(vxl_volume_desc, channels_interleaved) + sizeof d->channels_interleaved) {
+        channels = d->channels ? d->channels : 1;
+        interleaved = d->channels_interleaved;
+    }
+    if (channels != 1) {
+        if (out) *out = NULL;
+        if (components != 1)
+            return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT,
+                            "desc.channels %u with desc.components %u: a volume is colour or multi-channel, not both",
+                            channels, components);
+        if (interleaved > 1)
+            return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "desc.channels_interleaved is %u: 0 (planar) or 1",
+                            interleaved);
+        return vxl_volume_build_channels(d->data, d->dtype, channels, (int)interleaved, d->dims, d->spacing,
+                                         d->has_affine ? d->affine : NULL, d->scl_slope, d->scl_inter, opt, NULL, out,
+                                         NULL);
     }
     if (components != 1) {
         if (out) *out = NULL;
@@ -336,6 +355,15 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
     if (v->colour) {
         o->opacity_source = v->opacity_source;
         o->color_bytes = vxl_volume_colour_bytes(v);
+    }
+    if (v->channels) {
+        o->channel_count = v->channel_count;
+        o->scalar_channel = v->scalar_channel;
+        for (uint32_t c = 0; c < v->channel_count; c++) {
+            o->channel_min[c] = v->ch_min[c];
+            o->channel_max[c] = v->ch_max[c];
+        }
+        o->channel_bytes = vxl_volume_channel_bytes(v);
     }
     memcpy(out, o, have);
     return VXL_OK;
@@ -416,6 +444,7 @@ void vxl_volume_destroy(vxl_volume *v)
     if (!v) return;
     vxl_brick_source_free(v->source);
     free(v->colour);
+    free(v->channels);
     free(v->texels);
     free(v);
 }

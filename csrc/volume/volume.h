@@ -46,6 +46,16 @@ struct vxl_volume {
     uint8_t *colour;
     uint32_t components;     /* 1 grey (0 is read as 1), 3 RGB, 4 RGBA: what the source held */
     uint32_t opacity_source; /* VXL_OPACITY_SOURCE_* the texels came from (colour volumes) */
+    /* A multi-channel volume (channel_volume.h): channel_count scalars on the
+     * grid as 16-bit normalised texels, packed four to a texel in groups
+     * (group g at channels + 4 * g * n_voxels holds min(4, count - 4g)
+     * channels interleaved, x fastest), always whole in memory; NULL and 0
+     * otherwise. The texels above are channel scalar_channel's. */
+    uint16_t *channels;
+    uint32_t channel_count;
+    uint32_t scalar_channel;
+    double ch_tex_lo[VXL_MAX_CHANNELS], ch_tex_hi[VXL_MAX_CHANNELS]; /* data = lo + t (hi - lo) per channel */
+    double ch_min[VXL_MAX_CHANNELS], ch_max[VXL_MAX_CHANNELS];       /* finite data range per channel */
 };
 
 /* Appends one note (printf format) to v->notes, "; "-separated; cut with

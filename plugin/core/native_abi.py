@@ -84,7 +84,9 @@ class LoadOptions(ctypes.Structure):
                 ("progress", PROGRESS_CALLBACK),
                 ("progress_user", ctypes.c_void_p),
                 ("opacity_source", ctypes.c_uint32),   # appended: a colour volume's scalar
-                ("opacity_channel", ctypes.c_uint32)]
+                ("opacity_channel", ctypes.c_uint32),
+                ("channels", ctypes.c_uint32),         # appended: multi-channel volumes (VXL_CHANNELS_*)
+                ("scalar_channel", ctypes.c_uint32)]
 
 
 class DicomSeries(ctypes.Structure):
@@ -111,7 +113,9 @@ class VolumeDesc(ctypes.Structure):
                 ("scl_slope", ctypes.c_double),
                 ("scl_inter", ctypes.c_double),
                 ("components", ctypes.c_uint32),       # appended: 3 RGB, 4 RGBA, interleaved
-                ("reserved", ctypes.c_uint32)]
+                ("reserved", ctypes.c_uint32),
+                ("channels", ctypes.c_uint32),         # appended: 2..8 channels on the grid
+                ("channels_interleaved", ctypes.c_uint32)]
 
 
 class VolumeInfo(ctypes.Structure):
@@ -137,7 +141,12 @@ class VolumeInfo(ctypes.Structure):
                 ("notes", ctypes.c_char * NOTES_MAX),  # appended: what the reader decided
                 ("components", ctypes.c_uint32),       # appended: 1 grey, 3 RGB, 4 RGBA
                 ("opacity_source", ctypes.c_uint32),
-                ("color_bytes", ctypes.c_uint64)]
+                ("color_bytes", ctypes.c_uint64),
+                ("channel_count", ctypes.c_uint32),    # appended: multi-channel volumes
+                ("scalar_channel", ctypes.c_uint32),
+                ("channel_min", ctypes.c_double * 8),
+                ("channel_max", ctypes.c_double * 8),
+                ("channel_bytes", ctypes.c_uint64)]
 
 
 class PhantomDesc(ctypes.Structure):
@@ -298,6 +307,23 @@ class OverlayStyle(ctypes.Structure):
                 ("reserved", ctypes.c_uint32)]
 
 
+class ChannelStyle(ctypes.Structure):
+    _fields_ = [("struct_size", ctypes.c_uint32),
+                ("channel", ctypes.c_uint32),
+                ("hidden", ctypes.c_uint32),
+                ("solo", ctypes.c_uint32),
+                ("has_color", ctypes.c_uint32),
+                ("color", ctypes.c_float * 3),
+                ("has_window", ctypes.c_uint32),
+                ("window_low", ctypes.c_float),
+                ("window_high", ctypes.c_float),
+                ("preset", ctypes.c_uint32),
+                ("tf_size", ctypes.c_uint32),
+                ("tf_rgba", ctypes.POINTER(ctypes.c_float)),
+                ("opacity_scale", ctypes.c_float),
+                ("reserved", ctypes.c_uint32)]
+
+
 class RenderParams(ctypes.Structure):
     _fields_ = [("struct_size", ctypes.c_uint32),
                 ("width", ctypes.c_uint32),
@@ -366,7 +392,10 @@ class RenderParams(ctypes.Structure):
                 ("path_samples", ctypes.c_uint32),       # appended: the path shading model
                 ("path_sample_offset", ctypes.c_uint32),
                 ("path_bounces", ctypes.c_uint32),
-                ("path_seed", ctypes.c_uint32)]
+                ("path_seed", ctypes.c_uint32),
+                ("channel_count", ctypes.c_uint32),      # appended: multi-channel volumes
+                ("channel_blend", ctypes.c_uint32),
+                ("channels", ctypes.POINTER(ChannelStyle))]
 
 
 class RenderStats(ctypes.Structure):

@@ -3,7 +3,8 @@
 // CLASSIFY_PRE / CLASSIFY_PREINT (lib/classify.glsl; post-classification otherwise),
 // GOPACITY 1 (boundary) / 2 (iso-surface): Levoy's gradient-magnitude opacity,
 // DATA_COLOUR: a colour volume's colour replaces the table's (lib/colour.glsl),
-// SHADING_MODEL 1 (shadowed) / 2 (scatter): lib/shading.glsl's shade_lit.
+// SHADING_MODEL 1 (shadowed) / 2 (scatter): lib/shading.glsl's shade_lit,
+// CHANNEL_GROUPS: a multi-channel volume's channels in one march (lib/channels.glsl).
 #include "lib/gradients.glsl"
 #include "lib/classify.glsl"
 #include "lib/colour.glsl" // DATA_COLOUR: a colour volume's own colour
@@ -278,6 +279,10 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
 #endif
 #ifdef OVERLAYS
 #define march overlay_march // issue 20: several volumes in one march
+#endif
+#include "lib/channels.glsl" // CHANNEL_GROUPS: every channel of a multi-channel volume in one march
+#ifdef CHANNEL_GROUPS
+#define march channel_march
 #endif
 
 void main()

@@ -35,6 +35,7 @@ BINDINGS = {
     "vxl_label_entry": native.LabelEntry,
     "vxl_label_style": native.LabelStyle,
     "vxl_overlay_style": native.OverlayStyle,
+    "vxl_channel_style": native.native_abi.ChannelStyle,
     "vxl_cutter": native.Cutter,
     "vxl_cutaway": native.Cutaway,
     "vxl_matcap": native.Matcap,

@@ -378,7 +378,8 @@ def test_render_params_tail_matches_header():
     # model's four words (samples, offset, bounces, seed), ending on the alignment
     assert P.color_source.offset == 720 and P.environment.offset == 728
     assert P.path_samples.offset == 736 and P.path_seed.offset == 748
-    assert ctypes.sizeof(P) == 752
+    assert P.channel_count.offset == 752 and P.channels.offset == 760
+    assert ctypes.sizeof(P) == 768
     assert P.labels.offset == P.reserved.offset + 4 * native.RENDER_PARAMS_RESERVED
     assert P.preint_size.offset == P.no_skip.offset + 4
     names = [n for n, _t in P._fields_]

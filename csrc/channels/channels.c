@@ -1,0 +1,286 @@
+/* channels.c - a multi-channel volume's channels on the GL side (channels.h). */
+#include "channels.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "channel_volume.h"
+#include "hash.h"
+#include "holdings.h"
+#include "paging.h"
+
+void vxl_channels_init(vxl_channels_state *s, vxl_gpu *g)
+{
+    s->gpu = g;
+    vxl_holding_register(g, VXL_HOLD_CHANNELS, vxl_holding_counter, &s->bytes);
+}
+
+static void recount(vxl_channels_state *s) { s->bytes = s->volume_bytes + s->tf_bytes + s->distance_bytes; }
+
+static void delete_tex(vxl_gpu *g, GLuint *t)
+{
+    if (*t) g->gl.DeleteTextures(1, t);
+    *t = 0;
+}
+
+void vxl_channels_release(vxl_channels_state *s)
+{
+    for (uint32_t g = 0; g < VXL_CHANNEL_GROUPS_MAX; g++) delete_tex(s->gpu, &s->tex[g]);
+    for (uint32_t c = 0; c < VXL_MAX_CHANNELS; c++) {
+        delete_tex(s->gpu, &s->tf_tex[c]);
+        vxl_bricks_free(&s->bricks[c]);
+    }
+    delete_tex(s->gpu, &s->distance_tex);
+    vxl_gpu *g = s->gpu;
+    const uint64_t uploads = s->uploads;
+    memset(s, 0, sizeof *s);
+    s->gpu = g;
+    s->uploads = uploads;
+}
+
+int vxl_channels_plan(vxl_channels_state *s, const vxl_volume *v, uint32_t storage_mode, uint64_t storage_bytes)
+{
+    /* paged storage holds the scalar only: drawing channels is refused then */
+    if (!v->channels || storage_mode != VXL_STORAGE_DENSE) return VXL_OK;
+    vxl_gpu *g = s->gpu;
+    for (int a = 0; a < 3; a++)
+        if (v->dims[a] > (uint32_t)g->info.max_3d_texture_size)
+            return vxl_fail(&g->err, VXL_ERR_LIMIT,
+                            "the channels of a %ux%ux%u volume are 3D textures and exceed this backend's limit of %d "
+                            "per axis (crop it)",
+                            v->dims[0], v->dims[1], v->dims[2], g->info.max_3d_texture_size);
+    /* a new volume releases everything derived from the old one: only what
+     * it keeps (labels, overlays, the MatCap, cutters, shadow maps) stays */
+    uint64_t held[VXL_HOLD_COUNT];
+    vxl_holdings(g, held);
+    held[VXL_HOLD_GRADIENTS] = held[VXL_HOLD_BSPLINE] = held[VXL_HOLD_CLASSIFIED] = 0;
+    held[VXL_HOLD_ILLUMINATION] = held[VXL_HOLD_MODE_BRICKS] = held[VXL_HOLD_COLOUR] = 0;
+    return vxl_budget_ask(g->budget, held, VXL_HOLD_CHANNELS, vxl_volume_channel_bytes(v) + storage_bytes, &g->err,
+                          " (a multi-channel volume's channels are stored densely, 2 bytes a channel a voxel, beside "
+                          "its scalar)",
+                          "the %ux%ux%u volume's %u channels", v->dims[0], v->dims[1], v->dims[2], v->channel_count);
+}
+
+/* Channel c of v alone as a 16-bit volume, for the brick min-max grid. */
+static int channel_minmax(vxl_gpu *g, const vxl_volume *v, uint32_t c, vxl_bricks *out)
+{
+    const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
+    vxl_volume one;
+    memset(&one, 0, sizeof one);
+    memcpy(one.dims, v->dims, sizeof one.dims);
+    one.texture_bits = 16;
+    one.storage_bytes = n * 2;
+    uint16_t *t = malloc((size_t)(n * 2));
+    if (!t) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for channel %u's brick min-max", c);
+    const uint32_t grp = c / VXL_CHANNELS_PER_GROUP, w = vxl_channel_group_width(v, grp);
+    const uint16_t *src = vxl_channel_group(v, grp) + c % VXL_CHANNELS_PER_GROUP;
+    for (uint64_t i = 0; i < n; i++) t[i] = src[i * w];
+    one.texels = t;
+    memset(out, 0, sizeof *out);
+    int rc = vxl_bricks_minmax_cpu(out, &one, vxl_skip_brick_size(), &g->err);
+    free(t);
+    return rc;
+}
+
+static const GLenum group_formats[4] = {GL_R16, GL_RG16, GL_RGB16, GL_RGBA16};
+static const GLenum group_layouts[4] = {GL_RED, GL_RG, GL_RGB, GL_RGBA};
+
+int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, uint32_t storage_mode)
+{
+    vxl_channels_release(s);
+    if (!v || !v->channels) return VXL_OK;
+    vxl_gpu *g = s->gpu;
+    vxl_gl *gl = &g->gl;
+    s->count = v->channel_count;
+    s->storage_mode = storage_mode;
+    for (uint32_t c = 0; c < v->channel_count; c++) {
+        s->geom[c] = vxl_volume_geom_of(v);
+        s->geom[c].tex_lo = v->ch_tex_lo[c];
+        s->geom[c].tex_hi = v->ch_tex_hi[c];
+        s->geom[c].value_min = v->ch_min[c];
+        s->geom[c].value_max = v->ch_max[c];
+    }
+    if (storage_mode != VXL_STORAGE_DENSE) return VXL_OK; /* the scalar alone (vxl_channels_flags says why) */
+    int rc = VXL_OK;
+    for (uint32_t c = 0; c < v->channel_count && !rc; c++) rc = channel_minmax(g, v, c, &s->bricks[c]);
+    s->groups = vxl_channel_groups(v);
+    gl->GetError();
+    for (uint32_t grp = 0; grp < s->groups && !rc; grp++) {
+        const uint32_t w = vxl_channel_group_width(v, grp);
+        /* filtered as the scalar is: trilinear between voxel centres */
+        s->tex[grp] = vxl_texture_new(g, GL_TEXTURE_3D, GL_LINEAR);
+        gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)group_formats[w - 1], (GLsizei)v->dims[0], (GLsizei)v->dims[1],
+                       (GLsizei)v->dims[2], 0, group_layouts[w - 1], GL_UNSIGNED_SHORT, vxl_channel_group(v, grp));
+        rc = vxl_gl_check(g, "uploading a multi-channel volume's channels");
+    }
+    if (rc) {
+        vxl_channels_release(s);
+        return rc;
+    }
+    s->volume_bytes = vxl_volume_channel_bytes(v);
+    recount(s);
+    s->uploads++;
+    return VXL_OK;
+}
+
+int vxl_channels_flags(const vxl_channels_state *s, const vxl_frame *f, uint32_t *flags)
+{
+    *flags = 0;
+    if (!f->channels.on) return VXL_OK;
+    if (!s->count)
+        return vxl_fail(&s->gpu->err, VXL_ERR_STATE,
+                        "params.channels lists %u channels, but the volume has none (it is not multi-channel)",
+                        f->channels.listed);
+    if (s->storage_mode != VXL_STORAGE_DENSE)
+        return vxl_fail(&s->gpu->err, VXL_ERR_INVALID_ARGUMENT,
+                        "drawing channels needs dense storage: this renderer holds the volume in %s storage, which "
+                        "cannot page, compress or stream its %u channels yet (create the renderer with storage dense)",
+                        vxl_storage_name(s->storage_mode) ? vxl_storage_name(s->storage_mode) : "paged", s->count);
+    for (uint32_t k = 0; k < f->channels.count; k++)
+        if (f->channels.ch[k].channel >= s->count)
+            return vxl_fail(&s->gpu->err, VXL_ERR_STATE, "params.channels names channel %u: the volume has channels 0..%u",
+                            f->channels.ch[k].channel, s->count - 1);
+    *flags = s->groups << VXL_FLAG_CHANNELS_SHIFT;
+    return VXL_OK;
+}
+
+/* Channel c's table on its texture, when its key changed. */
+static int ensure_tf(vxl_channels_state *s, const vxl_frame_channel *ch)
+{
+    const uint32_t c = ch->channel;
+    if (s->tf_tex[c] && s->tf_key[c] == ch->key) return VXL_OK;
+    vxl_gpu *g = s->gpu;
+    const uint64_t bytes = (uint64_t)ch->tf_size * 4 * sizeof(float);
+    int rc = vxl_holdings_ask(g, VXL_HOLD_CHANNELS, s->bytes - s->tf_entry_bytes[c] + bytes, NULL,
+                              "channel %u's transfer function", c);
+    if (rc) return rc;
+    vxl_gl *gl = &g->gl;
+    gl->GetError();
+    if (!s->tf_tex[c]) s->tf_tex[c] = vxl_texture_new(g, GL_TEXTURE_1D, GL_LINEAR);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
+    gl->BindTexture(GL_TEXTURE_1D, s->tf_tex[c]);
+    gl->TexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, (GLsizei)ch->tf_size, 0, GL_RGBA, GL_FLOAT, ch->tf);
+    rc = vxl_gl_check(g, "uploading a channel's transfer function");
+    if (rc) delete_tex(g, &s->tf_tex[c]);
+    /* on an error the next frame uploads again */
+    s->tf_key[c] = rc ? 0 : ch->key;
+    s->tf_entry_bytes[c] = rc ? 0 : bytes;
+    s->tf_bytes = 0;
+    for (uint32_t k = 0; k < VXL_MAX_CHANNELS; k++) s->tf_bytes += s->tf_entry_bytes[k];
+    recount(s);
+    return rc;
+}
+
+/* The drawn channels' union occupancy as one distance map, when a drawn
+ * channel's classification or the drawn set changed. */
+static int ensure_distance(vxl_channels_state *s, const vxl_frame *f)
+{
+    vxl_gpu *g = s->gpu;
+    uint64_t key = 0xcbf29ce484222325ull;
+    for (uint32_t k = 0; k < f->channels.count; k++) {
+        const vxl_frame_channel *ch = &f->channels.ch[k];
+        const vxl_occupancy_rule rule = {.table_key = ch->key,
+                                         .tf = ch->tf,
+                                         .tf_size = ch->tf_size,
+                                         .window_offset = ch->window_offset,
+                                         .window_scale = ch->window_scale,
+                                         .opacity_scale = ch->opacity_scale,
+                                         .filter = VXL_FILTER_CENTRAL,
+                                         .sample_distance = 1.0f};
+        if (vxl_bricks_classify(&s->bricks[ch->channel], &rule) < 0)
+            return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for channel %u's brick occupancy", ch->channel);
+        const uint64_t part[2] = {ch->channel, s->bricks[ch->channel].tf_key};
+        key = vxl_fnv(key, part, sizeof part);
+    }
+    if (s->distance_tex && s->distance_key == key) return VXL_OK;
+    const vxl_bricks *b0 = &s->bricks[0];
+    const size_t n = (size_t)b0->dims[0] * b0->dims[1] * b0->dims[2];
+    int rc = VXL_OK;
+    if (!s->distance_tex &&
+        (rc = vxl_holdings_ask(g, VXL_HOLD_CHANNELS, s->bytes + n, NULL, "the channels' brick distance map")))
+        return rc;
+    uint8_t *d = malloc(n ? n : 1);
+    if (!d) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the channels' brick distance map");
+    memset(d, 255, n);
+    for (uint32_t k = 0; k < f->channels.count; k++) {
+        const uint8_t *dc = s->bricks[f->channels.ch[k].channel].distance;
+        for (size_t i = 0; i < n; i++)
+            if (dc[i] == 0) d[i] = 0;
+    }
+    uint32_t occupied = 0;
+    for (size_t i = 0; i < n; i++) occupied += d[i] == 0;
+    if (vxl_bricks_chebyshev(d, b0->dims) < 0) {
+        free(d);
+        return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the channels' brick distance map");
+    }
+    vxl_gl *gl = &g->gl;
+    gl->GetError();
+    if (!s->distance_tex) s->distance_tex = vxl_texture_new(g, GL_TEXTURE_3D, GL_NEAREST);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, s->distance_tex);
+    gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl->TexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, (GLsizei)b0->dims[0], (GLsizei)b0->dims[1], (GLsizei)b0->dims[2], 0,
+                   GL_RED_INTEGER, GL_UNSIGNED_BYTE, d);
+    free(d);
+    rc = vxl_gl_check(g, "uploading the channels' brick distance map");
+    if (rc) {
+        delete_tex(g, &s->distance_tex);
+        s->distance_key = 0;
+        s->distance_bytes = 0;
+        recount(s);
+        return rc;
+    }
+    s->distance_key = key;
+    s->distance_bytes = n;
+    s->occupied = occupied;
+    s->bricks_total = (uint32_t)n;
+    recount(s);
+    return VXL_OK;
+}
+
+static GLint loc_k(vxl_gl *gl, GLuint prog, const char *name, uint32_t k)
+{
+    char buf[64];
+    snprintf(buf, sizeof buf, "%s[%u]", name, k);
+    return gl->GetUniformLocation(prog, buf);
+}
+
+int vxl_channels_prepare(vxl_channels_state *s, const vxl_frame *f, GLuint prog)
+{
+    if (!f->channels.on) return VXL_OK;
+    int rc;
+    for (uint32_t k = 0; k < f->channels.count; k++)
+        if ((rc = ensure_tf(s, &f->channels.ch[k]))) return rc;
+    if (f->skip && (rc = ensure_distance(s, f))) return rc;
+    vxl_gl *gl = &s->gpu->gl;
+    for (uint32_t grp = 0; grp < s->groups; grp++) {
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_CHANNEL_DATA_UNIT + grp);
+        gl->BindTexture(GL_TEXTURE_3D, s->tex[grp]);
+    }
+    vxl_uniform_i(s->gpu, prog, "u_ch_data0", VXL_CHANNEL_DATA_UNIT);
+    vxl_uniform_i(s->gpu, prog, "u_ch_data1", VXL_CHANNEL_DATA_UNIT + 1);
+    gl->ActiveTexture(GL_TEXTURE0 + VXL_CHANNEL_DISTANCE_UNIT);
+    gl->BindTexture(GL_TEXTURE_3D, s->distance_tex); /* 0 when skipping is off: never read then */
+    vxl_uniform_i(s->gpu, prog, "u_ch_distance", VXL_CHANNEL_DISTANCE_UNIT);
+    vxl_uniform_i(s->gpu, prog, "u_ch_brick_size", (int)(s->bricks[0].size ? s->bricks[0].size : VXL_DEFAULT_BRICK));
+    vxl_uniform_i(s->gpu, prog, "u_ch_blend", (int)f->channels.blend);
+    int drawn = 0;
+    const uint32_t slots = s->groups * VXL_CHANNELS_PER_GROUP;
+    /* every sampler gets its own unit even when unread: samplers of
+     * different types on one unit fail the draw */
+    for (uint32_t c = 0; c < slots; c++) gl->Uniform1i(loc_k(gl, prog, "u_ch_tf", c), (GLint)(VXL_CHANNEL_TF_UNIT + c));
+    for (uint32_t k = 0; k < f->channels.count; k++) {
+        const vxl_frame_channel *ch = &f->channels.ch[k];
+        const uint32_t c = ch->channel;
+        drawn |= 1 << c;
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_CHANNEL_TF_UNIT + c);
+        gl->BindTexture(GL_TEXTURE_1D, s->tf_tex[c]);
+        const float cls[4] = {ch->window_offset, ch->window_scale, (float)ch->tf_size, ch->opacity_scale};
+        gl->Uniform4fv(loc_k(gl, prog, "u_ch_class", c), 1, cls);
+        gl->Uniform3fv(loc_k(gl, prog, "u_ch_color", c), 1, ch->color);
+    }
+    vxl_uniform_i(s->gpu, prog, "u_ch_drawn", drawn);
+    return VXL_OK;
+}

@@ -1,0 +1,138 @@
+"""Multi-channel volumes in the CLI (docs/channels.md), on a NIfTI whose
+dim[5] holds two uint16 channels (header written here): `info` lists the
+channels and the reader's note; `--channels 0,1` draws both in one pass and
+its image is the sum of `--channels 0` and `--channels 1` (numpy, within the
+8-bit PNG's rounding); hiding a channel (leaving it out) removes exactly its
+blob; `--channel-window` changes only its channel's pixels; `--channel N`
+renders channel N alone as a one-channel file of it; bad values are clean
+errors."""
+import struct
+
+import numpy as np
+import pytest
+
+from test_cli import assert_clean_error, png_rgba, run, write_nifti
+
+N = 20
+VIEW = ["--size", "%dx%d" % (N, N), "--ortho", "--no-jitter", "--no-shading", "--view", "z"]
+
+
+def ball(cx, cy, cz, r, peak):
+    z, y, x = np.indices((N, N, N)).astype(float)
+    d = np.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2)
+    return np.where(d < r, peak * (1 - 0.5 * d / r), 0).astype(np.uint16)
+
+
+def write_channels_nifti(path, channels):
+    """NIfTI-1, dim = (5, N, N, N, 1, C): C uint16 (z, y, x) channels, one after the other."""
+    hdr = bytearray(348)
+    struct.pack_into("<i", hdr, 0, 348)
+    struct.pack_into("<8h", hdr, 40, 5, N, N, N, 1, len(channels), 1, 1)
+    struct.pack_into("<hh", hdr, 70, 512, 16)
+    struct.pack_into("<8f", hdr, 76, 1, 1, 1, 1, 1, 1, 1, 1)
+    struct.pack_into("<f", hdr, 108, 352.0)
+    hdr[344:348] = b"n+1\0"
+    path.write_bytes(bytes(hdr) + b"\0" * 4 + b"".join(c.astype("<u2").tobytes() for c in channels))
+
+
+@pytest.fixture
+def disjoint(tmp_path):
+    path = tmp_path / "two.nii"
+    write_channels_nifti(path, [ball(6, 10, 10, 4, 40000), ball(14, 10, 10, 4, 30000)])
+    return path
+
+
+@pytest.fixture
+def overlapping(tmp_path):
+    path = tmp_path / "over.nii"
+    write_channels_nifti(path, [ball(8, 10, 10, 5, 40000), ball(12, 10, 10, 5, 30000)])
+    return path
+
+
+def premultiplied(path, *args):
+    """The render as premultiplied floats in [0, 1] (the PNG holds straight alpha)."""
+    out = path.parent / ("out_%d.png" % (abs(hash(args)) % 100000))
+    res = run("render", path, "-o", out, *VIEW, *args)
+    assert res.returncode == 0, res.stderr
+    rgba = png_rgba(out).astype(float) / 255.0
+    rgba[..., :3] *= rgba[..., 3:4]
+    return rgba
+
+
+def test_info_lists_the_channels(disjoint):
+    res = run("info", disjoint)
+    assert res.returncode == 0, res.stderr
+    assert "channels:    2 (the scalar is channel 0" in res.stdout
+    assert "channel 0: 0 .. 40000" in res.stdout and "channel 1: 0 .. 30000" in res.stdout
+    assert "NIfTI dim[5]: 2 channels (channel 0 is the scalar)" in res.stdout
+    res = run("info", disjoint, "--channel-axis", "off")
+    assert "channels:" not in res.stdout and "frames:      2" in res.stdout
+
+
+def test_additive_composite_is_the_sum_of_the_channels(overlapping):
+    both = premultiplied(overlapping, "--channels", "0,1")
+    alone = [premultiplied(overlapping, "--channels", str(c)) for c in (0, 1)]
+    total = alone[0] + alone[1]
+    assert total[..., 3].max() < 1.0  # nothing clamped
+    assert (alone[0][..., 3] > 0).sum() > 10 and (alone[1][..., 3] > 0).sum() > 10
+    assert ((alone[0][..., 3] > 0) & (alone[1][..., 3] > 0)).sum() > 5  # they overlap
+    assert np.abs(both - total).max() <= 3.0 / 255.0
+    # the default colours: channel 0 red, channel 1 green
+    assert alone[0][..., 1:3].max() == 0 and alone[1][..., [0, 2]].max() == 0
+    assert np.array_equal(premultiplied(overlapping, "--channels", "all"), both)
+
+
+def test_hiding_a_channel_removes_exactly_its_blob(disjoint):
+    both = premultiplied(disjoint, "--channels", "0,1")
+    only0 = premultiplied(disjoint, "--channels", "0")
+    only1 = premultiplied(disjoint, "--channels", "1")
+    empty1 = only1[..., 3] == 0
+    assert np.array_equal(both[empty1], only0[empty1])
+    assert (only0[~empty1][..., 3] == 0).all() and (both[~empty1][..., 3] > 0).all()
+
+
+def test_a_channel_window_changes_only_that_channel(disjoint):
+    before = premultiplied(disjoint, "--channels", "0,1")
+    after = premultiplied(disjoint, "--channels", "0,1", "--channel-window", "1:0:15000",
+                          "--channel-color", "1:0,0.5,1")
+    only1 = premultiplied(disjoint, "--channels", "1", "--channel-window", "1:0:15000")
+    empty1 = only1[..., 3] == 0
+    assert np.array_equal(before[empty1], after[empty1])
+    assert (after[~empty1][..., 3] > before[~empty1][..., 3]).sum() > 10
+    assert after[~empty1][..., 2].max() > 0  # the new colour's blue
+
+
+def test_channel_n_renders_that_channel_alone(disjoint, tmp_path):
+    one = tmp_path / "one.nii"
+    write_nifti(one, ball(14, 10, 10, 4, 30000).astype(np.int16))
+    a = premultiplied(disjoint, "--channel", "1", "--preset", "gray")
+    b = premultiplied(one, "--preset", "gray")
+    assert np.array_equal(a, b) and a[..., 3].max() > 0
+
+
+def test_max_blend_renders(overlapping):
+    both = premultiplied(overlapping, "--channels", "0,1", "--channel-blend", "max")
+    assert both[..., 3].max() > 0
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--channels", "0,5"], ["channels 0..1"]),
+    (["--channels", "0,x"], ["--channels", "all or I,J"]),
+    (["--channels", "0", "--channel-color", "0:2,0,0"], ["--channel-color", "0..1"]),
+    (["--channels", "0", "--channel-window", "0:5:1"], ["--channel-window", "LO < HI"]),
+    (["--channel-color", "0:1,0,0"], ["need --channels"]),
+    (["--channels", "0", "--channel-window", "1:0:5"], ["does not draw"]),
+    (["--channels", "0", "--channel-blend", "over"], ["--channel-blend", "add or max"]),
+    (["--channel", "2"], ["scalar channel 2", "0..1"]),
+    (["--channels", "0,1", "--mode", "mip"], ["DVR"]),
+    (["--channels", "0,1", "--storage", "bricked"], ["dense storage"]),
+])
+def test_bad_channel_options_are_clean_errors(disjoint, tmp_path, args, words):
+    assert_clean_error(run("render", disjoint, "-o", tmp_path / "bad.png", *VIEW, *args), *words)
+
+
+def test_channels_of_a_volume_without_channels(tmp_path):
+    grey = tmp_path / "grey.nii"
+    write_nifti(grey, np.zeros((4, 4, 4), np.uint8))
+    assert_clean_error(run("render", grey, "-o", tmp_path / "g.png", "--channels", "all"), "no channels")
+    assert_clean_error(run("render", grey, "-o", tmp_path / "g.png", "--channel", "1"), "no channels")

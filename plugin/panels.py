@@ -215,8 +215,13 @@ class VOXLIGHT_PT_volume_lighting(_VolumePanel, bpy.types.Panel):
         col.prop(p, "occlusion_strength", text="Strength", slider=True)
         col.prop(p, "shadow_quality", text="Shadows")
         sub = layout.column()
-        sub.active = p.shading_model == "scatter"
+        sub.active = p.shading_model in ("scatter", "path")
         sub.prop(p, "anisotropy", slider=True)
+        if p.shading_model == "path":  # Monte Carlo: how many samples and bounces
+            col = layout.column(align=True)
+            col.prop(p, "path_samples", text="Samples")
+            col.prop(p, "path_viewport_samples", text="Viewport")
+            col.prop(p, "path_bounces", text="Bounces")
         # Scene shadows (issue 18): the volume and the scene's meshes.
         # Short texts: a checkbox's text shares the value column with the
         # checkbox (the tooltips keep the detail).

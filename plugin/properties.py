@@ -86,6 +86,8 @@ _SHADING_MODEL_UI = {
                              "and ambient occlusion in folds and crevices"),
     "scatter": ("Scatter", "Scatter: shadows, and light scattered through soft tissue where "
                            "there is no clear surface (Anisotropy sets its direction)"),
+    "path": ("Path", "Path: light scattered many times through the volume (Monte Carlo, as "
+                     "Cycles): the viewport refines sample by sample, F12 takes Samples"),
 }
 _BACKEND_UI = {
     "auto": ("Auto", "EGL on a GPU, then OSMesa, then EGL on Mesa"),
@@ -306,6 +308,17 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                                 default=lighting.DEFAULT_MODEL, update=tag_redraw,
                                 description="How light reaches each sample: local Phong, with "
                                             "shadows and occlusion, or with scattering too")
+    path_samples: IntProperty(name="Samples", default=64, min=1, max=65536, soft_max=1024,
+                              update=tag_redraw,
+                              description="Path: samples per pixel in F12; the viewport refines "
+                                          "up to Viewport Samples")
+    path_viewport_samples: IntProperty(name="Viewport Samples", default=16, min=1, max=65536,
+                                       soft_max=256, update=tag_redraw,
+                                       description="Path: samples the still viewport accumulates, "
+                                                   "one a redraw")
+    path_bounces: IntProperty(name="Bounces", default=4, min=1, max=64, update=tag_redraw,
+                              description="Path: how many times light may scatter on its way to "
+                                          "the eye (1 is single scattering)")
     occlusion_radius: FloatProperty(name="Occlusion Radius",
                                     default=lighting.DEFAULT_OCCLUSION_RADIUS, min=0.0, max=64.0,
                                     soft_max=16.0, update=tag_redraw,

@@ -60,7 +60,7 @@ from bpy.app.handlers import persistent
 from . import app_handlers, box_outline, gpu_quad, overlay_frames, params, scene_shadows, scene_shadows_viewport
 from .core import depth as _depth
 from .core import upsample as _upsample
-from .core import native, resolution_policy, runtime, volume_space
+from .core import native, path_progress, resolution_policy, runtime, volume_space
 
 _handle = None
 _shader = None
@@ -156,6 +156,10 @@ class _Image:
     level = 0
     made_at = 0.0
     stalled_since = None
+    # the path model: samples the image holds (0: not a path frame), and its
+    # colour kept for the next pass's running mean (core/path_progress.py)
+    path_samples = 0
+    rgba = None
 
     def __init__(self, key, rgba, vdepth, win_small, proj, full, scale=1.0, rect=None,
                  box=(0.0, 1e30, 0.0)):
@@ -221,11 +225,15 @@ class _State:
         self.job = None
         self.next_refine = None
 
-    def submit(self, entry, frame, full, owner):
-        """Queue `frame` on the entry's worker as this volume's refine job."""
+    def submit(self, entry, frame, full, owner, path_offset=None):
+        """Queue `frame` on the entry's worker as this volume's refine job;
+        path_offset: the path model's sample it renders (None: not a path
+        frame; 0 for the first)."""
         self.cancel_job()
         self.job = entry.worker.submit(runtime.Job(owner, frame.key, frame.params, frame.rect))
         self.job.full = full  # for busy_full(): the last, slowest refine step
+        self.job.path_offset = path_offset if path_offset is not None else \
+            (0 if getattr(frame, "path", False) else None)
         self.job_entry = entry
         self.announced = False
         _ensure_poll()
@@ -600,9 +608,23 @@ class _Frame:
         # Issue 21: never wait for a streamed volume's bricks here; what is
         # still loading is drawn coarser and refined later (_keep_refining).
         self.params.progressive = 1
+        # the path model: one sample a pass (offset set when queued), the
+        # passes accumulated while the view is still (_keep_refining)
+        self.path = self.params.shading_model == _path_model()
+        self.path_target = ob.voxlight.path_viewport_samples if self.path else 0
+        if self.path:
+            self.params.path_samples, self.params.path_sample_offset = 1, 0
         _profile.mark("params")
         self.key = native.params_digest(self.params, entry.identity)
         _profile.mark("digest")
+
+
+def _path_model():
+    """VXL_SHADING_PATH's number, or -1 with a library without it."""
+    try:
+        return native.load_library().index("shading_model", "path")
+    except (ValueError, KeyError, native.VoxlightError, native.LibraryUnavailable):
+        return -1
 
 
 def _size(W, H, frac):
@@ -884,12 +906,21 @@ def _refine_still(st, s, args, owner):
     if fr is not None and job.key == fr.key:
         if job.result is not None:
             rgba, vdepth, stats = job.result
+            offset = getattr(job, "path_offset", None)
+            if offset is not None:  # a path pass: the running mean of its samples
+                prev = st.full if fr is full and st.full is not None and st.full.key == fr.key else None
+                rgba = path_progress.accumulate(prev.rgba if prev is not None else None, rgba,
+                                                offset if prev is not None else 0)
             if _rect_pixels(fr.rect) > 0 and stats.get("seconds", 0.0) > 0.0:
                 st.refine_spp = stats["seconds"] / _rect_pixels(fr.rect)
             img = _Image(fr.key, rgba, vdepth, fr.win_small, args[5], fr is full, fr.scale, fr.rect,
                          fr.box)
             _note_streaming(img, stats, st.full if fr is full and st.full is not None
                             and st.full.key == fr.key else None)
+            if offset is not None:
+                img.rgba = rgba
+                img.path_samples = (offset + 1) if st.full is not None and fr is full \
+                    and st.full.key == fr.key else 1
             st.job = None
             if fr is full:
                 st.full = img
@@ -950,6 +981,15 @@ def _keep_refining(st, entry, full, owner):
     it once STREAM_REFINE_S has passed). False when it is final."""
     img = st.full
     now = time.monotonic()
+    if full.path and not img.pending:
+        nxt = path_progress.next_offset(img.path_samples, full.path_target)
+        if nxt is None:
+            return False
+        if st.job is not None and not st.job.done:
+            return True  # the next sample is on its way; the poll timer redraws
+        full.params.path_sample_offset = nxt
+        st.submit(entry, full, True, owner, path_offset=nxt)
+        return True
     if not img.pending or (img.stalled_since is not None and now - img.stalled_since > STREAM_STALL_S):
         return False
     if st.job is not None and not st.job.done:

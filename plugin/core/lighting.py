@@ -84,6 +84,10 @@ def look_kwargs(props, dragging=False):
         occlusion_strength=strength,
         anisotropy=min(max(float(props.anisotropy), -0.99), 0.99),
         illumination_size=illumination_size(props.shadow_quality, dragging),
+        # the path model: F12's samples (the viewport renders one a pass,
+        # viewport.py), bounces, and the seed (the same frame, the same noise)
+        path_samples=max(int(getattr(props, "path_samples", 0)), 1),
+        path_bounces=max(int(getattr(props, "path_bounces", 0)), 0),
     )
 
 

@@ -47,7 +47,8 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 shading_model=0, ambient_occlusion=0.0, occlusion_strength=0.0, anisotropy=0.0,
                 illumination_size=0, mode="dvr", matcap=None, matcap_key=0, cutaway=None,
                 scene_shadows=None, labels=None, overlays=None, minip_floor=None, environment=None,
-                color_space="display", color_source="auto", lib=None):
+                color_space="display", color_source="auto", path_samples=0, path_sample_offset=0,
+                path_bounces=0, path_seed=0, lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -76,7 +77,9 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     in and out, as the CLI's PNGs) or "linear" (scene-linear, Blender's and
     Cycles' colours: the add-on's), or VXL_COLOR_SPACE_*. `color_source`
     says where a colour volume's colour comes from: "auto" (its own RGB;
-    the table's for a grey volume), "data" or "tf" (COLOR_SOURCES)."""
+    the table's for a grey volume), "data" or "tf" (COLOR_SOURCES).
+    `path_samples`, `path_sample_offset`, `path_bounces` and `path_seed`
+    are the `path` shading model's (vxl_render_params; 0: its defaults)."""
     lib = lib or load_library()
     p = _sized(RenderParams)
     p.width, p.height = int(width), int(height)
@@ -120,6 +123,8 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
         p.tf_rgba = _fptr(tf)
     p.color_space = color_space if isinstance(color_space, int) else COLOR_SPACES.index(color_space)
     p.color_source = color_source if isinstance(color_source, int) else COLOR_SOURCES.index(color_source)
+    p.path_samples, p.path_sample_offset = int(path_samples), int(path_sample_offset)
+    p.path_bounces, p.path_seed = int(path_bounces), int(path_seed) & 0xFFFFFFFF
     p.classify = classify if isinstance(classify, int) else lib.index("classify", classify)
     p.gradient_opacity = (gradient_opacity if isinstance(gradient_opacity, int)
                           else lib.index("gradient_opacity", gradient_opacity))

@@ -40,7 +40,7 @@ OIIO_LIBS := $(shell pkg-config --libs OpenImageIO)
 # not installed, so the three libraries dcmdata needs are named directly.
 DCMTK_LIBS := -ldcmjpeg -ldcmjpls -ldcmdata -loflog -lofstd
 
-# libvoxlight.so is C and links only the C runtime (issue 13): the readers
+# libvoxlight.so is C and links only the C runtime: the readers
 # that need OpenImageIO or dcmtk are built into helper processes next to it
 # (csrc/io/reader_stream.h), one per library, so a missing library breaks only
 # its own formats: voxlight-read-oiio (TIFF/PNG stacks, OpenVDB) and
@@ -179,15 +179,15 @@ $(BUILD)/voxlight-storagebench: bench/storage_study.c bench/bench_util.h $(BUILD
 $(BUILD)/voxlight-lightbench: bench/lighting_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
-# issue 20: frame time against the number of labels (docs/labels.md)
+# frame time against the number of labels (docs/labels.md)
 $(BUILD)/voxlight-labelsbench: bench/labels_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
-# issue 21: open, first and refined frame, F12, bytes read and peak RSS of one file (docs/streaming.md)
+# open, first and refined frame, F12, bytes read and peak RSS of one file (docs/streaming.md)
 $(BUILD)/voxlight-streambench: bench/stream_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
-# issue 20: frame time against the number of overlays (docs/overlays.md)
+# frame time against the number of overlays (docs/overlays.md)
 $(BUILD)/voxlight-overlaysbench: bench/overlays_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
@@ -195,7 +195,7 @@ $(BUILD)/voxlight-overlaysbench: bench/overlays_study.c bench/bench_util.h $(BUI
 $(BUILD)/voxlight-channelsbench: bench/channels_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
-# issue 19: the render modes' run time against error (docs/modes.md, docs/benchmark.md)
+# the render modes' run time against error (docs/modes.md, docs/benchmark.md)
 $(BUILD)/voxlight-modesbench: bench/modes_study.c bench/bench_util.h $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
 
@@ -384,7 +384,7 @@ $(BUILD)/tests/%: tests/%.c tests/harness.h $(wildcard tests/*.h tests/fuzz/*.h)
 $(BUILD)/obj $(BUILD)/gen $(BUILD)/tests:
 	mkdir -p $@
 
-# ---- fuzzing (issue 7): `make fuzz` builds one libFuzzer binary per loader
+# ---- fuzzing: `make fuzz` builds one libFuzzer binary per loader
 # in build/fuzz/ with Debian's clang under ASan+UBSan, the loaders compiled
 # in directly, plus the seed writer; ./build.sh fuzz / test run them.
 FUZZ_BUILD := build/fuzz
@@ -397,7 +397,7 @@ FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc
 # in-process by their targets: libFuzzer sees coverage in its own process only)
 FUZZ_LIB_C := volume.c colour_volume.c channel_volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
 	reader_spawn.c remote_readers.c label_table.c zarr_detect.c $(notdir $(ZARR_C)) zarr_source.c brick_source.c
-# the brick cache of .nii.gz files and the TIFF directory walk (issue 21): opened by the loaders, read by
+# the brick cache of .nii.gz files and the TIFF directory walk: opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout; the Radiance reader of World maps, read by fuzz_hdr
 FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_write.c brick_cache_format.c \
 	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c hdr_read.c \

@@ -414,7 +414,7 @@ case "$cmd" in
         install_deps; build; build_asan
         # Without them the Blender suite reports the missing versions as failures.
         bpy_venvs || echo "build.sh: the bpy venvs are incomplete" >&2
-        # dependencies go one way (issue 15): no include cycle between csrc/
+        # dependencies go one way: no include cycle between csrc/
         # files or folders, each folder above the ones it uses
         run_suite "Include cycles and layers (csrc/)" /usr/bin/python3 tools/check_includes.py
         run_suite "C tests" run_c_tests build
@@ -465,10 +465,10 @@ case "$cmd" in
             --out "$([ "$mode" = --quick ] && echo bench/out/slicing.csv || echo bench/slicing.csv)"
         ./build/voxlight-storagebench $([ "$mode" = --quick ] && echo --quick) \
             --out "$([ "$mode" = --quick ] && echo bench/out/storage.csv || echo bench/storage.csv)"
-        # Issue 17: shadows, occlusion and scattering (docs/lighting.md pastes bench/out/lighting_tables.md).
+        # shadows, occlusion and scattering (docs/lighting.md pastes bench/out/lighting_tables.md).
         light_csv=$([ "$mode" = --quick ] && echo bench/out/lighting.csv || echo bench/lighting.csv)
         ./build/voxlight-lightbench $([ "$mode" = --quick ] && echo --quick) --out "$light_csv"
-        # Issue 18: scene shadows on against off (docs/scene_shadows.md).
+        # scene shadows on against off (docs/scene_shadows.md).
         ./build/voxlight-sceneshadowbench $([ "$mode" = --quick ] && echo --quick || echo --frames 9) \
             --out "$([ "$mode" = --quick ] && echo bench/out/scene_shadows.csv || echo bench/scene_shadows.csv)"
         /usr/bin/python3 bench/plot_lighting.py "$light_csv" \
@@ -483,12 +483,12 @@ case "$cmd" in
             --size "$([ "$mode" = --quick ] && echo 64 || echo 512)" --frames "$([ "$mode" = --quick ] && echo 3 || echo 5)" \
             --out "$cmp_csv" --md bench/out/vtk_compare.md --command "./build.sh bench $mode"
         if [ "$mode" = --quick ]; then dest=bench/out/benchmark; else dest=docs/benchmark; fi
-        # Issue 19: the render modes' run time against error (docs/modes.md).
+        # the render modes' run time against error (docs/modes.md).
         ./build/voxlight-modesbench $([ "$mode" = --quick ] && echo --quick) \
             --out "$([ "$mode" = --quick ] && echo bench/out/modes.csv || echo bench/modes.csv)" --md bench/out/modes.md
         /usr/bin/python3 bench/plot.py bench/results.csv --png "$dest.png" --md "$dest.md" --command "./build.sh bench $mode"
         { echo; cat bench/out/vtk_compare.md; } >> "$dest.md"
-        { echo; echo "## Render modes: run time against error (issue 19)"; echo;
+        { echo; echo "## Render modes: run time against error"; echo;
           echo "\`build/voxlight-modesbench\` (bench/modes_study.c, docs/modes.md), from \`./build.sh bench $mode\`:";
           echo; cat bench/out/modes.md; } >> "$dest.md" ;;
     bpy)

@@ -1,4 +1,4 @@
-/* filter_scan_study.c - the gradient filters on a real scan (issue 14):
+/* filter_scan_study.c - the gradient filters on a real scan:
  * renders one close view per filter and light, writes the images, and prints
  * two smoothness measures of the normals:
  *  - hf: RMS of the shaded luminance minus its 3x3 mean, over pixels whose

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Warm-frame time of the shaded ray caster on ch2better, as issue 16 measured it.
+"""Warm-frame time of the shaded ray caster on ch2better, as measured it.
 
 ch2better at 512x512, default camera (azimuth 30, elevation 15), MRI preset,
 through plugin/core/native.py; per configuration the median of --frames warm
@@ -36,7 +36,7 @@ from voxlight.core import native  # noqa: E402
 
 VOLUME = "/usr/share/mricron/templates/ch2better.nii.gz"
 
-# (name, filter, step, shading): issue 16's table.
+# (name, filter, step, shading): the configurations the frame-time table compares.
 CONFIGS = [
     ("central-s1-shaded", "central", 1.0, True),
     ("central-s1-unshaded", "central", 1.0, False),

@@ -1,5 +1,5 @@
-/* labels_study.c - frame time against the number of labels (issue 20,
- * docs/labels.md "Rendering"): a 128^3 sphere phantom drawn once with its
+/* labels_study.c - frame time against the number of labels
+ * (docs/labels.md "Rendering"): a 128^3 sphere phantom drawn once with its
  * transfer function alone (the baseline), then with a label volume of the
  * same grid split into 1, 16 and 256 labels (blocks inside the phantom's
  * ellipsoid) in each label mode (surface, mask, tint), all labels visible.

@@ -1,4 +1,4 @@
-/* lighting_study.c - the numbers of issue 17 (docs/lighting.md): the cost
+/* lighting_study.c - the numbers (docs/lighting.md): the cost
  * of the shadowed and scatter shading models on the ch2better brain
  * (cached illumination volume against a Phong frame, the rebuild after a
  * light move, the switch of the illumination grid a dragged light makes in

@@ -1,5 +1,5 @@
-/* modes_study.c - run time against error of the render modes (issue 19,
- * docs/modes.md): for MIP, MinIP, average and ISO, at each ray step, the
+/* modes_study.c - run time against error of the render modes
+ * (docs/modes.md): for MIP, MinIP, average and ISO, at each ray step, the
  * median frame time and the error against a double-precision CPU reference
  * of the same trilinear field along the same rays.
  *   MIP / MinIP / average: the projected value (read back through a grey

@@ -1,5 +1,5 @@
-/* overlays_study.c - frame time against the number of overlays (issue 20,
- * docs/overlays.md "Measured"): a 128^3 sphere phantom drawn alone (the
+/* overlays_study.c - frame time against the number of overlays
+ * (docs/overlays.md "Measured"): a 128^3 sphere phantom drawn alone (the
  * baseline), then with 1, 2 and 3 overlays, each a 96^3 Gaussian blob on its
  * own grid (scaled, turned and shifted so the boxes overlap the base's and
  * each other's), blended OVER, MAX and ADD in turn, linear and cubic, with

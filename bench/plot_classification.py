@@ -3,7 +3,7 @@ thin opacity spike (workload spike64, voxlight-bench), image error against
 frame time for post-, pre- and pre-integrated classification across ray
 steps. Called by plot.py, which keeps these rows out of the filter panels.
 
-The claim it tests (issue 6): pre-integration reaches a given error at a much
+The claim it tests: pre-integration reaches a given error at a much
 larger step, hence in less time. The text below the table is computed from
 the rows, never written by hand.
 """

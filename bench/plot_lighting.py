@@ -1,4 +1,4 @@
-"""plot_lighting.py - issue 17's numbers from voxlight-lightbench's CSV
+"""plot_lighting.py - numbers from voxlight-lightbench's CSV
 (bench/lighting_study.c): the cost table on ch2better, and run time against
 error on the two-blobs phantom, as a figure and markdown tables for
 docs/lighting.md. Every sentence below a table is computed from the rows.

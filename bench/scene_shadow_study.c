@@ -1,5 +1,5 @@
-/* scene_shadow_study.c - the cost of scene shadows (issue 18, item 5;
- * docs/scene_shadows.md): the ch2better brain at size^2 in the shadowed
+/* scene_shadow_study.c - the cost of scene shadows
+ * (docs/scene_shadows.md): the ch2better brain at size^2 in the shadowed
  * model with one sun, and a tessellated sphere of `triangles` triangles
  * between the sun and the brain plus a floor under it as the scene's
  * occluders. Medians of warm frames:

@@ -1,4 +1,4 @@
-/* slicing_study.c - the slicing comparison modes (issue 16, docs/slicing.md)
+/* slicing_study.c - the slicing comparison modes (docs/slicing.md)
  * against the ray caster: time and error per technique and sampling rate
  * (step = slice spacing), and the popping of 2D stacks where they switch
  * axis at 45 degrees azimuth.

@@ -1,4 +1,4 @@
-/* stream_study.c - data larger than memory (issue 21, docs/streaming.md
+/* stream_study.c - data larger than memory (docs/streaming.md
  * "Benchmark"): for one file, the times a user waits and the memory it
  * takes, under a memory budget split as the CLI splits it (half for the
  * volume's CPU side, the other half for the GL side of a streamed volume).

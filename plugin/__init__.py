@@ -45,9 +45,9 @@ if UNSUPPORTED is None:
     from . import (api, blender_volume, compositor, importer, offline, operators, panels, params,  # noqa: E402
                    preferences, properties, render_hooks, render_setup, scene_shadows, tf,
                    viewport, volume_object, world_light)
-    from . import cutaway_ui, slice_planes  # noqa: E402  (issue 19)
-    from . import label_props, label_ui  # noqa: E402  (issue 20)
-    from . import overlay_props, overlay_ui  # noqa: E402  (issue 20 overlays)
+    from . import cutaway_ui, slice_planes  # noqa: E402
+    from . import label_props, label_ui  # noqa: E402
+    from . import overlay_props, overlay_ui  # noqa: E402  (overlays)
     from .core import (depth, import_job, lights, native, runtime, scene_geometry,  # noqa: E402,F401
                        volume_space, zbuffer)
     from .api import render_volume  # noqa: E402,F401

@@ -232,7 +232,7 @@ def mute(scene):
 
 
 # ------------------------------------------------- the volume's shadows
-# Issue 18: between Render Layers' Image and the Alpha Over's background, a
+# between Render Layers' Image and the Alpha Over's background, a
 # chain of nodes (planned by core/shadow_plan.py) multiplies each light
 # group's light, or the direct light, by the volume's transmittance:
 #

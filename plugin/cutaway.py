@@ -1,4 +1,4 @@
-"""A volume's render mode, MatCap and cutaway (issue 19) as make_params
+"""A volume's render mode, MatCap and cutaway as make_params
 keyword arguments, read from its properties (cutaway_props.py) and the
 objects they point at: clip planes from objects' local XY planes, the crop
 box from a cube Empty, cutters from evaluated meshes in world space

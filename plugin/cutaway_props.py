@@ -1,4 +1,4 @@
-"""Issue 19's properties on a volume (Object.voxlight): the render mode, the
+"""The properties on a volume (Object.voxlight): the render mode, the
 MatCap, clip planes, the crop box, cutter meshes and caps. The property
 groups of one clip plane and one cutter live here; properties.py puts them
 (and the fields below) on VoxlightVolumeProperties. Every number is

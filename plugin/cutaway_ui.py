@@ -1,4 +1,4 @@
-"""Issue 19's UI: the volume's Render Mode and Cutaway sub-panels, the
+"""The UI: the volume's Render Mode and Cutaway sub-panels, the
 Slice Plane panel of a plane object, and the operators that set up what
 artists expect: a clip plane (an arrow Empty through the volume's centre,
 its arrow pointing at the kept side), a crop box (a cube Empty around the

@@ -99,7 +99,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
     frame_in_view: BoolProperty(name="Frame in View", default=True,
                                 description="Point every 3D viewport at the imported volume "
                                             "(as View Selected does)")
-    # Issue 20: label maps (core/label_import.py decides, label_props.py holds them).
+    # label maps (core/label_import.py decides, label_props.py holds them).
     import_as: EnumProperty(name="Import As", default="AUTO",
                             items=[m + (i,) for i, m in enumerate(label_import.IMPORT_MODES)],
                             description="An intensity volume, or a label map (integer volume of "
@@ -122,7 +122,7 @@ class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         path = resolve_path(self.filepath, self.directory)
-        preferences.sync(context)  # issue 21: streaming mode and cache folder
+        preferences.sync(context)  # streaming mode and cache folder
         opts = runtime.options_of(context.scene.voxlight)  # backend, storage, memory budget
         if self.use_modal and context.window is not None:
             self._job = import_job.ImportJob(path, tuple(self.voxel_size), series=self.series, **opts)
@@ -295,7 +295,7 @@ def _lookup_ids(path):
 
 
 def _show_status(context, job):
-    """The status bar while a file is opened (issue 21): what the library's
+    """The status bar while a file is opened: what the library's
     first pass is doing and how far it is, and that Esc cancels; job None
     gives the status bar back."""
     workspace = getattr(context, "workspace", None)

@@ -1,4 +1,4 @@
-"""Label maps on a volume object (issue 20): Object.voxlight_labels holds the
+"""Label maps on a volume object: Object.voxlight_labels holds the
 label image, its lookup file, how labels are drawn (surface / mask / tint,
 the library's VXL_LABEL_MODE_* names), the boundaries (smooth or the raw
 voxels, VXL_LABEL_BOUNDARY_*) and one entry per label (id, name,
@@ -149,7 +149,7 @@ def attach(obj, label_path, lookup_path, table, mode):
 def look_kwargs(props):
     """make_params' labels=(mode, [(id, rgba, visible), ...], boundary) for a volume
     object (props: Object.voxlight), or {} when it draws no labels (then
-    its frames are exactly those of before issue 20)."""
+    its frames are exactly those of a volume without labels)."""
     ob = getattr(props, "id_data", None)
     s = getattr(ob, "voxlight_labels", None)
     if s is None or not s.active_path or not label_runtime.usable(s.active_path):

@@ -1,4 +1,4 @@
-"""The Labels sub-panel of a volume object (issue 20): the label image and
+"""The Labels sub-panel of a volume object: the label image and
 lookup file, the label mode and boundaries, and a list of the labels (searchable by name
 with the list's own filter) with colour, opacity and visibility per row,
 Show All / Hide All and how many labels are visible; the active label's id

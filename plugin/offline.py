@@ -80,7 +80,7 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
     vols = volume_instances(depsgraph, only, for_render)
     if not vols:
         return None
-    # Issue 20: overlays are drawn inside their base, not on their own.
+    # overlays are drawn inside their base, not on their own.
     vols, fused = overlay_frames.fuse_instances(volume_instances(depsgraph, None, for_render), vols)
     view = proj = None
     named = scene_shadows.named_lights(depsgraph, for_render) \

@@ -1,4 +1,4 @@
-"""Overlays in the frames the viewport and F12 render (issue 20).
+"""Overlays in the frames the viewport and F12 render.
 
 For the visible volume objects of one draw, fuse() says which are bases and
 which overlays each base draws (core/overlay_runtime.plan over

@@ -1,4 +1,4 @@
-"""Overlays on a volume object (issue 20): other volume objects drawn in the
+"""Overlays on a volume object: other volume objects drawn in the
 same ray march as it (the base), each with its own placement, transfer
 function, window and preset (its own Object.voxlight, as any volume object).
 

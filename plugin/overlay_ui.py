@@ -1,4 +1,4 @@
-"""The Overlays sub-panel of a volume object (issue 20): the volumes linked
+"""The Overlays sub-panel of a volume object: the volumes linked
 as its overlays (a list with Add / Remove) and whether its volume children
 are overlays too; then, per overlay in slot order, its blend, opacity,
 shading and interpolation (properties of the overlay object, so keyframes

@@ -208,7 +208,7 @@ class VOXLIGHT_PT_volume_lighting(_VolumePanel, bpy.types.Panel):
         col.prop(p, "diffuse", slider=True)
         col.prop(p, "specular", slider=True)
         col.prop(p, "shininess")
-        # Shadows, occlusion and scattering (issue 17): not in Phong.
+        # Shadows, occlusion and scattering: not in Phong.
         col = layout.column(align=True)
         col.active = p.shading_model != "phong"
         col.prop(p, "occlusion_radius", text="Occlusion")
@@ -222,7 +222,7 @@ class VOXLIGHT_PT_volume_lighting(_VolumePanel, bpy.types.Panel):
             col.prop(p, "path_samples", text="Samples")
             col.prop(p, "path_viewport_samples", text="Viewport")
             col.prop(p, "path_bounces", text="Bounces")
-        # Scene shadows (issue 18): the volume and the scene's meshes.
+        # Scene shadows: the volume and the scene's meshes.
         # Short texts: a checkbox's text shares the value column with the
         # checkbox (the tooltips keep the detail).
         col = layout.column(heading="Scene Shadows", align=True)
@@ -313,7 +313,7 @@ class VOXLIGHT_PT_volume_stats(_VolumePanel, bpy.types.Panel):
         else:
             col.label(text="Empty-space skipping off")
         col.label(text=storage_text(frame))
-        if stream_text(frame):  # issue 21
+        if stream_text(frame):
             col.label(text=stream_text(frame))
         if frame.get("lod_level"):
             col.label(text=lod_text(frame), icon="ERROR")
@@ -374,7 +374,7 @@ class VOXLIGHT_PT_scene(bpy.types.Panel):
         col.prop(s, "render_occlusion", text="Mesh Occlusion")
         col.prop(s, "render_separate_layer", text="Separate Layer")
         from . import scene_shadows
-        if scene_shadows.note:  # how the last render applied the volume's shadows (issue 18)
+        if scene_shadows.note:  # how the last render applied the volume's shadows
             for i, line in enumerate(compat.wrap(scene_shadows.note, 40)):
                 col.label(text=line, icon="INFO" if i == 0 else "BLANK1")
         layout.prop(s, "use_scene_lights")

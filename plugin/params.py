@@ -64,8 +64,8 @@ def look_kwargs(props, fast=False, dragging=False):
         minip_floor=props.minip_floor if props.use_minip_floor else None,
         iso_thickness=props.iso_thickness,
         **lighting.look_kwargs(props, dragging),
-        **cutaway.look_kwargs(props),  # issue 19: mode, MatCap, cutaway
-        **label_props.look_kwargs(props),  # issue 20: label map colours and visibility
+        **cutaway.look_kwargs(props),  # mode, MatCap, cutaway
+        **label_props.look_kwargs(props),  # label map colours and visibility
     )
 
 
@@ -107,8 +107,8 @@ def while_lights_move(lights, now, settle_time):
 def build(obj, width, height, view, proj, scene_depth=None, lights=(), fast=False, lib=None,
           scene_shadows=None, overlays=None):
     """scene_shadows: the occluders (vertices, triangles, key) that shadow
-    the volume (issue 18), or None. overlays: make_params' overlay dicts
-    (issue 20, overlay_frames.prepare), or None."""
+    the volume, or None. overlays: make_params' overlay dicts
+    (overlay_frames.prepare), or None."""
     kw = look_kwargs(obj.voxlight, fast, dragging=getattr(lights, "dragged", False))
     kw["environment"] = getattr(lights, "environment", None)
     if overlays:

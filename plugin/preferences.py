@@ -1,5 +1,5 @@
 """Add-on preferences: where the user sees whether the library loaded, and
-how files larger than memory are opened (issue 21): the streaming mode and
+how files larger than memory are opened: the streaming mode and
 the folder for bricked caches. These two are per user, not per .blend, so
 they live here; runtime.stream_settings carries them to the loads (which run
 on worker threads, without bpy)."""

@@ -303,7 +303,7 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                              update=tag_redraw,
                              description="Size of the highlights: higher is smaller and "
                                          "sharper, like a glossier surface")
-    # --- lighting (issue 17; defaults and old files: lighting.py)
+    # --- lighting (defaults and old files: lighting.py)
     shading_model: EnumProperty(name="Shading Model", items=SHADING_MODEL_ITEMS,
                                 default=lighting.DEFAULT_MODEL, update=tag_redraw,
                                 description="How light reaches each sample: local Phong, with "
@@ -340,7 +340,7 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                                  description="Resolution of the volumes that hold each light's "
                                              "shadows: higher is crisper and slower to update "
                                              "when a light moves")
-    # --- scene shadows (issue 18; scene_shadows.py, compositor.py)
+    # --- scene shadows (scene_shadows.py, compositor.py)
     cast_shadows: BoolProperty(name="Cast Shadows", default=True, update=tag_redraw,
                                description="The volume darkens the meshes behind it as seen "
                                            "from each light (F12: each light's direct light; "
@@ -349,7 +349,7 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
                                   description="Meshes between a light and the volume shadow it "
                                               "(meshes whose Shadow visibility is on; Shadowed "
                                               "and Scatter models)")
-    # --- render mode, MatCap and cutaways (issue 19; cutaway_props.py, cutaway.py)
+    # --- render mode, MatCap and cutaways (cutaway_props.py, cutaway.py)
     render_mode: EnumProperty(name="Render Mode", items=MODE_ITEMS, default="dvr",
                               update=_render_mode_changed,
                               description="How each ray's samples become a pixel: volume "

@@ -1,4 +1,4 @@
-"""The volume in the scene's light (issue 18), on the Blender side:
+"""The volume in the scene's light, on the Blender side:
 
 * receive_shadows: the scene's opaque meshes (objects whose Shadow ray
   visibility is on) go to the library as params.scene_shadows, so they

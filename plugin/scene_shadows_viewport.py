@@ -1,4 +1,4 @@
-"""The volume's shadow on the meshes in the 3D viewport (issue 18): a
+"""The volume's shadow on the meshes in the 3D viewport: a
 multiply layer drawn by the viewport's draw handler before the volumes
 (as black with coverage 1 - T, which multiplies the scene under it by T).
 

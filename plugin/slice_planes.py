@@ -1,4 +1,4 @@
-"""Slice planes (issue 19): a mesh plane marked as a slice of a volume
+"""Slice planes: a mesh plane marked as a slice of a volume
 (Object.voxlight_slice) shows the volume resampled on it, with the
 volume's window and colour map: vxl_render_slice writes an Image, and an
 emission material on the plane shows it (transparent where the plane

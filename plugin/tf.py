@@ -44,7 +44,7 @@ TF_SINGLE_EDITOR = 1
 TF_LINEAR_COLOUR = 4
 TF_VERSION = 4
 
-# Kept for scripts written against the ColorRamp presets of issue 6.
+# Kept for scripts written against the ColorRamp presets.
 SLICER_PRESETS = tf_presets.SLICER_PRESETS
 PRESET_ITEMS = [(k, p.name, p.description) for k, p in tf_presets.PRESETS.items()]
 
@@ -191,7 +191,7 @@ def load_preset(obj, key, info=None):
 
 
 def apply_preset(obj, key):
-    """Kept for scripts of issue 6: load a preset (now fitted to the data)."""
+    """Kept for scripts: load a preset (now fitted to the data)."""
     load_preset(obj, key)
 
 

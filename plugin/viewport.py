@@ -149,7 +149,7 @@ class _Image:
     """One rendered frame, uploaded: GPUTextures must outlive the draw call
     that samples them, so they live here until replaced."""
 
-    # Issue 21, streamed volumes: bricks drawn coarser than the frame wanted
+    # streamed volumes: bricks drawn coarser than the frame wanted
     # (stats refine_pending), the coarsest level drawn, when it was made, and
     # since when the passes of its view have not got finer (None: they do).
     pending = 0
@@ -591,7 +591,7 @@ class _Frame:
         self.scale = scale
         dims = tuple(ob.voxlight.dims)
         _profile.mark("frame_setup")
-        ovl = overlay_frames.current(ob.name)  # issue 20: the pixels and depths of its overlays too
+        ovl = overlay_frames.current(ob.name)  # the pixels and depths of its overlays too
         self.rect = overlay_frames.screen_rect(model, dims, ovl, view, proj, w, h)
         self.win_small = None
         scene_depth = None
@@ -605,7 +605,7 @@ class _Frame:
         self.params = params.build(ob, w, h, view, proj, scene_depth=scene_depth,
                                    lights=lights, fast=fast,
                                    scene_shadows=scene_shadows.for_viewport(ob), overlays=ovl.overlays)
-        # Issue 21: never wait for a streamed volume's bricks here; what is
+        # never wait for a streamed volume's bricks here; what is
         # still loading is drawn coarser and refined later (_keep_refining).
         self.params.progressive = 1
         # the path model: one sample a pass (offset set when queued), the
@@ -707,7 +707,7 @@ def _draw():
     # and local view; such volumes cost nothing.
     objs = [o for o in view_layer.objects
             if o.type in volume_space.VOLUME_TYPES and o.voxlight.is_volume and o.visible_get(viewport=space)]
-    # Issue 20: an overlay is drawn inside its base's frame, not on its own.
+    # an overlay is drawn inside its base's frame, not on its own.
     fused = {b.name: ovs for b, ovs in overlay_frames.fuse(objs)}
     outlined = objs
     objs = [o for o in objs if o.name in fused]
@@ -752,7 +752,7 @@ def _draw():
             try:
                 entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
                                           scene.frame_current, **runtime.options_of(s))
-                overlay_frames.prepare(entry, ob, overlays, scene.frame_current)  # issue 20
+                overlay_frames.prepare(entry, ob, overlays, scene.frame_current)
             except native.VoxlightError as e:
                 _report(e)
                 continue
@@ -762,13 +762,13 @@ def _draw():
                 depth_read = True
                 _profile.mark("depth_read")
                 lights = params.scene_lights(scene, depsgraph)
-                # Issue 17: a light being dragged gets a coarse illumination
+                # a light being dragged gets a coarse illumination
                 # volume, refined by a redraw once it settles (params.py).
                 lights, light_settles_in = params.while_lights_move(lights, now, s.settle_time)
                 if light_settles_in is not None:
                     _schedule_refine(light_settles_in + 0.01)
                 _profile.mark("lights")
-                # Issue 18: the meshes that shadow the volumes, and the
+                # the meshes that shadow the volumes, and the
                 # volumes' shadow on the meshes (drawn under the volumes).
                 scene_shadows.refresh_viewport(depsgraph, objs)
                 scene_shadows_viewport.draw_layer(scene, depsgraph, objs, window_depth, W, H,
@@ -949,7 +949,7 @@ def _refine_still(st, s, args, owner):
     return False, None
 
 
-# Issue 21: a streamed volume's frame is drawn at once from the bricks at
+# a streamed volume's frame is drawn at once from the bricks at
 # hand, coarser where finer ones are still loading on the renderer's loader
 # thread (stats refine_pending > 0). The still view is then rendered again
 # every STREAM_REFINE_S, each finer image replacing the last, until nothing

@@ -1,4 +1,4 @@
-"""The data issue 21's benchmark streams (bench/stream_study.c,
+"""The data benchmark streams (bench/stream_study.c,
 docs/streaming.md "Benchmark"), generated with numpy and nothing
 downloaded; every file is the same on every run (fixed seeds).
 

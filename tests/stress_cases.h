@@ -1262,9 +1262,9 @@ static inline int stress_apply_variant(vxl_render_params *p, const stress_view_c
     }
 }
 
-/* ------------------------------------------------------ issue 19: modes */
+/* ------------------------------------------------------ render modes */
 
-/* The issue 19 renders each case gets beside the DVR matrix: every render
+/* The renders each case gets beside the DVR matrix: every render
  * mode but DVR, ISO shaded by a MatCap, and a cutaway (a clip plane through
  * the volume's centre, half-space and slab) on DVR and MIP. */
 enum { SM_MIP, SM_MINIP, SM_AVERAGE, SM_ISO, SM_ISO_MATCAP, SM_DVR_CUT, SM_MIP_SLAB, SM_COUNT };
@@ -1275,7 +1275,7 @@ static inline const char *stress_mode_render_name(int m)
     return m >= 0 && m < SM_COUNT ? names[m] : "?";
 }
 
-/* Sets p (after the case's view) for issue 19 render m, with mc and cut as
+/* Sets p (after the case's view) for render m, with mc and cut as
  * the MatCap and cutaway it may point to. For a valid case the classify,
  * gradient-opacity and technique settings the modes refuse are reset (the
  * DVR matrix covers those); an invalid case keeps what makes it invalid. */

@@ -457,7 +457,7 @@ TEST(old_output_structs_are_written_up_to_their_size)
     CHECK(vxl_render(r, &p, img, NULL) == VXL_OK);
     vxl_render_stats st;
     memset(&st, 0xEE, sizeof st);
-    st.struct_size = (uint32_t)offsetof(vxl_render_stats, storage); /* before issue 8 */
+    st.struct_size = (uint32_t)offsetof(vxl_render_stats, storage); /* a struct from before the storage fields */
     CHECK(vxl_renderer_get_stats(r, &st) == VXL_OK && st.rays > 0 && st.storage == 0xEEEEEEEEu);
     vxl_renderer_destroy(r);
 }

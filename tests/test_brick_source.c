@@ -1,4 +1,4 @@
-/* test_brick_source.c - issue 21's CPU side: brick sources serve exactly
+/* test_brick_source.c - CPU side: brick sources serve exactly
  * what the whole volume holds. The memory source against the whole volume
  * at every level (the LOD fallback's downsampling, storage/lod.c) and in any
  * box; every source's index against the skipping grid's CPU copy
@@ -231,7 +231,7 @@ TEST(auto_streams_only_over_half_the_budget)
     o.memory_budget_bytes = texture / 2; /* streaming off: over the budget is an error, as always */
     o.streaming = VXL_STREAMING_OFF;
     CHECK(vxl_volume_load(p, &o, &v) == VXL_ERR_LIMIT && strstr(vxl_last_error(), "budget"));
-    /* an options struct from before issue 21 (no streaming field) is AUTO */
+    /* an options struct from before streaming (no streaming field) is AUTO */
     o.struct_size = (uint32_t)offsetof(vxl_load_options, streaming);
     o.streaming = VXL_STREAMING_OFF;
     o.memory_budget_bytes = 2 * texture - 2;

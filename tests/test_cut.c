@@ -1,4 +1,4 @@
-/* test_cut.c - cutaways (issue 19; csrc/frame/frame_cut.c, csrc/cut/,
+/* test_cut.c - cutaways (csrc/frame/frame_cut.c, csrc/cut/,
  * shaders/lib/cut.glsl): clip planes, slabs, the crop box and cutter
  * meshes remove what they should and nothing else, caps are shaded by the
  * cut's normal, every storage mode cuts alike, the GL image matches the

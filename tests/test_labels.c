@@ -1,4 +1,4 @@
-/* test_labels.c - label maps (issue 20; csrc/labels/, csrc/frame/frame_labels.c,
+/* test_labels.c - label maps (csrc/labels/, csrc/frame/frame_labels.c,
  * shaders/lib/labels.glsl): hiding a label removes exactly its pixels, two
  * labels touching along a plane meet on a straight line, a sphere labelled
  * on a 32^3 grid renders round (silhouette and depth against the analytic

@@ -1,4 +1,4 @@
-/* test_modes.c - the render modes and the MatCap of issue 19
+/* test_modes.c - the render modes and the MatCap
  * (shaders/lib/modes.glsl, lib/matcap.glsl, csrc/render/modes.c, matcap.c,
  * csrc/frame/frame_mode.c): through an orthographic axis view whose pixels
  * are one voxel wide (csrc/cli/axis_view.h), MIP, MinIP and average equal

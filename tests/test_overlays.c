@@ -1,4 +1,4 @@
-/* test_overlays.c - several volumes in one ray march (issue 20 overlays;
+/* test_overlays.c - several volumes in one ray march (overlays;
  * csrc/overlay/, csrc/frame/frame_overlays.c, shaders/lib/overlays.glsl):
  * an overlay on another grid (scaled, rotated, translated, partly outside
  * the base box) lands where its affine says; an identical copy as OVER
@@ -321,6 +321,12 @@ TEST(every_shading_model_lights_the_overlays)
     float lit[VXL_SHADING_COUNT];
     for (uint32_t m = 0; m < VXL_SHADING_COUNT; m++) {
         p.shading_model = m;
+        if (m == VXL_SHADING_PATH) { /* path tracing does not draw overlays yet: refused by name */
+            CHECK(vxl_render(R, &p, IMG, NULL) == VXL_ERR_INVALID_ARGUMENT);
+            CHECK(strstr(vxl_renderer_error(R), "overlay") != NULL);
+            lit[m] = 2;
+            continue;
+        }
         REQUIRE(vxl_render(R, &p, IMG, NULL) == VXL_OK);
         CHECKF(image_is_sane(IMG, NULL, W * W), "shading model %u", m);
         double sum = 0;

@@ -1,6 +1,6 @@
 /* test_reference_light.c - the reference renderer's shadows, spot cones,
  * soft shadows, ambient occlusion and scattering (voxlight.h's
- * VXL_SHADING_*, issue 17), and the validation of the lighting fields. No
+ * VXL_SHADING_*), and the validation of the lighting fields. No
  * GL: the reference is the ground truth the fast path is measured against,
  * so these tests pin it down on its own.
  *

@@ -1,5 +1,5 @@
-/* test_scene_shadows.c - the volume in the scene's light (issue 18;
- * csrc/frame/frame_scene.c, csrc/light/shadow_maps.c, transmittance.c):
+/* test_scene_shadows.c - the volume in the scene's light
+ * (csrc/frame/frame_scene.c, csrc/light/shadow_maps.c, transmittance.c):
  * meshes between a light and the volume shadow the volume where the
  * geometry says and nowhere else; the volume's shadow on a floor
  * (vxl_scene_transmittance) covers exactly the analytic footprint of the

@@ -1,5 +1,5 @@
 /* test_shadows.c - the GL side of the shadowed and scatter shading models
- * (issue 17; csrc/light/illumination.c, shaders/compute/illumination.comp,
+ * (csrc/light/illumination.c, shaders/compute/illumination.comp,
  * lib/shading.glsl's shade_lit): shadows fall where the light is blocked
  * and only there, every storage mode gives the same shadows, nothing goes
  * NaN at the parameters' extremes, the illumination volumes are rebuilt

@@ -1,4 +1,4 @@
-/* test_slice_plane.c - vxl_render_slice (issue 19, csrc/render/slice_plane.c):
+/* test_slice_plane.c - vxl_render_slice (csrc/render/slice_plane.c):
  * the volume resampled on a plane. Against double-precision references of
  * the same voxels: nearest returns the voxel itself, linear the trilinear
  * blend within float rounding, cubic the interpolating B-spline (prefilter

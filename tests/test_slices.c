@@ -1,4 +1,4 @@
-/* test_slices.c - the slicing comparison modes (issue 16, csrc/render/slices.c):
+/* test_slices.c - the slicing comparison modes (csrc/render/slices.c):
  * both render what the ray caster renders, up to their sampling; an unknown
  * technique is refused; the 2D stacks pop where the stack switches (45
  * degrees) and the view-aligned slices do not; finer view-aligned slices

@@ -1,5 +1,5 @@
-/* test_streaming.c - the GL side of streamed volumes (issue 21,
- * docs/streaming.md): a streamed copy (vxl_volume_stream_copy) renders what
+/* test_streaming.c - the GL side of streamed volumes
+ * (docs/streaming.md): a streamed copy (vxl_volume_stream_copy) renders what
  * the whole volume renders in sparse storage (same bricks, PSNR >= 60 dB,
  * for several classifications and cameras); progressive frames start
  * coarse, mix levels per brick as fine bricks arrive and converge to the

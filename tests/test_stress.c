@@ -1,4 +1,4 @@
-/* test_stress.c - the numerical-stability stress suite (issue 4).
+/* test_stress.c - the numerical-stability stress suite.
  *
  * A matrix of adversarial volumes and views (the table in stress_cases.h),
  * each crossed with every gradient filter (0..VXL_FILTER_COUNT-1), every
@@ -385,13 +385,13 @@ static void mode_label(const vxl_render_params *p, char *out, size_t n)
              p->gradient_opacity < VXL_GOPACITY_COUNT ? gop[p->gradient_opacity] : "+gop_invalid");
 }
 
-/* Issue 19 (stress_mode_params): each render mode, a MatCap and a cutaway,
+/* (stress_mode_params): each render mode, a MatCap and a cutaway,
  * with one filter per case in rotation. A projection or an iso-surface may
  * rightly show nothing, or something, where DVR does the opposite (a
  * transparent maximum, a surface of opacity 1 in a transparent table), so
  * only the invariants every render keeps are asked, and the scene-depth
  * invariance. Returns the number of failed renders. */
-static int render_issue19_modes(case_run *cr, int b, stress_view_ctx *vc, buffers *bu)
+static int render_modes(case_run *cr, int b, stress_view_ctx *vc, buffers *bu)
 {
     stress_case c = *cr->c;
     c.flags &= F_SAME_AS_NO_DEPTH;
@@ -415,7 +415,7 @@ static int render_issue19_modes(case_run *cr, int b, stress_view_ctx *vc, buffer
     return errors;
 }
 
-/* Issue 20: the case's volume once more as an overlay in slot 0, shrunk to
+/* the case's volume once more as an overlay in slot 0, shrunk to
  * 0.6 and turned about its centre (so the ray walks the union of two boxes
  * and samples a grid at an angle to its own), OVER or MAX and nearest,
  * linear or cubic in rotation from case to case, shaded in every other
@@ -423,7 +423,7 @@ static int render_issue19_modes(case_run *cr, int b, stress_view_ctx *vc, buffer
  * do; an invalid case keeps them. ADD is left to test_overlays.c: its glow
  * rightly exceeds alpha, which pixels_sane forbids. Returns the number of
  * failed renders. */
-static int render_issue20_overlay(case_run *cr, int b, stress_view_ctx *vc, buffers *bu, const vxl_volume *v)
+static int render_overlay(case_run *cr, int b, stress_view_ctx *vc, buffers *bu, const vxl_volume *v)
 {
     const stress_case *c = cr->c;
     stress_case only_depth = *c; /* as the modes: only the invariants and the scene-depth invariance */
@@ -524,7 +524,7 @@ static int render_channels(case_run *cr, int b, stress_view_ctx *vc, buffers *bu
     return render_one(&run, b, &p, 0, label, bu, vc);
 }
 
-/* Issue 20 labels: a 24x20x16 label volume laid over the case's volume by
+/* labels: a 24x20x16 label volume laid over the case's volume by
  * its own affine (the case's, scaled to the box: another grid), ids 1..5 in
  * bands inside an ellipsoid (3 hidden, 2 and 4 translucent) and a block of
  * id 65535, drawn in every label mode (surface, mask, tint), shaded in
@@ -532,7 +532,7 @@ static int render_channels(case_run *cr, int b, stress_view_ctx *vc, buffers *bu
  * are reset, as the modes do; an invalid case keeps them. A label affine
  * the library cannot use (the case's is not invertible) is a clean
  * refusal. Returns the number of failed renders. */
-static int render_issue20_labels(case_run *cr, int b, stress_view_ctx *vc, buffers *bu, const vxl_volume *v)
+static int render_labels(case_run *cr, int b, stress_view_ctx *vc, buffers *bu, const vxl_volume *v)
 {
     enum { LX = 24, LY = 20, LZ = 16 };
     uint16_t ids[LX * LY * LZ];
@@ -658,9 +658,9 @@ static void *run_backend(void *arg)
                     errors += render_one(cr, b, &p, var, label, &bu, &vc);
                 }
             }
-    errors += render_issue19_modes(cr, b, &vc, &bu);
-    errors += render_issue20_overlay(cr, b, &vc, &bu, j->v);
-    errors += render_issue20_labels(cr, b, &vc, &bu, j->v);
+    errors += render_modes(cr, b, &vc, &bu);
+    errors += render_overlay(cr, b, &vc, &bu, j->v);
+    errors += render_labels(cr, b, &vc, &bu, j->v);
     errors += render_channels(cr, b, &vc, &bu, j->v);
     if (errors) { /* after any failed render the renderer must still work */
         snprintf(label, sizeof label, "[%s] backend=%s (a plain render after %d failed ones)", c->name,
@@ -751,7 +751,7 @@ static vxl_renderer *make_sparse_renderer(void)
     return vxl_renderer_create(&o, &r) == VXL_OK ? r : NULL;
 }
 
-/* Issue 21: every valid case streamed (vxl_volume_stream_copy: bricks read
+/* every valid case streamed (vxl_volume_stream_copy: bricks read
  * on demand by the renderer's loader thread), F12 and progressive, with an
  * on-the-fly filter and a classification in rotation; the unshaded F12
  * frame equals the whole volume's in the same sparse storage (the same
@@ -923,7 +923,7 @@ int main(int argc, char **argv)
     RUN(steps);
     RUN(lighting);
     RUN(invalid_inputs);
-    RUN(streamed); /* issue 21 */
+    RUN(streamed);
 
     pthread_mutex_lock(&lock); /* the watchdog must not fire during teardown */
     for (int b = 0; b < BACKEND_N; b++) render_started[b] = 0;

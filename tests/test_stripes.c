@@ -1,5 +1,5 @@
 /* test_stripes.c - flat surfaces must shade without the voxel lattice's
- * stripes (issue 14, item 7).
+ * stripes.
  *
  * A flat iso-surface tilted against the voxel lattice, seen through an
  * orthographic camera (as Blender's orthographic views reach the library:
@@ -169,8 +169,8 @@ TEST(smooth_flat_surface_has_no_lattice_stripes)
 }
 
 /* Noise (as in every scan, here 0.004 against an edge rising 0.025 per
- * voxel): the interpolating B-spline draws the lattice (the hatching of
- * issue 14), the filter offered for scans must not. */
+ * voxel): the interpolating B-spline draws the lattice (a fine
+ * hatching), the filter offered for scans must not. */
 TEST(noisy_flat_surface_has_no_lattice_stripes_with_cubic_smooth)
 {
     double e[VXL_FILTER_COUNT];

@@ -1,4 +1,4 @@
-/* test_tiff_stream.c - issue 21: uncompressed multi-page TIFF files stream,
+/* test_tiff_stream.c - uncompressed multi-page TIFF files stream,
  * read by offset (csrc/io/tiff_layout.c decides, csrc/io/raw_source.c
  * reads). TIFFs written here (classic and BigTIFF, both byte orders, every
  * pixel type the whole read maps, several strips per page) load streamed

@@ -48,7 +48,7 @@ def main():
     bpy.ops.voxlight.import_volume(filepath=BRAIN)  # 1 mm = 0.01 units: ~1.7 units long
     brain = bpy.context.view_layer.objects.active
     brain.voxlight.preset = "mri"
-    # The brain shadows the floor and the sphere (issue 18; on by default):
+    # The brain shadows the floor and the sphere (on by default):
     # each light's direct light in the render times the volume's
     # transmittance, through Cycles light groups and the compositor.
     brain.voxlight.cast_shadows = True

@@ -2,7 +2,7 @@
 """tools/check_includes.py [--root DIR] [-I DIR ...] [--layers ORDER]
 
 Fails (exit 1) on an include cycle under csrc/, so that dependencies keep
-going one way (issue 15): from the CLI down to core.
+going one way: from the CLI down to core.
 
 It reads every `#include "..."` line of csrc/**/*.{c,h,cpp} and resolves the
 name the way the compiler does with the Makefile's flags: first the including
@@ -295,7 +295,7 @@ def main(argv=None):
         cycles = find_cycles(edges)
         if cycles and what == "modules" and not args.modules:
             # a hub header makes every module that includes it part of a
-            # cycle (renderer_internal.h did until issue 15 item 4 split
+            # cycle (renderer_internal.h did until split
             # it): listed, not failed, unless --modules
             print(f"check_includes: note: {len(cycles)} cycle(s) between modules (not failed without --modules):")
             for c, members in cycles:

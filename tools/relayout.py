@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""tools/relayout.py [--dry-run] - issue 15 item 3: csrc/ by pipeline stage.
+"""tools/relayout.py [--dry-run] - csrc/ by pipeline stage.
 
 Moves every csrc/*.{c,h,cpp} into its stage folder (git mv; a file git does
 not track yet is moved and said so), following MOVES below, and rewrites what
@@ -69,9 +69,9 @@ FOLDERS = {
     # one frame: parameters, the renderer object, the reference renderer
     "render": """render.c render.h renderer.c renderer.h renderer_internal.h reference.c reference.h reference_light.c
                  probe.c slices.c slices.h slice_plane.c""",
-    # lighting: the illumination volumes (shadows, occlusion) of issue 17
+    # lighting: the illumination volumes (shadows, occlusion)
     "light": """illumination.c illumination.h""",
-    # cutaways (issue 19): clip planes' and crop box's uniforms, cutter meshes peeled per pixel
+    # cutaways: clip planes' and crop box's uniforms, cutter meshes peeled per pixel
     "cut": """cutaway.c cutaway.h""",
     # the command-line tool (an executable, not in the library)
     "cli": """cli.c cli_cut.c cli_cut.h""",
@@ -145,7 +145,7 @@ def rewrite_makefile(text, moves):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description="csrc/ by pipeline stage (issue 15 item 3)")
+    ap = argparse.ArgumentParser(description="csrc/ by pipeline stage (item 3)")
     ap.add_argument("--dry-run", action="store_true", help="print the plan, change nothing")
     args = ap.parse_args(argv)
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

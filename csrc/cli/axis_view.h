@@ -1,4 +1,4 @@
-/* axis_view.h - the CLI's cameras of issue 19: --view x|-x|y|-y|z|-z looks
+/* axis_view.h - the CLI's cameras: --view x|-x|y|-y|z|-z looks
  * along a world axis, framing the volume's world box, and --ortho makes
  * the projection orthographic. Pure math over the box (no library state),
  * header-only so the CLI, the tests and the benchmark share it (the CLI is

@@ -12,15 +12,15 @@
 #include "clock.h"
 #include "os.h"
 
-#include "cli_cut.h"   /* --clip-plane, --crop, --no-caps (issue 19) */
+#include "cli_cut.h"   /* --clip-plane, --crop, --no-caps */
 #include "cli_environment.h" /* --environment, --environment-rotation: the World's light */
-#include "cli_modes.h" /* --mode, --iso-value, --matcap, --ortho, --view (issue 19) */
-#include "cli_labels.h" /* the labels command (issue 20) */
-#include "cli_labels_render.h" /* render --labels ... (issue 20) */
-#include "cli_overlays.h" /* render --overlay ... (issue 20) */
+#include "cli_modes.h" /* --mode, --iso-value, --matcap, --ortho, --view */
+#include "cli_labels.h" /* the labels command */
+#include "cli_labels_render.h" /* render --labels ... */
+#include "cli_overlays.h" /* render --overlay ... */
 #include "cli_channels.h" /* --channel, --channels, --channel-color, --channel-window, --channel-blend */
 #include "cli_colour.h" /* --color-source, --opacity-source, the components line */
-#include "cli_stream.h" /* --streaming, --cache-dir, first-open progress, Ctrl-C, budget split (issue 21) */
+#include "cli_stream.h" /* --streaming, --cache-dir, first-open progress, Ctrl-C, budget split */
 #include "cli_path.h" /* --samples, --sample-offset, --bounces, --seed: --shading path */
 #include "voxlight_dev.h" /* phantoms (phantom:NAME inputs) and --no-skip */
 
@@ -245,7 +245,7 @@ static int light_option(const char *val, vxl_render_params *p)
     return 0;
 }
 
-/* --light, --shading, --ambient-occlusion, --anisotropy (issue 17). Returns
+/* --light, --shading, --ambient-occlusion, --anisotropy. Returns
  * 1 if argv[*i] was one of them (*i advanced past its value), -1 on a bad
  * value, 0 otherwise. The library checks the ranges and names the field. */
 static int parse_lighting_option(int argc, char **argv, int *i, vxl_render_params *p)
@@ -344,7 +344,7 @@ static int load_input(const char *input, const vxl_load_options *lo, vxl_volume 
 static int cmd_info(int argc, char **argv)
 {
     vxl_load_options lo = {.struct_size = sizeof lo};
-    vxl_cli_stream stream; /* issue 21 */
+    vxl_cli_stream stream;
     vxl_cli_stream_init(&stream);
     char serr[512];
     const char *input = NULL;
@@ -400,7 +400,7 @@ static int cmd_info(int argc, char **argv)
     for (int r = 0; r < 4; r++)
         /* %g: microscopy voxels are 0.0002 mm, which a fixed 4 decimals would round */
         printf("  [%10.6g %10.6g %10.6g %10.6g]\n", in.affine[r], in.affine[4 + r], in.affine[8 + r], in.affine[12 + r]);
-    vxl_cli_stream_print_info(&in, stdout); /* issue 21 */
+    vxl_cli_stream_print_info(&in, stdout);
     vxl_volume_destroy(v);
     return 0;
 }
@@ -410,12 +410,12 @@ typedef struct render_args {
     vxl_render_params p;
     vxl_renderer_options ro;
     vxl_load_options lo;
-    vxl_cli_modes modes; /* issue 19 */
-    vxl_cli_cut cut;     /* issue 19 cutaways */
-    vxl_cli_labels labels; /* issue 20 label maps */
-    vxl_cli_overlays overlays; /* issue 20 overlays */
+    vxl_cli_modes modes;
+    vxl_cli_cut cut;     /* cutaways */
+    vxl_cli_labels labels; /* label maps */
+    vxl_cli_overlays overlays; /* overlays */
     vxl_cli_channels channels; /* multi-channel volumes */
-    vxl_cli_stream stream; /* issue 21 streaming */
+    vxl_cli_stream stream; /* streaming */
     vxl_cli_environment environment; /* the World's light */
 } render_args;
 
@@ -514,11 +514,11 @@ static int parse_render(int argc, char **argv, render_args *a)
         } else if ((r = vxl_cli_cut_option(argc, argv, &i, &a->cut, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err);
         } else if ((r = vxl_cli_labels_option(argc, argv, &i, &a->labels, err, sizeof err)) != 0) {
-            if (r < 0) return die("%s", err); /* issue 20 */
+            if (r < 0) return die("%s", err);
         } else if ((r = vxl_cli_overlays_option(argc, argv, &i, &a->overlays, err, sizeof err)) != 0) {
-            if (r < 0) return die("%s", err); /* issue 20 overlays */
+            if (r < 0) return die("%s", err); /* overlays */
         } else if ((r = vxl_cli_stream_option(argc, argv, &i, &a->stream, err, sizeof err)) != 0) {
-            if (r < 0) return die("%s", err); /* issue 21 */
+            if (r < 0) return die("%s", err);
         } else if ((r = vxl_cli_colour_option(argc, argv, &i, p, &a->lo, err, sizeof err)) != 0) {
             if (r < 0) return die("%s", err); /* colour volumes */
         } else if ((r = vxl_cli_channels_option(argc, argv, &i, &a->channels, &a->lo, err, sizeof err)) != 0) {
@@ -557,7 +557,7 @@ static int cmd_render(int argc, char **argv)
     vxl_renderer *r = NULL;
     float *rgba = NULL, *depth = NULL;
     int status = 1;
-    /* issue 21: --memory-budget is split between the volume and the renderer */
+    /* --memory-budget is split between the volume and the renderer */
     vxl_cli_stream_begin(&a.stream, a.input, a.ro.memory_budget_bytes, &a.lo);
     int load_rc = load_input(a.input, &a.lo, &v);
     int cancelled = vxl_cli_stream_end(&a.stream, load_rc);
@@ -573,7 +573,7 @@ static int cmd_render(int argc, char **argv)
     char merr[512];
     if (vxl_cli_modes_apply(&a.modes, r, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_cut_apply(&a.cut, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
-    if (vxl_cli_labels_apply(&a.labels, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; } /* issue 20 */
+    if (vxl_cli_labels_apply(&a.labels, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_overlays_apply(&a.overlays, r, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_environment_apply(&a.environment, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
     if (vxl_cli_channels_apply(&a.channels, &a.lo, v, &a.p, merr, sizeof merr)) { die("%s", merr); goto done; }
@@ -602,7 +602,7 @@ static int cmd_render(int argc, char **argv)
                 st.resident_bytes / 1048576.0, secs);
     if (st.storage == VXL_STORAGE_COMPRESSED)
         fprintf(stderr, "voxlight: compressed bricks decoded into the cache in %.1f ms\n", st.decode_ms);
-    vxl_cli_stream_print_stats(&a.stream, &st, stderr); /* issue 21 */
+    vxl_cli_stream_print_stats(&a.stream, &st, stderr);
     if (st.lod_level) /* never silently coarser */
         fprintf(stderr, "voxlight: LOD fallback: level %u (%ux coarser per axis): the visible bricks need %.1f MiB at full "
                 "resolution, over the memory budget of %.1f MiB\n", st.lod_level, 1u << st.lod_level,

@@ -1,4 +1,4 @@
-/* cli_cut.h - the render command's cutaway options (issue 19):
+/* cli_cut.h - the render command's cutaway options:
  * --clip-plane A,B,C,D[,T] (repeatable), --crop X0:X1,Y0:Y1,Z0:Z1 and
  * --no-caps, into a vxl_cutaway (docs/cutaways.md). */
 #ifndef VXL_CLI_CUT_H

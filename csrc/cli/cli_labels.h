@@ -1,4 +1,4 @@
-/* cli_labels.h - `voxlight labels FILE` (issue 20): a label lookup table
+/* cli_labels.h - `voxlight labels FILE`: a label lookup table
  * printed as the library reads it, so a user can check a file. */
 #ifndef VXL_CLI_LABELS_H
 #define VXL_CLI_LABELS_H

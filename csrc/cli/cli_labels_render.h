@@ -1,4 +1,4 @@
-/* cli_labels_render.h - the render command's label options (issue 20):
+/* cli_labels_render.h - the render command's label options:
  * --labels FILE, --label-lut FILE, --label-mode surface|mask|tint,
  * --hide-labels ID,..., --label-opacity ID:ALPHA,... and
  * --label-surface smooth|voxels into

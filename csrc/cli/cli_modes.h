@@ -1,4 +1,4 @@
-/* cli_modes.h - the render command's options of issue 19: --mode,
+/* cli_modes.h - the render command's options: --mode,
  * --iso-value, --matcap FILE.png, --ortho and --view AXIS (axis_view.h). */
 #ifndef VXL_CLI_MODES_H
 #define VXL_CLI_MODES_H

@@ -1,4 +1,4 @@
-/* cli_overlays.h - the render command's overlay options (issue 20):
+/* cli_overlays.h - the render command's overlay options:
  * --overlay FILE[:PRESET][:LO:HI] (repeatable, up to VXL_MAX_OVERLAYS),
  * and after each of them --overlay-blend over|add|max and
  * --overlay-opacity X for that overlay. Each file goes into its own slot

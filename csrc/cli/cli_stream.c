@@ -1,5 +1,5 @@
 /* cli_stream.c - streaming options, first-open progress, Ctrl-C and the
- * memory budget split of the command-line tool (cli_stream.h, issue 21). */
+ * memory budget split of the command-line tool (cli_stream.h). */
 #include "cli_stream.h"
 
 #include <signal.h>
@@ -141,7 +141,7 @@ uint64_t vxl_cli_stream_renderer_budget(vxl_cli_stream *s, const vxl_volume *v)
     s->streamed = vxl_volume_get_info(v, &in) == VXL_OK && in.streamed;
     if (!s->streamed)
         /* Read whole: the CPU copy is freed once it is on the GL side, so
-         * the renderer may use the whole budget (as before issue 21). */
+         * the renderer may use the whole budget (as for any volume read whole). */
         return s->total_budget;
     uint64_t total = s->total_budget ? s->total_budget : CLI_DEFAULT_BUDGET;
     return total - s->volume_budget;

@@ -1,4 +1,4 @@
-/* cli_stream.h - data larger than memory in the command-line tool (issue 21):
+/* cli_stream.h - data larger than memory in the command-line tool:
  * --streaming auto|off|on and --cache-dir DIR, the progress of a file's first
  * open on stderr, Ctrl-C during that open as a clean cancel, the split of
  * --memory-budget between the volume (CPU side) and the renderer (GL side),

@@ -1,4 +1,4 @@
-/* matcap_png.h - --matcap FILE.png for the CLI (issue 19): a PNG read into
+/* matcap_png.h - --matcap FILE.png for the CLI: a PNG read into
  * the linear RGBA floats vxl_matcap takes. */
 #ifndef VXL_MATCAP_PNG_H
 #define VXL_MATCAP_PNG_H

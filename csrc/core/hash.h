@@ -16,7 +16,7 @@ static inline uint64_t vxl_fnv(uint64_t h, const void *p, size_t n)
 }
 
 /* The same step over 8-byte words (the tail byte by byte): several times
- * faster, for arrays of megabytes hashed every frame (issue 18's occluder
+ * faster, for arrays of megabytes hashed every frame (the occluder
  * meshes when the caller gives no key). A different key from vxl_fnv's. */
 static inline uint64_t vxl_fnv_words(uint64_t h, const void *p, size_t n)
 {

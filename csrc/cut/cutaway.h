@@ -1,4 +1,4 @@
-/* cutaway.h - the GL side of a frame's cutaways (issue 19; docs/cutaways.md).
+/* cutaway.h - the GL side of a frame's cutaways (docs/cutaways.md).
  * Clip planes and the crop box are uniforms of the ray caster
  * (shaders/lib/cut.glsl narrows each ray to what they keep). Cutter meshes
  * are depth-peeled from the camera every frame: their triangles are

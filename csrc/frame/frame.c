@@ -301,7 +301,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "unknown color_space %u (0 display, 1 linear)", p->color_space);
     f->color_source = p->color_source;
     f->color_space = p->color_space;
-    rc = vxl_frame_resolve_mode(f, p, e); /* issue 19: mode, iso_value, MatCap */
+    rc = vxl_frame_resolve_mode(f, p, e); /* mode, iso_value, MatCap */
     if (rc) return rc;
     f->gradient_ref = p->gradient_ref == 0 ? 0.05f : p->gradient_ref;
     f->gradient_exp = p->gradient_exp == 0 ? 1.0f : p->gradient_exp;
@@ -324,7 +324,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     if (f->preint_size < 16 || f->preint_size > 4096)
         return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "preint_size %u must be in [16, 4096]", f->preint_size);
     f->store = p->gradient_store;
-    f->shading = !p->shading_off && vxl_mode_shades(f->mode); /* issue 19: projections have no surface */
+    f->shading = !p->shading_off && vxl_mode_shades(f->mode); /* projections have no surface */
     f->reuse = p->reuse_gradients != 0;
     f->jitter = !p->jitter_off;
     f->seed = p->jitter_seed;
@@ -347,7 +347,7 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     /* ISO opacity: the occupancy follows the iso-surface instead of the
      * table (bricks.c), conservatively for filters without a gradient bound. */
     f->skip = !p->no_skip;
-    f->progressive = p->progressive != 0; /* issue 21 */
+    f->progressive = p->progressive != 0;
     f->depth_threshold = p->depth_threshold == 0 ? 0.5f : p->depth_threshold;
     rc = check_float(e, "depth_threshold", f->depth_threshold, 1e-6f, 1);
     if (rc) return rc;
@@ -357,9 +357,9 @@ int vxl_frame_resolve(vxl_frame *f, const vxl_render_params *pin, const vxl_volu
     if (!rc) rc = resolve_lights(f, p, e);
     if (!rc) rc = vxl_frame_resolve_lighting(f, p, e);
     if (!rc) rc = vxl_frame_resolve_path(f, p, e);
-    if (!rc) rc = vxl_frame_resolve_scene_shadows(f, p, e); /* issue 18 */
-    if (!rc) rc = vxl_frame_cut_resolve(&f->cut, p, f->model, f->technique, e); /* issue 19 cutaways */
-    if (!rc) rc = vxl_frame_resolve_labels(f, p, e); /* issue 20 labels */
+    if (!rc) rc = vxl_frame_resolve_scene_shadows(f, p, e);
+    if (!rc) rc = vxl_frame_cut_resolve(&f->cut, p, f->model, f->technique, e); /* cutaways */
+    if (!rc) rc = vxl_frame_resolve_labels(f, p, e); /* labels */
     if (!rc) rc = vxl_frame_resolve_tf(f, p, g, e);
     if (rc) vxl_frame_free(f);
     return rc;
@@ -369,7 +369,7 @@ void vxl_frame_free(vxl_frame *f)
 {
     free(f->tf_copy);
     f->tf_copy = NULL;
-    vxl_frame_overlays_free(f); /* issue 20 */
+    vxl_frame_overlays_free(f);
     vxl_frame_channels_free(f);
 }
 

@@ -24,7 +24,7 @@ struct vxl_volume;
 /* The geometry and value mapping a frame needs of a CPU volume. */
 vxl_volume_geom vxl_volume_geom_of(const struct vxl_volume *v);
 
-/* One overlay of a frame (issue 20), resolved against its volume's geometry. */
+/* One overlay of a frame, resolved against its volume's geometry. */
 typedef struct vxl_frame_overlay {
     uint32_t slot, blend, interpolation; /* VXL_BLEND_*, VXL_INTERP_* */
     uint32_t shading;           /* lit (the frame shades and the overlay's shading_off is 0) */
@@ -73,7 +73,7 @@ typedef struct vxl_frame {
     float material[4];
     int light_count;
     float light_pos[VXL_MAX_LIGHTS][4], light_color[VXL_MAX_LIGHTS][3];
-    /* Lighting beyond Phong (issue 17, frame_lighting.c; the formulas are
+    /* Lighting beyond Phong (frame_lighting.c; the formulas are
      * voxlight.h's VXL_SHADING_*). Per light i < light_count: */
     uint32_t shading_model;     /* VXL_SHADING_* */
     float ao_radius;            /* voxels; 0 = no occlusion */
@@ -90,7 +90,7 @@ typedef struct vxl_frame {
     float light_spot_blend[VXL_MAX_LIGHTS];   /* spot_blend, 0..1 (0 = hard edge) */
     float light_size[VXL_MAX_LIGHTS];         /* directional: angular diameter (radians); point:
                                                  radius (world units); 0 = hard shadows */
-    /* issue 18 scene shadows (frame_scene.c): the scene's occluder meshes,
+    /* scene shadows (frame_scene.c): the scene's occluder meshes,
      * validated (indices in range, vertices finite); none when
      * occluder_triangle_count is 0. The arrays are the caller's. */
     const float *occluder_vertices;      /* world xyz per vertex */
@@ -100,11 +100,11 @@ typedef struct vxl_frame {
     uint64_t occluder_key;               /* the caller's version, or the arrays' hash; never 0 with occluders */
     float early_termination, depth_threshold;
     int skip;                   /* empty-space skipping and the screen-space bound */
-    uint32_t progressive;       /* issue 21: 1 = draw streamed volumes from what is resident (docs/streaming.md) */
+    uint32_t progressive;       /* 1 = draw streamed volumes from what is resident (docs/streaming.md) */
     const float *scene_depth;
     float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
     float *tf_copy;             /* owned when the caller gave a table */
-    /* issue 19 modes (frame_mode.c): the projection or iso-surface, and the
+    /* modes (frame_mode.c): the projection or iso-surface, and the
      * MatCap when one is given and shading reads it (DVR with shading, ISO). */
     uint32_t mode;              /* VXL_MODE_* */
     uint32_t minip_floor_on;    /* MinIP skips samples below minip_floor_pos */
@@ -112,10 +112,10 @@ typedef struct vxl_frame {
     const float *matcap_rgba;   /* NULL: the material and lights */
     uint32_t matcap_width, matcap_height;
     uint64_t matcap_key;        /* the caller's key; 0: the GL side hashes the pixels */
-    /* issue 19 cutaways (frame_cut.c): clip planes and crop box in voxel
+    /* cutaways (frame_cut.c): clip planes and crop box in voxel
      * space, the cutters checked; cut.any is 0 without params.cutaway. */
     vxl_frame_cut cut;
-    /* issue 20 labels (frame_labels.c): on is 0 without params.labels. */
+    /* labels (frame_labels.c): on is 0 without params.labels. */
     struct {
         int on;
         uint32_t mode;                  /* VXL_LABEL_MODE_* */
@@ -132,7 +132,7 @@ typedef struct vxl_frame {
         float strength, rotation_deg; /* rotation in (-360, 360) */
         uint64_t key;               /* the map, its size, strength and rotation; never 0 when on */
     } env;
-    /* issue 20 overlays (frame_overlays.c): count is 0 without params.overlays. */
+    /* overlays (frame_overlays.c): count is 0 without params.overlays. */
     struct {
         uint32_t count;
         vxl_frame_overlay ov[VXL_MAX_OVERLAYS];
@@ -208,12 +208,12 @@ int vxl_frame_path_check(const vxl_frame *f, vxl_err *e);
 /* Whether mode (VXL_MODE_*) shades: DVR and ISO do, the projections have no surface. */
 static inline int vxl_mode_shades(uint32_t mode) { return mode == VXL_MODE_DVR || mode == VXL_MODE_ISO; }
 
-/* Validates the issue 19 mode fields of p (mode, iso_value, matcap) and how
+/* Validates the mode fields of p (mode, iso_value, matcap) and how
  * the mode combines with classify, gradient_opacity and technique, into f.
  * Part of vxl_frame_resolve (frame_mode.c). */
 int vxl_frame_resolve_mode(vxl_frame *f, const vxl_render_params *p, vxl_err *e);
 
-/* issue 20 labels: validates p->labels (mode, reserved, entries NULL with a
+/* labels: validates p->labels (mode, reserved, entries NULL with a
  * count, colours NaN or outside [0, 1], ids outside [0, VXL_MAX_LABEL_ID],
  * duplicate ids) into f->labels; needs f->mode and f->technique (labels take
  * the ray caster's DVR mode). SURFACE turns empty-space skipping off: the
@@ -228,7 +228,7 @@ static inline const float *vxl_label_material(const vxl_label_entry *en, uint32_
     return en->material;
 }
 
-/* issue 20 overlays: validates p->overlays (count <= VXL_MAX_OVERLAYS, the
+/* overlays: validates p->overlays (count <= VXL_MAX_OVERLAYS, the
  * stride, each slot in range, listed once and set (geoms[slot] non-NULL:
  * the overlay volume's geometry, else VXL_ERR_STATE), blend, interpolation,
  * reserved, a finite invertible model; DVR with the ray caster only, not
@@ -263,7 +263,7 @@ void vxl_channel_default_color(uint32_t c, float rgb[3]);
  * owned). Part of vxl_frame_resolve; overlays resolve theirs with it. */
 int vxl_frame_resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e);
 
-/* Validates p->scene_shadows (issue 18) into f's occluder fields: NULL
+/* Validates p->scene_shadows into f's occluder fields: NULL
  * arrays with counts, indices out of range, vertices not finite and map
  * sizes out of range fail naming the field. Part of vxl_frame_resolve. */
 int vxl_frame_resolve_scene_shadows(vxl_frame *f, const vxl_render_params *p, vxl_err *e);

@@ -1,4 +1,4 @@
-/* frame_cut.c - params.cutaway (issue 19) validated and resolved into the
+/* frame_cut.c - params.cutaway validated and resolved into the
  * frame: every field checked with a message naming it, clip planes and the
  * crop box moved into voxel space (frame_cut.h), cutters checked (counts,
  * arrays, indices, finite vertices). */

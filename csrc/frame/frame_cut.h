@@ -1,4 +1,4 @@
-/* frame_cut.h - a frame's cutaways (issue 19, voxlight.h's vxl_cutaway)
+/* frame_cut.h - a frame's cutaways (voxlight.h's vxl_cutaway)
  * resolved against the volume: clip planes and the crop box in voxel space,
  * where the ray caster marches, and the cutter meshes checked. Pure CPU;
  * the reference renderer clips its rays with the same numbers

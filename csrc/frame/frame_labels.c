@@ -1,4 +1,4 @@
-/* frame_labels.c - issue 20: params.labels checked into f->labels (frame.h).
+/* frame_labels.c - params.labels checked into f->labels (frame.h).
  * The table is read where the caller keeps it (the frame lives for one
  * render call); its hash keys the GL side's table texture, so hiding or
  * recolouring a label re-uploads only that table. */

@@ -1,5 +1,5 @@
 /* frame_lighting.c - validates and resolves the lighting fields of
- * vxl_render_params (issue 17) into a vxl_frame: the shading model, the
+ * vxl_render_params into a vxl_frame: the shading model, the
  * lights' shapes (spot cones, softness), occlusion and anisotropy. */
 #include <math.h>
 #include <string.h>

@@ -1,4 +1,4 @@
-/* frame_mode.c - the render mode (issue 19, voxlight.h's VXL_MODE_*) and the
+/* frame_mode.c - the render mode (voxlight.h's VXL_MODE_*) and the
  * MatCap of a frame: validated here so the GL side only draws.
  *
  * What combines with what. The projections (MIP, MINIP, AVERAGE) classify

@@ -1,4 +1,4 @@
-/* frame_overlays.c - issue 20: params.overlays checked into f->overlays
+/* frame_overlays.c - params.overlays checked into f->overlays
  * (frame.h). Each overlay's transfer function and window are resolved
  * against its own volume exactly as the base volume's are
  * (vxl_frame_resolve_tf); its classification key keys the GL side's

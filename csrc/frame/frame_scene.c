@@ -1,4 +1,4 @@
-/* frame_scene.c - validates vxl_render_params.scene_shadows (issue 18): the
+/* frame_scene.c - validates vxl_render_params.scene_shadows: the
  * scene's opaque meshes that shadow the volume. Every index and vertex is
  * checked here, on the CPU, before anything reaches the GL side: a bad
  * array from a Blender scene must give an error naming the field, never a

@@ -26,12 +26,12 @@ typedef enum vxl_holder {
     VXL_HOLD_BSPLINE,    /* cubic B-spline coefficients (texture, or pool + page table) */
     VXL_HOLD_CLASSIFIED, /* the pre-classified volume (RGBA8) */
     VXL_HOLD_ILLUMINATION, /* the illumination volumes: extinction, the lights' transmittance, occlusion */
-    VXL_HOLD_SCENE_SHADOWS, /* issue 18: the lights' shadow maps of the scene's occluders, transmittance images */
-    VXL_HOLD_MATCAP,     /* issue 19: the MatCap image */
-    VXL_HOLD_MODE_BRICKS, /* issue 19: the brick min-max grid as a texture (MIP, MinIP, ISO skipping) */
-    VXL_HOLD_CUTAWAY,    /* issue 19: the cutters' per-pixel crossing layers and their vertex buffer */
-    VXL_HOLD_LABELS,     /* issue 20: the label volume (R16UI, dense) and the per-label table */
-    VXL_HOLD_OVERLAYS,   /* issue 20: the overlay volumes (dense), their transfer functions and skipping maps */
+    VXL_HOLD_SCENE_SHADOWS, /* the lights' shadow maps of the scene's occluders, transmittance images */
+    VXL_HOLD_MATCAP,     /* the MatCap image */
+    VXL_HOLD_MODE_BRICKS, /* the brick min-max grid as a texture (MIP, MinIP, ISO skipping) */
+    VXL_HOLD_CUTAWAY,    /* the cutters' per-pixel crossing layers and their vertex buffer */
+    VXL_HOLD_LABELS,     /* the label volume (R16UI, dense) and the per-label table */
+    VXL_HOLD_OVERLAYS,   /* the overlay volumes (dense), their transfer functions and skipping maps */
     VXL_HOLD_COLOUR,     /* a colour volume's own colour (RGB8, dense, 3 bytes a voxel: colour/colour.c) */
     VXL_HOLD_PATH_MAJORANT, /* the PATH model's extinction majorant per skipping brick (R32F, render/path.c) */
     VXL_HOLD_CHANNELS,   /* a multi-channel volume's channels (16 bits each, dense), tables and union skip map: channels/channels.c */

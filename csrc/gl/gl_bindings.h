@@ -24,15 +24,15 @@
 #define VXL_CPAGE_UNIT 12         /* bricked storage: the coefficient pool's page table */
 #define VXL_ILLUMINATION_UNIT 13  /* raycast, illumination.comp: the lights' transmittance and the occlusion, stacked */
 #define VXL_EXTINCTION_UNIT 14    /* illumination.comp: the optical depth per cell the lights and occlusion read */
-#define VXL_SHADOW_MAP_UNIT 15    /* illumination.comp (pass 3), scene_transmittance.comp: the lights' shadow maps (issue 18) */
-#define VXL_MATCAP_UNIT 16        /* raycast: the MatCap image (issue 19, render/matcap.c) */
-#define VXL_LABELS_UNIT 18        /* raycast: the label volume (R16UI, issue 20, labels/labels.c) */
-#define VXL_LABEL_TABLE_UNIT 19   /* raycast: the per-label colour table (issue 20) */
+#define VXL_SHADOW_MAP_UNIT 15    /* illumination.comp (pass 3), scene_transmittance.comp: the lights' shadow maps */
+#define VXL_MATCAP_UNIT 16        /* raycast: the MatCap image (render/matcap.c) */
+#define VXL_LABELS_UNIT 18        /* raycast: the label volume (R16UI, labels/labels.c) */
+#define VXL_LABEL_TABLE_UNIT 19   /* raycast: the per-label colour table */
 #define VXL_ENVIRONMENT_UNIT 22   /* raycast: the World's irradiance volume (RGBA16F, light/illumination.c) */
 #define VXL_LABEL_MARGIN_UNIT 20  /* raycast: per label voxel, its margin inside its own label (R8, labels/label_margin.c) */
 #define VXL_COLOUR_UNIT 21        /* raycast, slices, slice_plane.comp: a colour volume's own colour (RGB8, colour/colour.c) */
-#define VXL_LABEL_BRICKS_UNIT 23  /* raycast: per label brick, the visible-label distance map and uniform id (issue 20, labels/label_bricks.c) */
-/* Overlays (issue 20, overlay/overlays.c) take three units each from 32 up (within GL 4.5's 80
+#define VXL_LABEL_BRICKS_UNIT 23  /* raycast: per label brick, the visible-label distance map and uniform id (labels/label_bricks.c) */
+/* Overlays (overlay/overlays.c) take three units each from 32 up (within GL 4.5's 80
  * combined units), so the units below stay free for the other rooms. */
 #define VXL_OVERLAY_VOLUME_UNIT 32   /* raycast: overlay k's volume on unit 32 + k, k < VXL_MAX_OVERLAYS */
 #define VXL_OVERLAY_TF_UNIT 35       /* raycast: overlay k's transfer function on unit 35 + k */
@@ -41,7 +41,7 @@
 #define VXL_CHANNEL_DATA_UNIT 41     /* raycast: channel group g's texture (four 16-bit channels) on unit 41 + g, g < 2 */
 #define VXL_CHANNEL_TF_UNIT 43       /* raycast: channel c's transfer function on unit 43 + c, c < VXL_MAX_CHANNELS */
 #define VXL_CHANNEL_DISTANCE_UNIT 51 /* raycast: the drawn channels' union brick distance map */
-#define VXL_BRICK_MINMAX_UNIT 17  /* raycast: the brick min-max grid the modes skip by (issue 19, render/mode_bricks.c) */
+#define VXL_BRICK_MINMAX_UNIT 17  /* raycast: the brick min-max grid the modes skip by (render/mode_bricks.c) */
 #define VXL_MAJORANT_UNIT 24      /* path.frag: the extinction majorant per skipping brick (render/path.c) */
 
 /* The ray caster reads every unit above at once, so no two may share a
@@ -84,7 +84,7 @@ _Static_assert(VXL_UNITS_SUM_ == VXL_UNITS_UNION_, "two texture units share a nu
 #define VXL_SSBO_PROBE_POINTS 0   /* probe.comp: the points to probe */
 #define VXL_SSBO_PROBE_RESULTS 1  /* probe.comp: what it measured */
 #define VXL_SSBO_STATS 2          /* raycast.frag: the frame's sample counts */
-#define VXL_SSBO_CUT_LAYERS 3     /* raycast, cut_peel.frag: the cutter crossings per pixel (issue 19, cut/cutaway.c) */
+#define VXL_SSBO_CUT_LAYERS 3     /* raycast, cut_peel.frag: the cutter crossings per pixel (cut/cutaway.c) */
 #define VXL_SSBO_BRICK_LIST 2     /* gradients.comp (bricked), decode_bricks.comp: per slot, the brick (or code slot) to derive */
 
 #define VXL_GLSL_STR_(x) #x

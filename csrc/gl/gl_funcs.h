@@ -72,8 +72,8 @@
     X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                            \
     X(PFNGLDISPATCHCOMPUTEPROC, DispatchCompute)                              \
     X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                  \
-    X(PFNGLCLEARBUFFERSUBDATAPROC, ClearBufferSubData) /* issue 19: cut/cutaway.c */ \
-    /* issue 18: occluder meshes rasterised into shadow maps (light/shadow_maps.c) */ \
+    X(PFNGLCLEARBUFFERSUBDATAPROC, ClearBufferSubData) /* cut/cutaway.c */ \
+    /* occluder meshes rasterised into shadow maps (light/shadow_maps.c) */ \
     X(PFNGLDRAWELEMENTSPROC, DrawElements)                                    \
     X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)                      \
     X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)              \
@@ -81,7 +81,7 @@
     X(PFNGLDEPTHFUNCPROC, DepthFunc)                                          \
     X(PFNGLDEPTHMASKPROC, DepthMask)                                          \
     X(PFNGLUNIFORM1FVPROC, Uniform1fv)                                        \
-    X(PFNGLCOPYIMAGESUBDATAPROC, CopyImageSubData) /* issue 21: a streamed pool grown keeps its bricks */
+    X(PFNGLCOPYIMAGESUBDATAPROC, CopyImageSubData) /* a streamed pool grown keeps its bricks */
 
 typedef struct vxl_gl {
 #define VXL_GL_MEMBER(type, name) type name;

@@ -14,9 +14,9 @@ static const char *const filter_defines[VXL_FILTER_COUNT] = {
 /* flags bits for RAYCAST: 1 shading, 2 reuse gradients, bits 2-3 the
  * classify mode, bits 4-5 the gradient-opacity mode, bit 6 (also PROBE)
  * bricked storage, bit 7 compressed storage filtered in the compressed
- * domain, bits 8-9 the shading model (issue 17), bits 10-12 the render
+ * domain, bits 8-9 the shading model, bits 10-12 the render
  * mode, bit 13 a MatCap, bit 14 convex cutaways (clip planes, crop box),
- * bit 15 cutter meshes (issue 19: VXL_FLAG_* in gpu.h); for GRAD_STORE: the store format; for DECODE_BRICKS: the cache's
+ * bit 15 cutter meshes (VXL_FLAG_* in gpu.h); for GRAD_STORE: the store format; for DECODE_BRICKS: the cache's
  * bytes per voxel - 1 */
 static const char *const store_formats[] = {"rgba8_snorm", "rgba16f", "rgba32f"};
 static const char *const cache_formats[] = {"r8", "r16", "r32f", "r32f"};
@@ -92,23 +92,23 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
                                                              : "");
         if (flags & VXL_FLAG_DATA_COLOUR) /* a colour volume's own colour (colour/colour.c) */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define DATA_COLOUR 1\n");
-        if ((flags >> 8) & 3) /* issue 17: shadowed / scatter; PHONG compiles as before */
+        if ((flags >> 8) & 3) /* shadowed / scatter; PHONG compiles as before */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define SHADING_MODEL %u\n",
                      (flags >> 8) & 3);
         if (flags & VXL_FLAG_ENVIRONMENT) /* the World's light replaces the ambient term */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define ENVIRONMENT 1\n");
-        if (kind == VXL_PROG_RAYCAST) /* issue 19: the mode, the MatCap and the cutaways */
+        if (kind == VXL_PROG_RAYCAST) /* the mode, the MatCap and the cutaways */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define MODE %u\n%s%s%s",
                      (flags >> VXL_FLAG_MODE_SHIFT) & 7, (flags & VXL_FLAG_MATCAP) ? "#define MATCAP 1\n" : "",
                      (flags & VXL_FLAG_CUT_CONVEX) ? "#define CUT_CONVEX 1\n" : "",
                      (flags & VXL_FLAG_CUT_CUTTERS) ? "#define CUT_CUTTERS 1\n" : "");
-        if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* issue 20: label mode + 1 */
+        if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_LABELS_SHIFT) & 3) /* label mode + 1 */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define LABELS %u\n%s",
                      (flags >> VXL_FLAG_LABELS_SHIFT) & 3, (flags & VXL_FLAG_LABEL_VOXELS) ? "#define LABEL_VOXELS 1\n" : "");
         if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_CHANNELS_SHIFT) & 3) /* a multi-channel volume's texture groups */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define CHANNEL_GROUPS %u\n",
                      (flags >> VXL_FLAG_CHANNELS_SHIFT) & 3);
-        if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3) /* issue 20: the number of overlays */
+        if (kind == VXL_PROG_RAYCAST && (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3) /* the number of overlays */
             snprintf(defines + strlen(defines), sizeof defines - strlen(defines), "#define OVERLAYS %u\n",
                      (flags >> VXL_FLAG_OVERLAYS_SHIFT) & 3);
         rc = compile(g, GL_VERTEX_SHADER, kind == VXL_PROG_SLICES ? "render/slices.vert" : "render/raycast.vert", NULL, &a);
@@ -177,7 +177,7 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
                  (flags & VXL_FLAG_DATA_COLOUR) ? "#define DATA_COLOUR 1\n" : "");
         rc = compile(g, GL_COMPUTE_SHADER, "compute/slice_plane.comp", defines, &a);
         return rc ? rc : link(g, a, 0, out);
-    case VXL_PROG_SHADOW_MAP: /* issue 18: depth only */
+    case VXL_PROG_SHADOW_MAP: /* depth only */
         rc = compile(g, GL_VERTEX_SHADER, "render/shadow_map.vert", NULL, &a);
         if (rc) return rc;
         rc = compile(g, GL_FRAGMENT_SHADER, "render/shadow_map.frag", NULL, &b);
@@ -186,10 +186,10 @@ static int build(vxl_gpu *g, uint32_t kind, uint32_t filter, uint32_t flags, GLu
             return rc;
         }
         return link(g, a, b, out);
-    case VXL_PROG_SCENE_TRANSMITTANCE: /* issue 18 */
+    case VXL_PROG_SCENE_TRANSMITTANCE:
         rc = compile(g, GL_COMPUTE_SHADER, "compute/scene_transmittance.comp", NULL, &a);
         return rc ? rc : link(g, a, 0, out);
-    case VXL_PROG_CUT_PEEL: /* issue 19: cut/cutaway.c */
+    case VXL_PROG_CUT_PEEL: /* cut/cutaway.c */
         rc = compile(g, GL_VERTEX_SHADER, "render/cut_peel.vert", NULL, &a);
         if (!rc && (rc = compile(g, GL_FRAGMENT_SHADER, "render/cut_peel.frag", "#define CUT_PEEL 1\n", &b)))
             g->gl.DeleteShader(a);

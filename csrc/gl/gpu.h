@@ -34,12 +34,12 @@
 #define VXL_PROG_DECODE_BRICKS 12 /* flags: the cache's bytes per voxel - 1 */
 #define VXL_PROG_SLICES 13 /* the slicing comparison modes (render/slices.c); flags as RAYCAST */
 #define VXL_PROG_ILLUMINATION 14 /* light/illumination.c: flags & 3 the pass, plus the sample flags */
-#define VXL_PROG_CUT_PEEL 24 /* cut/cutaway.c (issue 19): cutter meshes peeled into per-pixel crossings */
+#define VXL_PROG_CUT_PEEL 24 /* cut/cutaway.c: cutter meshes peeled into per-pixel crossings */
 /* kinds take 5 bits of the program cache's key (gl_util.c): at most 31 */
-#define VXL_PROG_SHADOW_MAP 20 /* light/shadow_maps.c (issue 18): occluders rasterised from a light (depth only) */
-#define VXL_PROG_SCENE_TRANSMITTANCE 21 /* light/transmittance.c (issue 18): scene points' transmittance to a light */
+#define VXL_PROG_SHADOW_MAP 20 /* light/shadow_maps.c: occluders rasterised from a light (depth only) */
+#define VXL_PROG_SCENE_TRANSMITTANCE 21 /* light/transmittance.c: scene points' transmittance to a light */
 #define VXL_PROG_PATH 25 /* render/path.c: the PATH shading model's tracer (render/path.frag); flags as RAYCAST */
-#define VXL_PROG_SLICE_PLANE 16 /* render/slice_plane.c (issue 19): flags & 3 the interpolation, plus the sample flags */
+#define VXL_PROG_SLICE_PLANE 16 /* render/slice_plane.c: flags & 3 the interpolation, plus the sample flags */
 
 /* Program flags the storage sets on shaders that sample the volume. */
 #define VXL_FLAG_PAGED 64u /* program flag: sample through the page table */
@@ -47,14 +47,14 @@
 /* with PAGED: the streamed storage's page table, whose entries may stand in for a coarser level's brick
  * (PAGED_MIXED, storage_streamed.c) */
 #define VXL_FLAG_PAGED_MIXED (1u << 20)
-/* Ray caster program flags of issue 19 (gl_util.c turns them into defines). */
+/* Ray caster program flags (gl_util.c turns them into defines). */
 #define VXL_FLAG_MODE_SHIFT 10u        /* bits 10-12: VXL_MODE_* (MODE) */
 #define VXL_FLAG_MATCAP (1u << 13)     /* MATCAP: shading reads the MatCap */
 #define VXL_FLAG_CUT_CONVEX (1u << 14) /* CUT_CONVEX: clip planes and the crop box narrow the ray */
 #define VXL_FLAG_CUT_CUTTERS (1u << 15) /* CUT_CUTTERS: cutter meshes remove depth intervals */
-/* Ray caster program flag of issue 20 (labels/labels.c): bits 16-17 hold the label mode + 1 (LABELS); 0 none. */
+/* Ray caster program flag (labels/labels.c): bits 16-17 hold the label mode + 1 (LABELS); 0 none. */
 #define VXL_FLAG_LABELS_SHIFT 16u
-/* Ray caster program flag of issue 20 (overlay/overlays.c): bits 18-19 hold the number of overlays (OVERLAYS); 0 none. */
+/* Ray caster program flag (overlay/overlays.c): bits 18-19 hold the number of overlays (OVERLAYS); 0 none. */
 #define VXL_FLAG_OVERLAYS_SHIFT 18u
 /* With the LABELS bits: label boundaries as the voxels' faces (LABEL_VOXELS), not smooth. */
 #define VXL_FLAG_LABEL_VOXELS (1u << 21)

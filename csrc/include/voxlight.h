@@ -58,7 +58,7 @@ extern "C" {
 #define VXL_ERR_GL 7               /* an OpenGL call failed */
 #define VXL_ERR_SHADER 8           /* a shader failed to compile or link */
 #define VXL_ERR_STATE 9            /* call made in the wrong state (e.g. no volume) */
-#define VXL_ERR_CANCELLED 10       /* the caller's progress callback asked to stop (issue 21) */
+#define VXL_ERR_CANCELLED 10       /* the caller's progress callback asked to stop */
 
 /* ---- data types of voxels ---- */
 #define VXL_DTYPE_U8 1
@@ -170,7 +170,7 @@ typedef struct vxl_load_options {
      * 0-based index in vxl_dicom_list_series order, as a string. NULL or ""
      * = the only series (an error listing them when there are several). */
     const char *series;
-    /* Appended (issue 21, data larger than memory); read only when
+    /* Appended (data larger than memory); read only when
      * struct_size covers them. A streamed volume is described by a brick
      * source that reads bricks on demand (docs/streaming.md): its voxels are
      * never all in memory at once, on the CPU side or the GL side.
@@ -300,7 +300,7 @@ typedef struct vxl_volume_info {
     /* Appended: written only when the caller's struct_size covers them. */
     uint32_t frame_count;       /* volumes in a 4D input; 1 for 3D */
     uint32_t frame;             /* which of them this volume is */
-    /* Appended (issue 21). */
+    /* Appended. */
     uint32_t streamed;          /* 1: read on demand from a brick source (vxl_load_options.streaming) */
     uint32_t level_count;       /* resolution levels the source offers (1 = full only) */
     uint64_t resident_bytes;    /* CPU bytes the volume holds now (whole: its voxels; streamed: its
@@ -362,7 +362,7 @@ VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint3
 
 /* ------------------------------------------------------- label tables */
 
-/* One entry of a label lookup table (issue 20): what a label id of a
+/* One entry of a label lookup table: what a label id of a
  * segmentation is called and how it looks. */
 typedef struct vxl_label_entry {
     uint32_t struct_size;
@@ -370,7 +370,7 @@ typedef struct vxl_label_entry {
     float color[4];             /* straight RGBA in [0, 1]; alpha 1 unless the file gives one */
     uint32_t visible;           /* 1 unless the file hides it (ITK-SNAP's VIS column) */
     char name[64];              /* UTF-8, NUL-terminated, cut to fit; "" when the file names none */
-    /* Appended (issue 20), read only when struct_size covers them: the
+    /* Appended, read only when struct_size covers them: the
      * label's own material when has_material is 1 (ambient, diffuse,
      * specular, shininess as params' material: >= 0 each, shininess > 0),
      * used wherever the label's samples are lit (SURFACE, and MASK/TINT
@@ -396,10 +396,10 @@ typedef struct vxl_renderer_options {
     uint64_t memory_budget_bytes; /* GPU storage budget; 0 = 2 GiB */
     const char *shader_dir;       /* developer override: load shaders from disk.
                                      NULL = embedded (env VOXLIGHT_SHADER_DIR overrides) */
-    /* Appended (issue 8); read only when struct_size covers them. */
+    /* Appended; read only when struct_size covers them. */
     uint32_t storage;             /* VXL_STORAGE_*; 0 = AUTO */
     uint32_t page_brick;          /* voxels per brick edge when bricked: 8, 16, 32 or 64; 0 = 32 */
-    /* Appended (issue 8). Developer hook (voxlight_dev.h): leave 0. */
+    /* Appended. Developer hook (voxlight_dev.h): leave 0. */
     uint32_t compressed_domain;
 } vxl_renderer_options;
 
@@ -420,7 +420,7 @@ typedef struct vxl_light {
     float intensity;    /* 0 = 1 */
 } vxl_light;
 
-/* How a light is shaped (issue 17). params.light_shapes[i] goes with
+/* How a light is shaped. params.light_shapes[i] goes with
  * params.lights[i]; all zero is a plain light (today's). The array's stride
  * is light_shapes[0].struct_size. */
 typedef struct vxl_light_shape {
@@ -436,7 +436,7 @@ typedef struct vxl_light_shape {
                                 units, Blender's shadow_soft_size); 0 = hard */
 } vxl_light_shape;
 
-/* Shading models (issue 17), params.shading_model. With T_i the transmittance
+/* Shading models, params.shading_model. With T_i the transmittance
  * from the sample to light i through the classified volume (exp of minus the
  * optical depth, opacity per voxel of path as the ray caster composites it;
  * the path ends where it leaves the volume, or at a point light's position),
@@ -504,7 +504,7 @@ typedef struct vxl_light_shape {
 VXL_API const char *vxl_shading_model_name(uint32_t model); /* "phong", "shadowed", "scatter", "path" */
 VXL_API int vxl_shading_model_from_name(const char *name, uint32_t *out);
 
-/* Rendering techniques (issue 16), params.technique. The slice-based ones are
+/* Rendering techniques, params.technique. The slice-based ones are
  * comparison modes for the benchmark (Engel et al., Real-Time Volume Graphics,
  * ch. 3), with the ray caster's classification and shading. */
 #define VXL_TECHNIQUE_RAYCAST 0
@@ -514,7 +514,7 @@ VXL_API int vxl_shading_model_from_name(const char *name, uint32_t *out);
 VXL_API const char *vxl_technique_name(uint32_t technique); /* "raycast", "slices2d", "slices3d" */
 VXL_API int vxl_technique_from_name(const char *name, uint32_t *out);
 
-/* Render modes (issue 19), params.mode. The projections classify the value
+/* Render modes, params.mode. The projections classify the value
  * they project: colour = the transfer function's colour at it (after the
  * window), opacity = its opacity (times opacity_scale, clamped to 1) as one
  * opaque-or-not layer, not per voxel of path; depth = where the projected
@@ -540,7 +540,7 @@ VXL_API int vxl_technique_from_name(const char *name, uint32_t *out);
 VXL_API const char *vxl_mode_name(uint32_t mode); /* "dvr", "mip", "minip", "average", "iso" */
 VXL_API int vxl_mode_from_name(const char *name, uint32_t *out);
 
-/* Cutaways (issue 19), params.cutaway. A sample is kept when it is inside
+/* Cutaways, params.cutaway. A sample is kept when it is inside
  * every clip plane's kept region, inside the crop box (when there is one)
  * and not removed by any cutter; the ray caster, every mode, skipping and
  * early termination see only kept samples. */
@@ -586,7 +586,7 @@ typedef struct vxl_cutaway {
     uint32_t reserved;          /* must be 0 */
 } vxl_cutaway;
 
-/* A MatCap (issue 19), params.matcap: a picture of a lit sphere that fills
+/* A MatCap, params.matcap: a picture of a lit sphere that fills
  * the image. With one, the shaded colour of a sample (DVR with shading on,
  * ISO) is its classified colour times the MatCap's colour at the view-space
  * normal: texel (0.5 + 0.5 n.x, 0.5 + 0.5 n.y) of the image (linear, row 0
@@ -600,7 +600,7 @@ typedef struct vxl_matcap {
                                    not uploaded again; 0: the library hashes the pixels */
 } vxl_matcap;
 
-/* Scene shadows (issue 18), params.scene_shadows: the scene's opaque meshes
+/* Scene shadows, params.scene_shadows: the scene's opaque meshes
  * as occluders between the lights and the volume. For each light the
  * library rasterises them as seen from the light into a shadow map and
  * multiplies the light's transmittance T_i (see the shading models) by the
@@ -619,7 +619,7 @@ typedef struct vxl_scene_shadows {
                                         unchanged, no rebuild); 0: the library hashes them */
 } vxl_scene_shadows;
 
-/* Label maps (issue 20), params.labels with a label volume set by
+/* Label maps, params.labels with a label volume set by
  * vxl_renderer_set_labels. Label ids are never interpolated as numbers.
  * Boundaries (`boundary`):
  *   SMOOTH (0, the default) each label's indicator (1 on its voxels)
@@ -661,7 +661,7 @@ typedef struct vxl_label_style {
 #define VXL_LABEL_BOUNDARY_SMOOTH 0 /* smoothed per label, no voxel stairs */
 #define VXL_LABEL_BOUNDARY_VOXELS 1 /* the raw voxels' faces */
 
-/* Overlays (issue 20): up to VXL_MAX_OVERLAYS more volumes in the same ray
+/* Overlays: up to VXL_MAX_OVERLAYS more volumes in the same ray
  * march as the renderer's volume, each set with vxl_renderer_set_overlay
  * and drawn when params.overlays lists its slot. Each has its own affine
  * (placement), transfer function, window, interpolation and GL storage;
@@ -857,32 +857,32 @@ typedef struct vxl_render_params {
     float gradient_exp;              /* 0 = 1 */
     float iso_value;                 /* data units (gradient_opacity ISO, mode ISO) */
     float iso_thickness;             /* voxels; 0 = 1 (ISO) */
-    /* lighting (issue 17): see VXL_SHADING_* */
+    /* lighting: see VXL_SHADING_* */
     uint32_t shading_model;          /* VXL_SHADING_* */
     const vxl_light_shape *light_shapes; /* NULL, or light_count entries (stride: their struct_size) */
     float ambient_occlusion;         /* occlusion radius, voxels; 0 = off */
     float occlusion_strength;        /* 0..1; 0 = 1 */
     float anisotropy;                /* Henyey-Greenstein g in (-1, 1), SCATTER */
     uint32_t illumination_size;      /* cells along the illumination volumes' longest side; 0 = automatic */
-    /* technique (issue 16): VXL_TECHNIQUE_* */
+    /* technique: VXL_TECHNIQUE_* */
     uint32_t technique;
-    /* issue 19: VXL_MODE_* (ISO reads iso_value) */
+    /* VXL_MODE_* (ISO reads iso_value) */
     uint32_t mode;
     const vxl_cutaway *cutaway;      /* NULL: nothing cut away */
-    /* issue 18: NULL: no scene meshes shadow the volume */
+    /* NULL: no scene meshes shadow the volume */
     const vxl_scene_shadows *scene_shadows;
-    const vxl_matcap *matcap;        /* issue 19: NULL: the material and lights */
+    const vxl_matcap *matcap;        /* NULL: the material and lights */
     /* Room for the next features (fields taken from here keep the struct's
      * size and offsets). Must be zero: vxl_render fails with
      * VXL_ERR_INVALID_ARGUMENT naming the word otherwise. */
     uint32_t reserved[VXL_RENDER_PARAMS_RESERVED];
-    /* Appended (issue 20); read only when struct_size covers it. NULL: no
+    /* Appended; read only when struct_size covers it. NULL: no
      * labels (a label volume set on the renderer is then not drawn). */
     const vxl_label_style *labels;
-    /* Appended (issue 20): overlay_count entries (stride overlays[0].struct_size), each naming a
+    /* Appended: overlay_count entries (stride overlays[0].struct_size), each naming a
      * slot set with vxl_renderer_set_overlay; 0 / NULL: none drawn. */
     uint32_t overlay_count;     /* <= VXL_MAX_OVERLAYS */
-    /* Appended (issue 21): 1: do not wait for streamed bricks (the viewport): the frame renders at
+    /* Appended: 1: do not wait for streamed bricks (the viewport): the frame renders at
      * once from what is resident, coarser where finer bricks are still loading on the renderer's
      * loader thread, visible bricks large on screen first; stats.refine_pending > 0 says a later
      * frame will be finer. 0: wait until every brick the frame needs is resident at the finest
@@ -968,14 +968,14 @@ VXL_API int vxl_renderer_get_info(vxl_renderer *r, vxl_renderer_info *out);
  * vxl_volume may be destroyed afterwards. */
 VXL_API int vxl_renderer_set_volume(vxl_renderer *r, const vxl_volume *vol);
 
-/* Label maps (issue 20): a volume of integer label ids (u8, u16, i16 or
+/* Label maps: a volume of integer label ids (u8, u16, i16 or
  * i32 data with values in [0, VXL_MAX_LABEL_ID]; anything else is
  * VXL_ERR_INVALID_ARGUMENT) drawn with params.labels. Its own affine places
  * it (the same grid as the intensity volume or another one). Kept on the GL
  * side like the volume; NULL removes it. */
 VXL_API int vxl_renderer_set_labels(vxl_renderer *r, const vxl_volume *labels);
 
-/* Overlays (issue 20): puts vol in overlay slot `slot` (< VXL_MAX_OVERLAYS),
+/* Overlays: puts vol in overlay slot `slot` (< VXL_MAX_OVERLAYS),
  * kept on the GL side like the volume (charged to the renderer's budget;
  * over it: VXL_ERR_LIMIT, and the slot keeps what it had). NULL empties the
  * slot. Any grid: its affine places it. */
@@ -997,7 +997,7 @@ typedef struct vxl_render_stats {
     uint32_t bricks_total;      /* bricks of the skipping grid (0 when skipping is off) */
     uint32_t bricks_occupied;   /* bricks that can be visible under the classification */
     uint32_t brick_size;        /* voxels per brick edge */
-    /* Appended (issue 8): how the volume is stored on the GL side. */
+    /* Appended: how the volume is stored on the GL side. */
     uint32_t storage;           /* VXL_STORAGE_* in use (never AUTO) */
     uint64_t resident_bytes;    /* GL memory of the volume: texture, or pool + page table */
     uint32_t page_brick;        /* voxels per page brick edge (0 when dense) */
@@ -1012,13 +1012,13 @@ typedef struct vxl_render_stats {
     /* Compressed storage: milliseconds the last decode into the linear cache
      * took (GPU, finished), 0 when nothing was decoded for this frame. */
     double decode_ms;
-    /* Appended (issue 17): the illumination volumes of the shadowed and
+    /* Appended: the illumination volumes of the shadowed and
      * scatter shading models. */
     uint32_t illumination_size;  /* cells along their longest side (coarser than asked when the memory
                                     budget is short); 0 when the frame used none */
     uint32_t illumination_rebuilt; /* volumes (one per light, plus the occlusion) the frame rebuilt: 0
                                       when only the camera moved */
-    /* Appended (issue 21): streamed volumes (0 otherwise). */
+    /* Appended: streamed volumes (0 otherwise). */
     uint32_t refine_pending;    /* bricks the frame wanted finer than it drew (progressive: still loading) */
     uint32_t stream_level;      /* the coarsest level any drawn brick came from (0 = full resolution) */
     uint64_t bytes_read;        /* bytes the frame read from the file or cache */
@@ -1028,7 +1028,7 @@ typedef struct vxl_render_stats {
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);
 
-/* Scene shadows (issue 18): for every pixel of p->scene_depth (required;
+/* Scene shadows: for every pixel of p->scene_depth (required;
  * seen through p's camera), the transmittance through the volume from that
  * scene point to light `light` (an index into p->lights; with light_count 0
  * the headlight), from the same illumination volume the SHADOWED model
@@ -1041,7 +1041,7 @@ VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);
 VXL_API int vxl_scene_transmittance(vxl_renderer *r, const vxl_render_params *p, uint32_t light,
                                     float *out);
 
-/* Slice planes (issue 19): the volume resampled on a plane. */
+/* Slice planes: the volume resampled on a plane. */
 #define VXL_INTERP_NEAREST 0
 #define VXL_INTERP_LINEAR 1
 #define VXL_INTERP_CUBIC 2   /* the interpolating cubic B-spline (as VXL_FILTER_CUBIC) */

@@ -30,7 +30,7 @@
 extern "C" {
 #endif
 
-/* ------------------------------------------------ streamed volumes (issue 21) */
+/* ------------------------------------------------ streamed volumes */
 
 /* A streamed copy of a whole volume: the same info, no texels, its voxels
  * served by a brick source over a copy of whole's texels with n_levels
@@ -63,7 +63,7 @@ VXL_API int vxl_volume_add_note(vxl_volume *vol, const char *note);
 
 /* ------------------------------------------------------- label uploads */
 
-/* Issue 20: how many label volumes and label tables the renderer has
+/* how many label volumes and label tables the renderer has
  * uploaded since it was created (either pointer may be NULL), so tests can
  * check that recolouring or hiding a label re-uploads only the table. */
 VXL_API int vxl_renderer_label_uploads(vxl_renderer *r, uint64_t *volume_uploads, uint64_t *table_uploads);
@@ -88,7 +88,7 @@ VXL_API int vxl_probe_gradients(vxl_renderer *r, const vxl_render_params *p, con
  * 2*dims[0]*dims[1]*dims[2] floats. VXL_ERR_STATE while there is no grid. */
 VXL_API int vxl_probe_skip_grid(vxl_renderer *r, uint32_t dims[3], uint32_t *brick, float *out, size_t max_floats);
 
-/* ------------------------------------------------- ground truth (issue 4) */
+/* ------------------------------------------------- ground truth */
 
 /* Analytic phantoms, generated at any resolution, each with an analytic
  * gradient. The volume covers [-1,1]^3 in world units (affine maps voxel
@@ -101,7 +101,7 @@ VXL_API int vxl_probe_skip_grid(vxl_renderer *r, uint32_t dims[3], uint32_t *bri
 #define VXL_PHANTOM_DENSE_BALLS 6    /* its dense twin: a ball on every lattice site */
 #define VXL_PHANTOM_LARGE_SPARSE 7  /* 8-bit Gaussian ellipsoids on 30% of a 12x8x2 lattice; default
                                         2500x1500x400 (over every 2048 texture limit, for bricking) */
-#define VXL_PHANTOM_TWO_BLOBS 8     /* Gaussian blobs (sigma 0.2) at x = -0.45 and +0.45 (shadows, issue 17) */
+#define VXL_PHANTOM_TWO_BLOBS 8     /* Gaussian blobs (sigma 0.2) at x = -0.45 and +0.45 (shadows) */
 #define VXL_PHANTOM_COUNT 9
 
 typedef struct vxl_phantom_desc {

@@ -1,5 +1,5 @@
-/* brick_cache.h - gzip/zlib-compressed volumes read on demand (issue 21,
- * docs/streaming.md "The brick cache"). A .nii.gz (or gzip NRRD or zlib
+/* brick_cache.h - gzip/zlib-compressed volumes read on demand
+ * (docs/streaming.md "The brick cache"). A .nii.gz (or gzip NRRD or zlib
  * MetaImage data, from layout->compressed_start) cannot seek, so the first
  * open streams through it once and writes a bricked cache file: the voxels
  * already in texture format, cut into bricks compressed one by one, with

@@ -1,5 +1,5 @@
 /* label_table.c - vxl_label_table_load: label names and colours from the
- * common lookup files (issue 20; docs/labels.md has every decision):
+ * common lookup files (docs/labels.md has every decision):
  *   FreeSurfer LUT      `id name R G B T`, T = 255 - alpha (FreeSurfer's own reader)
  *   3D Slicer .ctbl     `id name R G B A`, A = opacity 0..255
  *   ITK-SNAP labels     `IDX R G B A VIS MSH "LABEL"`, A = opacity 0..1

@@ -285,7 +285,7 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
         stream = 0; /* AUTO and a file too short to stream: today's whole-read checks say why */
         rc = vxl_plan_voxels(path, dims, h.dtype, opt, &nbytes, e);
     }
-    vxl_raw_layout *l = NULL; /* issue 21: streamed, the voxels are read on demand (stream_load.h) */
+    vxl_raw_layout *l = NULL; /* streamed, the voxels are read on demand (stream_load.h) */
     if (!rc && stream && !(l = malloc(sizeof *l))) rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory opening '%s'", path);
     if (l) {
         double sp[3], A[16];

@@ -709,8 +709,8 @@ static int read_channel_voxels(vxl_gz *f, const char *path, uint64_t offset, uin
 }
 
 /* Validates the header and works out what to read: whole (today's checks
- * against the budget, before anything is allocated) or streamed (issue 21:
- * *stream = 1, stream_load.h). */
+ * against the budget, before anything is allocated) or streamed
+ * (*stream = 1, stream_load.h). */
 static int plan_read(const nii_header *h, const nii_colour *colour, const char *path, const vxl_load_options *opt,
                      uint32_t dims[3], uint32_t *dtype, uint64_t *offset, uint64_t *nbytes, int *stream, vxl_err *e)
 {
@@ -777,7 +777,7 @@ static void scaling_from(const nii_header *h, double *slope, double *inter)
     }
 }
 
-/* Streams the chosen volume instead of reading it (issue 21): the layout
+/* Streams the chosen volume instead of reading it: the layout
  * of its voxels for a raw source (.nii, .img) or a bricked cache (.nii.gz,
  * .img.gz), keyed by the header. */
 static int stream_volume(const nii_header *h, const char *data_path, const uint32_t dims[3],

@@ -512,7 +512,7 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
         stream = 0; /* AUTO and a file too short to stream: today's whole-read checks say why */
         rc = vxl_plan_voxels(path, dims, h.dtype, opt, &nbytes, e);
     }
-    if (!rc && stream) { /* issue 21: read on demand (stream_load.h); gzip data through a cache */
+    if (!rc && stream) { /* read on demand (stream_load.h); gzip data through a cache */
         double sp[3], A[16];
         vxl_raw_layout l;
         rc = geometry(&h, axes, nax, sp, A, path, e);

@@ -1,4 +1,4 @@
-/* raw_layout.h - where a file's voxels lie and how they read (issue 21):
+/* raw_layout.h - where a file's voxels lie and how they read:
  * what the NIfTI, NRRD and MetaImage headers say, handed from the loader
  * that parsed the header to the brick source that reads the voxels (by
  * offset, raw_source.c) or streams them once into a bricked cache

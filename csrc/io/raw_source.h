@@ -1,4 +1,4 @@
-/* raw_source.h - a brick source over an uncompressed file (issue 21): the
+/* raw_source.h - a brick source over an uncompressed file: the
  * voxels of NIfTI (.nii, .img), NRRD and MetaImage data read by offset,
  * one box at a time with pread (no mmap: mapped pages would count as the
  * process's resident memory), converted into the texture format exactly as

@@ -1,4 +1,4 @@
-/* stream_load.h - whether a file loader streams (issue 21), and the
+/* stream_load.h - whether a file loader streams, and the
  * streamed volume it then makes: the NIfTI, NRRD and MetaImage loaders
  * parse their header, fill a vxl_raw_layout and hand it here instead of
  * reading the voxels (docs/streaming.md). An uncompressed file is read by

@@ -1,4 +1,4 @@
-/* tiff_layout.h - whether a multi-page TIFF can be read by offset (issue 21),
+/* tiff_layout.h - whether a multi-page TIFF can be read by offset,
  * decided by walking its directories in this process (no libtiff, no
  * OpenImageIO): classic TIFF and BigTIFF, either byte order. A file streams
  * when every page is one uncompressed, untiled, single-sample image of the

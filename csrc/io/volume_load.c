@@ -102,7 +102,7 @@ int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **
     vxl_loader_fn fn = vxl_loader_for(path);
     vxl_err e = {0};
     int rc = fn(path, opt, out, &e);
-    /* Issue 21: these formats are read whole even when streaming is asked
+    /* these formats are read whole even when streaming is asked
      * for; over the budget, say that streaming would not have helped. */
     const char *whole_only = fn == vxl_dicom_load ? "DICOM" : fn == vxl_image_stack_load ? "TIFF/PNG image stacks"
                              : fn == vxl_vdb_load ? "OpenVDB" : NULL;

@@ -1,5 +1,5 @@
-/* label_bricks.h - the label volume's own skipping grid (issue 20,
- * docs/labels.md "Speed"). Built once per label volume on the CPU: per brick
+/* label_bricks.h - the label volume's own skipping grid
+ * (docs/labels.md "Speed"). Built once per label volume on the CPU: per brick
  * of VXL_LABEL_BRICK^3 label voxels, the distinct ids in the brick and its
  * apron (the voxels labels.glsl reads from a point in the brick: the 8
  * corners of its cell, and for a crossing's normal those of the cells half a

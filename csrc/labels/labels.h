@@ -1,4 +1,4 @@
-/* labels.h - the GL side of issue 20's label maps (docs/labels.md): the
+/* labels.h - the GL side of label maps (docs/labels.md): the
  * label volume as an R16UI texture (nearest, never filtered by the
  * hardware: ids are not numbers), its own voxel -> world affine, and the
  * per-label table (65536 ids as a 256x256 RGBA32F texture: colour and

@@ -47,7 +47,7 @@ void vxl_illumination_release(vxl_illumination_state *s)
     *s = kept;
 }
 
-/* Issue 18's GL memory: the shadow maps, the occluders, the transmittance images. */
+/* GL memory: the shadow maps, the occluders, the transmittance images. */
 static uint64_t scene_shadow_bytes(const void *state)
 {
     const vxl_illumination_state *s = state;
@@ -386,7 +386,7 @@ static float cell_world(const vxl_illumination_state *s, const vxl_frame *f)
 }
 
 /* Light i's block times the visibility through the scene's occluders
- * (issue 18), cell by cell. The compared point moves half a cell towards
+ *, cell by cell. The compared point moves half a cell towards
  * the light, plus the map's texels' depth error, so a cell an occluder
  * surface cuts is not shadowed by that surface; the filter spans a cell, so
  * the trilinear read between cells sees a soft, not a stepped, edge. */
@@ -504,7 +504,7 @@ int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f)
     /* the lights and the occlusion follow the extinction and their own grid */
     key = vxl_fnv(key, s->extinction_cells, sizeof s->extinction_cells);
     key = vxl_fnv(key, s->cells, sizeof s->cells);
-    /* issue 18: the occluders' maps first; a light's volume follows its map */
+    /* the occluders' maps first; a light's volume follows its map */
     if ((rc = vxl_shadow_maps_prepare(&s->shadows, f, s->storage->geom.dims))) return rc;
     for (int i = 0; i < f->light_count; i++) {
         float lv[4], radius;

@@ -1,5 +1,5 @@
 /* illumination.h - the illumination volumes of the shadowed and scatter
- * shading models (issue 17): per light, the transmittance from every cell of
+ * shading models: per light, the transmittance from every cell of
  * a reduced grid over the volume to the light, and the ambient occlusion,
  * read by the ray caster with one fetch per light per shaded sample
  * (shaders/lib/illumination.glsl). Built on the GL side by
@@ -63,7 +63,7 @@ typedef struct vxl_illumination_state {
     int in_use;                 /* the last prepared frame reads it */
     uint32_t rebuilt;           /* volumes the last prepare rebuilt (lights + occlusion + environment) */
     uint32_t builds;            /* every volume built since the renderer opened (tests) */
-    /* Issue 18: the scene's occluders seen from each light; a light's
+    /* the scene's occluders seen from each light; a light's
      * volume is multiplied by their visibility and keyed by its maps. */
     vxl_shadow_maps_state shadows;
     /* vxl_scene_transmittance's images (transmittance.c): the scene depth
@@ -85,7 +85,7 @@ void vxl_illumination_init(vxl_illumination_state *s, vxl_gpu *g, vxl_storage_st
 /* Builds what frame f's shading model reads (nothing for Phong or unshaded
  * frames but the environment's reduction) and binds it on
  * VXL_ILLUMINATION_UNIT (and the environment's on VXL_ENVIRONMENT_UNIT). With occluders in f
- * (issue 18), each light's volume is cut by its shadow maps. Needs the storage prepared
+ *, each light's volume is cut by its shadow maps. Needs the storage prepared
  * for f and the transfer function on VXL_TF_UNIT; uses programs of its own,
  * so call it before the ray caster's program is bound. */
 int vxl_illumination_prepare(vxl_illumination_state *s, const vxl_frame *f);

@@ -1,5 +1,5 @@
-/* transmittance.h - the volume's shadow on the scene (issue 18,
- * vxl_scene_transmittance): for every pixel of a frame's scene depth, the
+/* transmittance.h - the volume's shadow on the scene
+ * (vxl_scene_transmittance): for every pixel of a frame's scene depth, the
  * transmittance from that scene point to one light through the volume, read
  * from the light's illumination volume (illumination.h) where the point's
  * path to the light enters the volume's box (at the point itself when it

@@ -1,4 +1,4 @@
-/* overlays.h - the GL side of issue 20's overlays (docs/overlays.md): up to
+/* overlays.h - the GL side of overlays (docs/overlays.md): up to
  * VXL_MAX_OVERLAYS more volumes sampled in the base volume's ray march. Each
  * slot holds its volume as one dense texture of its own texels (R8/R16
  * normalised or R32F, filtered linearly: nearest is a texelFetch, cubic 8

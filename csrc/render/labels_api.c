@@ -1,4 +1,4 @@
-/* labels_api.c - issue 20's renderer calls: the label volume goes to the
+/* labels_api.c - renderer calls: the label volume goes to the
  * labels room (labels/labels.h) on the renderer's GL thread. */
 #include "renderer_internal.h"
 #include "voxlight_dev.h"
@@ -18,7 +18,7 @@ static int job_set_labels(void *p)
 int vxl_renderer_set_labels(vxl_renderer *r, const vxl_volume *labels)
 {
     if (!r) return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "renderer is NULL");
-    if (labels && labels->source) /* issue 21: the label volume is uploaded whole */
+    if (labels && labels->source) /* the label volume is uploaded whole */
         return vxl_fail(&r->gpu.err, VXL_ERR_INVALID_ARGUMENT,
                         "a label map is uploaded whole and this one is streamed: load it with streaming off");
     labels_job j = {r, labels, {0, 0}};

@@ -1,4 +1,4 @@
-/* matcap.h - the MatCap image of issue 19 (voxlight.h's vxl_matcap) on the
+/* matcap.h - the MatCap image (voxlight.h's vxl_matcap) on the
  * GL side: a 2D texture uploaded when its key changes (the caller's key, or
  * a hash of the pixels when that is 0), charged to the budget as a holding,
  * bound at VXL_MATCAP_UNIT for lib/matcap.glsl. */

@@ -1,4 +1,4 @@
-/* modes.h - the GL side of issue 19's render modes (voxlight.h's
+/* modes.h - the GL side of render modes (voxlight.h's
  * VXL_MODE_*; the marches are shaders/lib/modes.glsl): the program flags of
  * a frame's mode and MatCap, and the brick min-max grid as a texture, which
  * MIP, MinIP and ISO skip bricks by. */

@@ -1,4 +1,4 @@
-/* overlays_api.c - issue 20's overlay call: the volume goes to the overlay
+/* overlays_api.c - overlay call: the volume goes to the overlay
  * room (overlay/overlays.h) on the renderer's GL thread. */
 #include "renderer_internal.h"
 

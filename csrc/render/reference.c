@@ -139,7 +139,7 @@ static void trace(const ref_ctx *c, double px, double py, float *out_rgba, float
         if (!isnan(dd)) t1 = fmin(t1, (-dd - z0) / dz);
     }
     if (!(t0 < t1)) return;
-    double cap[3] = {0, 0, 0}; /* issue 19: clip planes and crop box as cut.glsl (cutters are not modelled) */
+    double cap[3] = {0, 0, 0}; /* clip planes and crop box as cut.glsl (cutters are not modelled) */
     if (f->cut.any && !vxl_frame_cut_interval(&f->cut, o, dir, &t0, &t1, cap)) return;
     int capped = f->cut.caps && (cap[0] != 0 || cap[1] != 0 || cap[2] != 0);
     double view_dir[3];

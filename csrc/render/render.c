@@ -166,10 +166,10 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     GLuint prog;
     uint32_t flags = (f->shading ? 1u : 0u) | (f->shading && f->reuse ? 2u : 0u) | (f->classify << 2) |
                      (f->gopacity << 4) | r->storage.ops->sample_flags(&r->storage) | (f->shading ? f->shading_model << 8 : 0);
-    flags = vxl_modes_flags(f, flags); /* issue 19: the mode and the MatCap */
-    flags |= vxl_cut_flags(f);         /* issue 19: clip planes, crop box, cutters */
-    flags |= vxl_labels_flags(f);      /* issue 20: the label mode */
-    flags |= vxl_overlays_flags(f);    /* issue 20: the overlay count */
+    flags = vxl_modes_flags(f, flags); /* the mode and the MatCap */
+    flags |= vxl_cut_flags(f);         /* clip planes, crop box, cutters */
+    flags |= vxl_labels_flags(f);      /* the label mode */
+    flags |= vxl_overlays_flags(f);    /* the overlay count */
     uint32_t colour_flags;
     int rc = vxl_colour_flags(&r->colour, f, &colour_flags); /* a colour volume's own colour */
     if (rc) return rc;
@@ -198,19 +198,19 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
         return rc;
     if ((rc = r->storage.ops->prepare(&r->storage, f))) return rc;
     if ((rc = vxl_classification_prepare(&r->classification, f))) return rc;
-    if ((rc = vxl_illumination_prepare(&r->illumination, f))) return rc; /* shadows, occlusion (issue 17) */
-    if ((rc = vxl_cut_prepare(&r->cut, f))) return rc; /* issue 19: the cutter meshes peeled */
+    if ((rc = vxl_illumination_prepare(&r->illumination, f))) return rc; /* shadows, occlusion */
+    if ((rc = vxl_cut_prepare(&r->cut, f))) return rc; /* the cutter meshes peeled */
     rc = vxl_bind_volume_textures(r, prog, filter, (int)f->store);
     if (rc) return rc;
     set_frame_uniforms(r, prog, f);
     vxl_illumination_bind(&r->illumination, prog, f);
-    vxl_cut_bind(&r->cut, prog, f); /* issue 19 */
+    vxl_cut_bind(&r->cut, prog, f);
     vxl_colour_bind(&r->colour, flags, prog);
     if (path && (rc = vxl_path_bind(&r->path, f, prog))) return rc;
-    if ((rc = vxl_labels_prepare(&r->labels, f, prog, r->storage.geom.affine))) return rc; /* issue 20 */
-    if ((rc = vxl_overlays_prepare(&r->overlays, f, prog))) return rc; /* issue 20 */
+    if ((rc = vxl_labels_prepare(&r->labels, f, prog, r->storage.geom.affine))) return rc;
+    if ((rc = vxl_overlays_prepare(&r->overlays, f, prog))) return rc;
     if ((rc = vxl_channels_prepare(&r->channels, f, prog))) return rc;
-    if ((rc = vxl_modes_bind(&r->modes, f, prog)) || (rc = vxl_matcap_prepare(&r->matcap, f, prog))) return rc; /* issue 19 */
+    if ((rc = vxl_modes_bind(&r->modes, f, prog)) || (rc = vxl_matcap_prepare(&r->matcap, f, prog))) return rc;
     vxl_uniform_i(&r->gpu, prog, "u_skip", f->skip);
     vxl_uniform_i(&r->gpu, prog, "u_brick_size", (int)(r->skipping.bricks.size ? r->skipping.bricks.size : VXL_DEFAULT_BRICK));
     vxl_uniform_i(&r->gpu, prog, "u_brick_distance", VXL_DISTANCE_UNIT);
@@ -295,7 +295,7 @@ static int job_render(void *p)
     if (rc) return rc;
     const vxl_volume_geom *ov_geoms[VXL_MAX_OVERLAYS];
     vxl_overlays_geoms(&r->overlays, ov_geoms);
-    rc = vxl_frame_resolve_overlays(&f, j->p, ov_geoms, &g, &r->gpu.err); /* issue 20 */
+    rc = vxl_frame_resolve_overlays(&f, j->p, ov_geoms, &g, &r->gpu.err);
     if (!rc) rc = vxl_frame_resolve_channels(&f, j->p, r->channels.geom, r->channels.count, &r->gpu.err);
     if (!rc) rc = draw(r, &f, j->rgba, j->depth);
     vxl_frame_free(&f);

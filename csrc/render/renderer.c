@@ -86,9 +86,9 @@ static int job_close(void *p)
         delete_texture(r, &r->scene_depth_tex);
         delete_texture(r, &r->tf_tex);
         vxl_matcap_release(&r->matcap);
-        vxl_cut_release(&r->cut); /* issue 19: the cutter layers */
-        vxl_labels_release(&r->labels); /* issue 20 */
-        vxl_overlays_release(&r->overlays); /* issue 20 */
+        vxl_cut_release(&r->cut); /* the cutter layers */
+        vxl_labels_release(&r->labels);
+        vxl_overlays_release(&r->overlays);
         vxl_programs_delete(&r->gpu);
         r->gpu.gl.DeleteFramebuffers(1, &r->fbo);
         r->gpu.gl.DeleteVertexArrays(1, &r->vao);
@@ -120,14 +120,14 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     vxl_skipping_init(&r->skipping, &r->gpu, &r->storage);
     vxl_classification_init(&r->classification, &r->gpu, &r->storage);
     vxl_illumination_init(&r->illumination, &r->gpu, &r->storage);
-    vxl_cut_init(&r->cut, &r->gpu); /* issue 19 cutaways */
+    vxl_cut_init(&r->cut, &r->gpu); /* cutaways */
     vxl_modes_init(&r->modes, &r->gpu, &r->skipping, &r->storage);
     vxl_path_init(&r->path, &r->gpu, &r->skipping, &r->storage);
     vxl_matcap_init(&r->matcap, &r->gpu);
-    vxl_labels_init(&r->labels, &r->gpu); /* issue 20 label maps */
+    vxl_labels_init(&r->labels, &r->gpu); /* label maps */
     r->illumination.bind_labels = bind_labels_for_shadows; /* hidden labels cast no shadow */
     r->illumination.labels_ctx = r;
-    vxl_overlays_init(&r->overlays, &r->gpu); /* issue 20 overlays */
+    vxl_overlays_init(&r->overlays, &r->gpu); /* overlays */
     vxl_colour_init(&r->colour, &r->gpu); /* colour volumes */
     vxl_channels_init(&r->channels, &r->gpu); /* multi-channel volumes */
     r->gpu.budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;

@@ -42,12 +42,12 @@ struct vxl_renderer {
     vxl_bspline_state bspline;
     vxl_skipping_state skipping;             /* skipping.h */
     vxl_classification_state classification; /* classification.h */
-    vxl_illumination_state illumination;     /* illumination.h: shadows and occlusion (issue 17) */
-    vxl_cut_state cut;                       /* cutaway.h: issue 19 clip planes, crop box, cutter layers */
-    vxl_modes_state modes;                   /* modes.h: issue 19 render modes (min-max grid texture) */
-    vxl_matcap_state matcap;                 /* matcap.h: issue 19 MatCap image */
-    vxl_labels_state labels;                 /* labels.h: issue 20 label volume and table */
-    vxl_overlays_state overlays;             /* overlays.h: issue 20 overlay volumes */
+    vxl_illumination_state illumination;     /* illumination.h: shadows and occlusion */
+    vxl_cut_state cut;                       /* cutaway.h: clip planes, crop box, cutter layers */
+    vxl_modes_state modes;                   /* modes.h: render modes (min-max grid texture) */
+    vxl_matcap_state matcap;                 /* matcap.h: MatCap image */
+    vxl_labels_state labels;                 /* labels.h: label volume and table */
+    vxl_overlays_state overlays;             /* overlays.h: overlay volumes */
     vxl_colour_state colour;                 /* colour.h: a colour volume's own colour (RGB8) */
     vxl_path_state path;                     /* path.h: the PATH model's majorant grid */
     vxl_channels_state channels;             /* channels.h: a multi-channel volume's channels (16-bit, dense) */

@@ -1,4 +1,4 @@
-/* scene_transmittance.c - vxl_scene_transmittance (issue 18): the frame
+/* scene_transmittance.c - vxl_scene_transmittance: the frame
  * resolved as vxl_render resolves it, with a shading model that has
  * illumination volumes, everything the light's volume derives from
  * prepared as a frame prepares it (so a frame rendered with the same

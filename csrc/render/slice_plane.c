@@ -1,4 +1,4 @@
-/* slice_plane.c - vxl_render_slice (issue 19): the volume resampled on a
+/* slice_plane.c - vxl_render_slice: the volume resampled on a
  * plane with the window and colour map, for multi-planar views. A compute
  * pass (shaders/compute/slice_plane.comp) writes one texel per output pixel;
  * it samples through the storage's own binding, so dense, bricked, sparse

@@ -1,4 +1,4 @@
-/* slices.c - the slicing comparison modes (issue 16): texture-based volume
+/* slices.c - the slicing comparison modes: texture-based volume
  * rendering as the textbooks teach it (Engel et al., Real-Time Volume
  * Graphics, ch. 3), on the ray caster's sampling, classification, gradient
  * and shading GLSL (shaders/render/slices.frag includes the same lib/ files).

@@ -1,4 +1,4 @@
-/* slices.h - the slicing comparison modes (issue 16, VXL_TECHNIQUE_SLICES2D
+/* slices.h - the slicing comparison modes (VXL_TECHNIQUE_SLICES2D
  * and SLICES3D): proxy polygons through the volume box, composited slice by
  * slice with the ray caster's classification, gradients and shading. Not a
  * default; the benchmark measures them against the ray caster. */

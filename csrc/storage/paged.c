@@ -249,7 +249,7 @@ void vxl_paged_see(vxl_storage_state *st, const vxl_frame *f, int every)
     st->decode_ms = 0;
     /* what derived pools (gradients, coefficients) must cover */
     st->visible_reach = f ? visible_reach(f) : 0;
-    /* issue 19: a projection or iso-surface reads every brick, not only the table's visible ones */
+    /* a projection or iso-surface reads every brick, not only the table's visible ones */
     st->visible_all = !f || f->gopacity == VXL_GOPACITY_ISO || f->mode != VXL_MODE_DVR || every;
 }
 

@@ -16,7 +16,7 @@ const vxl_storage_ops *vxl_storage_ops_for(uint32_t mode) { return mode < VXL_ST
 
 const vxl_storage_ops *vxl_storage_ops_for_volume(const vxl_volume *v, uint32_t mode)
 {
-    return v->source ? &vxl_storage_streamed : vxl_storage_ops_for(mode); /* issue 21: no texels to upload */
+    return v->source ? &vxl_storage_streamed : vxl_storage_ops_for(mode); /* no texels to upload */
 }
 
 uint32_t vxl_storage_choose(const vxl_storage_state *st, const vxl_volume *v)

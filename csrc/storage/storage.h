@@ -157,7 +157,7 @@ struct vxl_storage_state {
     uint32_t code_slots[3];
     uint64_t code_bytes;          /* code pool + palettes */
     double decode_ms;             /* the decode of this frame, 0 if none */
-    /* Streamed volumes (issue 21, storage_streamed.c): the pool is a cache
+    /* Streamed volumes (storage_streamed.c): the pool is a cache
      * of bricks of every level read on demand by a loader thread. */
     struct vxl_stream *stream;
 };

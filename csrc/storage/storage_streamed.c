@@ -1,5 +1,5 @@
-/* storage_streamed.c - sparse storage of a streamed volume (issue 21,
- * docs/streaming.md): the voxels stay in the volume's brick source and the
+/* storage_streamed.c - sparse storage of a streamed volume
+ * (docs/streaming.md): the voxels stay in the volume's brick source and the
  * GL side holds a pool of page bricks of any level, read on demand by the
  * loader thread (brick_loader.c) and uploaded here, on the renderer's
  * thread. The page plan of every level and the skipping grid come from the

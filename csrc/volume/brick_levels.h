@@ -1,4 +1,4 @@
-/* brick_levels.h - the coarser levels of a brick source (issue 21): each the
+/* brick_levels.h - the coarser levels of a brick source: each the
  * 2x2x2 mean of the level before, computed as vxl_volume_downsample2
  * (storage/lod.c) does, bit for bit (the same eight texels summed in the
  * same order in double, then rounded into the texel format), so a streamed

@@ -1,4 +1,4 @@
-/* brick_source.h - a volume read on demand (issue 21, docs/streaming.md).
+/* brick_source.h - a volume read on demand (docs/streaming.md).
  * A streamed vxl_volume has no texels: its `source` reads any box of voxels
  * of any resolution level, already in the volume's texture format, when the
  * GL side (or a pass over the data) asks for it. What a source is made from
@@ -65,7 +65,7 @@ void vxl_brick_source_retain(vxl_brick_source *s);
  * and s itself); NULL is a no-op. */
 void vxl_brick_source_free(vxl_brick_source *s);
 
-/* ---- shared by every source (issue 21; brick_source.c, brick_levels.c,
+/* ---- shared by every source (brick_source.c, brick_levels.c,
  * memory_source.c) ---- */
 
 #define VXL_SOURCE_INDEX_BRICK 8                 /* the index brick when the grid fits the cap below */

@@ -30,7 +30,7 @@ struct vxl_volume {
     double affine[16];      /* column-major voxel -> world */
     uint32_t frame_count;   /* volumes in the 4D input (0 is read as 1) */
     uint32_t frame;         /* the one this is */
-    /* Streamed (issue 21): texels is NULL and the voxels are read on demand
+    /* Streamed: texels is NULL and the voxels are read on demand
      * from source (owned; storage_bytes is what reading it whole would take).
      * Code that needs every voxel either reads through source a box at a
      * time or refuses a streamed volume with a clear error. */
@@ -86,7 +86,7 @@ int vxl_volume_build(const void *raw, uint32_t dtype, const uint32_t dims[3], co
                      const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 
 /* The conversion vxl_volume_build makes, in pieces, for sources that see a
- * volume a slab at a time (issue 21, io/raw_source.c): the range of raw
+ * volume a slab at a time (io/raw_source.c): the range of raw
  * values first (accumulated over calls into *mn, *mx and the counts; start
  * with mn = +inf, mx = -inf), then the map it fixes, then texels. raw is
  * native-endian dtype; slope 0 = unscaled. */

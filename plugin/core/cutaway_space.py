@@ -1,4 +1,4 @@
-"""Issue 19's cutaways in world space, from Blender objects' matrices
+"""The cutaways in world space, from Blender objects' matrices
 (plain numpy, no bpy): a clip plane from an object's local XY plane, the
 crop box from a cube Empty. Matrices are 4x4 math matrices (m[row][col],
 as mathutils and numpy index them)."""

@@ -5,7 +5,7 @@ Cancelling returns control at once and lets the worker finish its current
 step in the background; the worker sees the flag between steps
 (runtime.open_volume asks) and closes whatever it made, and a result that
 arrives after the cancel is closed too. The library's first pass over a
-file (a .nii.gz streamed into its bricked cache, issue 21) reports progress
+file (a .nii.gz streamed into its bricked cache) reports progress
 and stops at the flag, leaving no partial cache; other loads run to their
 end. Nothing of a cancelled import is registered or kept.
 """

@@ -1,4 +1,4 @@
-"""Which lookup files beside a label image could name its labels (issue 20):
+"""Which lookup files beside a label image could name its labels:
 the importer offers the first that exists, and the library
 (vxl_label_table_load, docs/labels.md) tells the formats apart by content.
 

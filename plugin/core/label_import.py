@@ -1,4 +1,4 @@
-"""How the importer treats a label image (issue 20): whether a file is a
+"""How the importer treats a label image: whether a file is a
 label map and which lookup file names its labels, and how its info line
 reads. Pure Python, no bpy (tests/python/test_label_import.py); the
 importer asks it before and after the load."""

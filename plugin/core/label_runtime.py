@@ -1,4 +1,4 @@
-"""The label volume on a renderer (issue 20). A volume object with a label
+"""The label volume on a renderer. A volume object with a label
 map has its label file put on its entry's renderer
 (vxl_renderer_set_labels) before the entry renders; the entry remembers
 which (entry.label_key, part of entry.identity, so frames with other labels

@@ -1,4 +1,4 @@
-"""The volume's lighting settings (issue 17) as library render parameters:
+"""The volume's lighting settings as library render parameters:
 shading model, ambient occlusion, anisotropy and the illumination volumes'
 resolution ("shadow quality"), how volumes from older files keep their
 look, and the coarser illumination volume while a light is dragged in the

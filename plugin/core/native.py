@@ -21,8 +21,8 @@ of the add-on and the tests say `native.X`:
   native_volume        Volume, list_dicom_series
   native_tiles         tile_params, params_digest
   native_renderer      make_params, Renderer
-  native_cutaway       issue 19's cutaway, MatCap and slice structs from plain data
-  native_overlays      issue 20's overlay styles (params.overlays) from plain data
+  native_cutaway       cutaway, MatCap and slice structs from plain data
+  native_overlays      overlay styles (params.overlays) from plain data
 """
 
 import sys

@@ -77,7 +77,7 @@ class LoadOptions(ctypes.Structure):
                 ("frame", ctypes.c_uint32),      # 4D inputs: which volume
                 ("reserved0", ctypes.c_uint32),
                 ("series", ctypes.c_char_p),     # DICOM: index or SeriesInstanceUID
-                # appended (issue 21): streaming
+                # appended: streaming
                 ("streaming", ctypes.c_uint32),
                 ("reserved1", ctypes.c_uint32),
                 ("cache_dir", ctypes.c_char_p),
@@ -134,7 +134,7 @@ class VolumeInfo(ctypes.Structure):
                 ("affine_source", ctypes.c_uint32),
                 ("frame_count", ctypes.c_uint32),
                 ("frame", ctypes.c_uint32),
-                ("streamed", ctypes.c_uint32),        # appended (issue 21)
+                ("streamed", ctypes.c_uint32),        # appended
                 ("level_count", ctypes.c_uint32),
                 ("resident_bytes", ctypes.c_uint64),
                 ("bytes_read", ctypes.c_uint64),
@@ -197,7 +197,7 @@ class LabelEntry(ctypes.Structure):
                 ("color", ctypes.c_float * 4),
                 ("visible", ctypes.c_uint32),
                 ("name", ctypes.c_char * 64),
-                ("has_material", ctypes.c_uint32),  # appended (issue 20): the label's own material
+                ("has_material", ctypes.c_uint32),  # appended: the label's own material
                 ("material", ctypes.c_float * 4)]
 
 
@@ -380,9 +380,9 @@ class RenderParams(ctypes.Structure):
                 ("scene_shadows", ctypes.POINTER(SceneShadows)),
                 ("matcap", ctypes.POINTER(Matcap)),
                 ("reserved", ctypes.c_uint32 * RENDER_PARAMS_RESERVED),  # must stay 0
-                ("labels", ctypes.POINTER(LabelStyle)),  # appended (issue 20)
-                ("overlay_count", ctypes.c_uint32),      # appended (issue 20)
-                ("progressive", ctypes.c_uint32),        # appended (issue 21)
+                ("labels", ctypes.POINTER(LabelStyle)),  # appended
+                ("overlay_count", ctypes.c_uint32),      # appended
+                ("progressive", ctypes.c_uint32),        # appended
                 ("overlays", ctypes.POINTER(OverlayStyle)),
                 ("minip_floor_on", ctypes.c_uint32),     # appended: MinIP's floor
                 ("minip_floor", ctypes.c_float),
@@ -419,7 +419,7 @@ class RenderStats(ctypes.Structure):
                 ("decode_ms", ctypes.c_double),
                 ("illumination_size", ctypes.c_uint32),
                 ("illumination_rebuilt", ctypes.c_uint32),
-                ("refine_pending", ctypes.c_uint32),     # appended (issue 21)
+                ("refine_pending", ctypes.c_uint32),     # appended
                 ("stream_level", ctypes.c_uint32),
                 ("bytes_read", ctypes.c_uint64),
                 ("load_ms", ctypes.c_double)]

@@ -1,4 +1,4 @@
-"""Issue 19's optional render inputs as ctypes structs: the cutaway (clip
+"""The optional render inputs as ctypes structs: the cutaway (clip
 planes, crop box, cutter meshes, caps), the MatCap and a slice plane's
 params, built from plain Python data (numbers, numpy arrays) so the
 add-on's Blender side stays free of ctypes.

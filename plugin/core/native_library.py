@@ -62,14 +62,14 @@ def _declare(lib):
         "vxl_renderer_error": (ctypes.c_char_p, [vp]),
         "vxl_renderer_get_info": (ctypes.c_int, [vp, P(RendererInfo)]),
         "vxl_renderer_set_volume": (ctypes.c_int, [vp, vp]),
-        "vxl_renderer_set_labels": (ctypes.c_int, [vp, vp]),  # issue 20
-        "vxl_renderer_set_overlay": (ctypes.c_int, [vp, ctypes.c_uint32, vp]),  # issue 20
+        "vxl_renderer_set_labels": (ctypes.c_int, [vp, vp]),
+        "vxl_renderer_set_overlay": (ctypes.c_int, [vp, ctypes.c_uint32, vp]),
         "vxl_renderer_label_uploads": (ctypes.c_int, [vp, P(ctypes.c_uint64), P(ctypes.c_uint64)]),
         "vxl_render": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                       P(ctypes.c_float)]),
         "vxl_renderer_get_stats": (ctypes.c_int, [vp, P(RenderStats)]),
         "vxl_scene_transmittance": (ctypes.c_int, [vp, P(RenderParams), ctypes.c_uint32,
-                                                   P(ctypes.c_float)]),  # issue 18
+                                                   P(ctypes.c_float)]),
         "vxl_default_camera": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),
                                               P(ctypes.c_float)]),
         "vxl_probe_gradients": (ctypes.c_int, [vp, P(RenderParams), P(ctypes.c_float),

@@ -1,4 +1,4 @@
-"""Overlays (issue 20) as ctypes structs: params.overlays built from plain
+"""Overlays as ctypes structs: params.overlays built from plain
 Python data, so the add-on's Blender side stays free of ctypes.
 
 An overlay is a dict (every key but `slot` optional) or a ready

@@ -60,16 +60,16 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     `shading_model`. A light may carry a fourth item, its shape
     (spot_direction3, spot_angle, spot_blend, size, as vxl_light_shape);
     the shapes' array lives as long as the params.
-    Issue 19: `mode` is a render mode's name (Library.names("mode")) or
+    `mode` is a render mode's name (Library.names("mode")) or
     VXL_MODE_*; `matcap` an (h, w, 3|4) linear image (row 0 = bottom) with
     `matcap_key` its name, or None for the material and lights; `cutaway`
     a dict as native_cutaway.cutaway_struct takes it, or None. Their structs
     live as long as the params, and their contents are in _keep.
-    Issue 18: `scene_shadows` is (vertices (n, 3) world, triangles (m, 3)
+    `scene_shadows` is (vertices (n, 3) world, triangles (m, 3)
     vertex indices, key[, shadow_map_size]), the scene's opaque meshes that
     shadow the volume; key 0 lets the library hash the arrays, a nonzero key
     names this version of them (the same key: no shadow map is rebuilt).
-    Issue 20: `overlays` is a list of dicts or OverlayStyles
+    `overlays` is a list of dicts or OverlayStyles
     (native_overlays.py), each naming a slot filled by Renderer.set_overlay.
     `environment` is the World's light, (rgb (h, w, 3) linear, row 0 at the
     bottom; strength; rotation_deg about world +Z) as world_light.Environment
@@ -165,10 +165,10 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     p.early_termination = early_termination
     p.depth_threshold = depth_threshold
     p.no_skip = 1 if no_skip else 0
-    _issue19_inputs(p, lib, mode, matcap, matcap_key, cutaway)
+    _mode_and_cutaway_inputs(p, lib, mode, matcap, matcap_key, cutaway)
     if labels is not None:
         _set_labels(p, lib, *labels)
-    if overlays:  # issue 20: the struct array and its tables live as long as p
+    if overlays:  # the struct array and its tables live as long as p
         p._overlays, p._overlay_tables, digest = overlay_array(overlays, lib)
         p._keep.extend(digest)
         p.overlay_count = len(overlays)
@@ -253,7 +253,7 @@ def _set_labels(p, lib, mode, entries, boundary="smooth"):
     p.labels = ctypes.pointer(s)
 
 
-def _issue19_inputs(p, lib, mode, matcap, matcap_key, cutaway):
+def _mode_and_cutaway_inputs(p, lib, mode, matcap, matcap_key, cutaway):
     """The render mode, MatCap and cutaway of make_params."""
     p.mode = mode if isinstance(mode, int) else lib.index("mode", mode)
     if cutaway is not None:
@@ -306,12 +306,12 @@ class Renderer(LibraryObject):
                 "max_3d_texture_size": i.max_3d_texture_size}
 
     def set_labels(self, volume):
-        """The label volume (issue 20): a Volume of integer ids, or None to remove it."""
+        """The label volume: a Volume of integer ids, or None to remove it."""
         self._check(self.lib.cdll.vxl_renderer_set_labels(self.handle, volume.handle if volume is not None else None),
                     "set labels")
 
     def set_overlay(self, slot, volume):
-        """Overlay slot `slot` (< MAX_OVERLAYS, issue 20): a Volume in any
+        """Overlay slot `slot` (< MAX_OVERLAYS): a Volume in any
         grid (its affine places it), or None to empty the slot."""
         self._check(self.lib.cdll.vxl_renderer_set_overlay(self.handle, int(slot),
                                                            volume.handle if volume is not None else None),
@@ -343,7 +343,7 @@ class Renderer(LibraryObject):
         return rgba, depth
 
     def scene_transmittance(self, params, light=0):
-        """The volume's shadow on the scene (issue 18): for every pixel of
+        """The volume's shadow on the scene: for every pixel of
         params' scene_depth, the transmittance from that scene point to
         light `light` (an index into params' lights) through the volume;
         (h, w) float32, row 0 = bottom, 1 where the path misses the volume

@@ -32,14 +32,14 @@ def params_digest(params, *extra):
     c.scene_depth = None
     c.tf_rgba = None
     c.light_shapes = None  # their contents are in _keep
-    c.cutaway = None  # issue 19: so are the cutaway's and the MatCap's
+    c.cutaway = None  # so are the cutaway's and the MatCap's
     c.matcap = None
-    c.scene_shadows = None  # issue 18: its key (or arrays) are in _keep
-    # Issue 20: the label style by contents (read before the field, which
+    c.scene_shadows = None  # its key (or arrays) are in _keep
+    # the label style by contents (read before the field, which
     # shares c's memory, is cleared).
     labels = _label_style_bytes(c.labels.contents) if c.labels else b""
     c.labels = None
-    c.overlays = None  # issue 20: their contents are in _keep
+    c.overlays = None  # their contents are in _keep
     c.environment = None  # the World's map and numbers are in _keep
     h = hashlib.blake2b(bytes(c), digest_size=16)
     h.update(labels)
@@ -117,7 +117,7 @@ def _empty_stats():
             "brick_size": 0, "calls": 0, "seconds": 0.0, "storage_name": "", "resident_bytes": 0,
             "pages_total": 0, "pages_resident": 0, "pages_constant": 0, "lod_level": 0,
             "lod_wanted_bytes": 0, "decode_ms": 0.0,
-            "refine_pending": 0, "stream_level": 0, "bytes_read": 0, "load_ms": 0.0}  # issue 21
+            "refine_pending": 0, "stream_level": 0, "bytes_read": 0, "load_ms": 0.0}
 
 
 def _merge_stats(acc, s):
@@ -129,7 +129,7 @@ def _merge_stats(acc, s):
               "resident_bytes", "pages_total", "pages_resident", "pages_constant", "lod_level",
               "lod_wanted_bytes", "decode_ms"):
         acc[k] = s[k]
-    # Issue 21 (streamed volumes): every band's pending bricks and reads
+    # (streamed volumes): every band's pending bricks and reads
     # count, and the frame is as coarse as its coarsest band.
     for k in ("refine_pending", "bytes_read", "load_ms"):
         acc[k] += s.get(k, 0)

@@ -51,7 +51,7 @@ class Volume(LibraryObject):
         frame: the volume of a 4D file (only it is read); series: for a
         DICOM folder of several series, an index (int or its string) or a
         SeriesInstanceUID, as list_dicom_series() gives them.
-        Issue 21: streaming is "auto", "off" or "on" (vxl_streaming_name, or
+        streaming is "auto", "off" or "on" (vxl_streaming_name, or
         VXL_STREAMING_*): whether the voxels are read on demand instead of
         whole; cache_dir is where the bricked cache of a .nii.gz goes (None:
         beside the file). progress(fraction, stage) is called on this thread
@@ -166,7 +166,7 @@ class Volume(LibraryObject):
             if info.affine_source < 3 else str(info.affine_source),
             "frame_count": max(1, info.frame_count),
             "frame": info.frame,
-            # issue 21: read on demand, its resolution levels, CPU bytes held, bytes read so far
+            # read on demand, its resolution levels, CPU bytes held, bytes read so far
             "streamed": bool(info.streamed),
             "level_count": max(1, info.level_count),
             "resident_bytes": info.resident_bytes,

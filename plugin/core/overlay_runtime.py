@@ -1,4 +1,4 @@
-"""Overlay volumes on a renderer (issue 20), and which volume objects are
+"""Overlay volumes on a renderer, and which volume objects are
 drawn fused into which. No bpy here (tests/python/test_overlay_runtime.py).
 
 A base volume object draws up to MAX_OVERLAYS other volume objects in its

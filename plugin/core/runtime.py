@@ -181,7 +181,7 @@ class Worker:
 # Frames of 4D volumes, shared by every entry (frames.py).
 frame_cache = frames.FrameCache()
 
-# Issue 21: how files are opened, from the add-on preferences (preferences.py
+# how files are opened, from the add-on preferences (preferences.py
 # keeps this current): VXL_STREAMING_* by name, and where bricked caches go
 # ("" = beside the file).
 stream_settings = {"streaming": "auto", "cache_dir": ""}
@@ -216,7 +216,7 @@ class VolumeEntry:
         self.pending_frame = None  # 4D: the loaded frame, cached by adopt()
         self.frame_count = info.get("frame_count", 1)
         self.last_frame = None   # stats of the last frame rendered (panel)
-        self.load_kwargs = load_kwargs(self.options.get("memory_budget", 0))  # issue 21: other frames alike
+        self.load_kwargs = load_kwargs(self.options.get("memory_budget", 0))  # other frames alike
         self._worker = None
         renderer.on_render = _count_call
 
@@ -224,8 +224,8 @@ class VolumeEntry:
     def identity(self):
         """Part of every frame key: which data this renderer holds."""
         return (self.path, self.series, self.mtime, id(self), self.frame,
-                getattr(self, "label_key", None),  # issue 20: label_runtime
-                getattr(self, "overlay_key", None))  # issue 20: overlay_runtime
+                getattr(self, "label_key", None),  # label_runtime
+                getattr(self, "overlay_key", None))  # overlay_runtime
 
     def _frame_key(self, frame):
         return (self.path, self.series, self.mtime, frame)
@@ -318,7 +318,7 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
     and None returned. voxel_size (mm) is for inputs without geometry; it only
     changes info["affine"], which the importer bakes into the object, so later
     reloads need not repeat it.
-    Issue 21: memory_budget bounds the volume and its renderer together
+    memory_budget bounds the volume and its renderer together
     (budget_split); the file is opened as stream_settings say, and the
     library's first pass over it (a .nii.gz cached brick by brick) reports
     load_progress(fraction, stage) and stops when cancelled() says so."""
@@ -419,7 +419,7 @@ def entry_for(path, props, scene_frame, backend="auto", storage="auto", memory_b
     entry = get_entry(path, backend, props.series, storage, memory_budget)
     entry.show_frame(frames.volume_frame(scene_frame, entry.frame_count, props.frame_mode,
                                          props.frame_offset, props.fixed_frame))
-    # Issue 20: the object's label map (Object.voxlight_labels, label_props.py).
+    # the object's label map (Object.voxlight_labels, label_props.py).
     labels = getattr(getattr(props, "id_data", None), "voxlight_labels", None)
     label_runtime.show(entry, getattr(labels, "active_path", "") if labels is not None else "")
     return entry

@@ -22,8 +22,8 @@ def _visible_for_render(ob):
 def mesh_arrays(ob, matrix_world):
     """(vertices (n, 3) float64 in world space through matrix_world,
     triangles (m, 3) int64 indices) of an evaluated object's mesh, or None
-    when it has no triangles (or no mesh). Also the cutter meshes of
-    issue 19 (cutaway.py)."""
+    when it has no triangles (or no mesh). Also the cutaways' cutter
+    meshes (cutaway.py)."""
     try:
         mesh = ob.to_mesh()
     except RuntimeError:

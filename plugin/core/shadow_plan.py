@@ -1,4 +1,4 @@
-"""Planning of the volume's shadows on the scene in F12 (issue 18): which
+"""Planning of the volume's shadows on the scene in F12: which
 light goes into which Cycles light group, and the compositor nodes that
 multiply each group's light by its transmittance. No bpy: the Blender side
 (scene_shadows.py, compositor.py) carries the plan out, and

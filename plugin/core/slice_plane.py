@@ -1,4 +1,4 @@
-"""Slice planes (issue 19) without bpy: which part of a plane object the
+"""Slice planes without bpy: which part of a plane object the
 slice image covers, how many pixels it gets, and where each pixel lies.
 
 A slice is the square [-1, 1]^2 at z = 0 of its plane_to_world matrix

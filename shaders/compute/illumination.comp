@@ -1,5 +1,5 @@
 // illumination.comp - the illumination volumes of the shadowed and scatter
-// shading models (issue 17; csrc/illumination.c), at a reduced resolution:
+// shading models (csrc/illumination.c), at a reduced resolution:
 // u_cells cells over the volume box, cell c centred at voxel position
 // (c + 0.5) * u_cell - 0.5. One pass per program (PASS):
 //  0  extinction: per cell, the mean optical depth per voxel of path,
@@ -18,7 +18,7 @@
 //     the disc it covers seen from the cell (soft shadows).
 //  2  occlusion: per cell, the mean transmittance over 14 directions along
 //     rays of u_radius voxels (local ambient occlusion, Hernell et al. 2010).
-//  3  scene shadows (issue 18): a light's block, swept, times the
+//  3  scene shadows: a light's block, swept, times the
 //     visibility of each cell's centre through the scene's occluders
 //     (lib/shadow_maps.glsl), in place. The product is the cell's direct
 //     transmittance: the volume's and the meshes' attenuate the same path.

@@ -1,5 +1,5 @@
-// scene_transmittance.comp - the volume's shadow on the scene (issue 18;
-// csrc/light/transmittance.c): per pixel, the scene point at the given
+// scene_transmittance.comp - the volume's shadow on the scene
+// (csrc/light/transmittance.c): per pixel, the scene point at the given
 // depth through the frame's camera, and the transmittance of its path to
 // light u_light through the volume: the light's illumination volume, which
 // holds every cell's transmittance to the light (mesh shadows included),

@@ -70,7 +70,7 @@ vec4 channel_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
         float t = t_start + float(i) * u_step;
         if (t >= t1) break;
 #ifdef CUT_CUTTERS
-        CUT_SKIP_REMOVED(i, t, t_start) // issue 19: removed by a cutter (lib/cut.glsl)
+        CUT_SKIP_REMOVED(i, t, t_start) // removed by a cutter (lib/cut.glsl)
 #endif
         vec3 p = o + t * dir;
         if (u_skip != 0) {
@@ -116,7 +116,7 @@ vec4 channel_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
                 vec3 rgb = cs[c].rgb;
 #ifdef SHADING
                 vec3 g = vec3(gx[c / 4][c % 4], gy[c / 4][c % 4], gz[c / 4][c % 4]);
-                CUT_CAP(g, t); // issue 19: the first sample behind a cut takes the cut's normal
+                CUT_CAP(g, t); // the first sample behind a cut takes the cut's normal
                 rgb = shade_at(rgb, g, t, p, r);
 #endif
                 acc[slot] += (1.0 - acc[slot].a) * a * vec4(rgb, 1.0);

@@ -1,4 +1,4 @@
-// cut.glsl - cutaways (issue 19, voxlight.h's vxl_cutaway) in the ray
+// cut.glsl - cutaways (voxlight.h's vxl_cutaway) in the ray
 // caster, and the layer format the cutter peel writes (render/cut_peel.frag).
 //
 // CUT_CONVEX: clip planes (half-spaces or slabs) and the crop box narrow

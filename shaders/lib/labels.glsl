@@ -1,4 +1,4 @@
-// labels.glsl - issue 20 label maps (docs/labels.md; the GL side is
+// labels.glsl - label maps (docs/labels.md; the GL side is
 // csrc/labels/labels.c). LABELS is the label mode + 1: 1 SURFACE (label_march
 // replaces march), 2 MASK and 3 TINT (label_leap and label_mask in march).
 // Ids are never interpolated: ids are fetched with texelFetch. Smooth

@@ -1,4 +1,4 @@
-// matcap.glsl - MatCap shading (issue 19, voxlight.h's vxl_matcap): the
+// matcap.glsl - MatCap shading (voxlight.h's vxl_matcap): the
 // classified colour times the picture of a lit sphere at the view-space
 // normal, texel (0.5 + 0.5 n.x, 0.5 + 0.5 n.y), instead of the material and
 // lights. Needs lib/shading.glsl's u_normal_matrix. Compiled with MATCAP only.

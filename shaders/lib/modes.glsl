@@ -1,4 +1,4 @@
-// modes.glsl - the render modes beside DVR (issue 19, voxlight.h's
+// modes.glsl - the render modes beside DVR (voxlight.h's
 // VXL_MODE_*), one per program by MODE: 1 MIP, 2 MinIP, 3 average (the
 // projections), 4 ISO (the first crossing of the iso value). Included by
 // render/raycast.frag after its march (it uses RaySetup, jitter_hash and

@@ -1,4 +1,4 @@
-// overlays.glsl - issue 20 overlays (docs/overlays.md; the GL side is
+// overlays.glsl - overlays (docs/overlays.md; the GL side is
 // csrc/overlay/overlays.c). OVERLAYS (1..3) more volumes are sampled in the
 // base volume's ray march: overlay_march replaces march. The ray walks the
 // union of all boxes (overlay_span) in the base volume's voxel steps, at
@@ -149,7 +149,7 @@ vec4 overlay_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
     depth = uintBitsToFloat(0x7f800000u);
     taken = 0u;
 #if defined(LABELS) && LABELS > 1
-    LabelRay lr = label_ray(o, dir, t_start, u_step); // issue 20: the labels mask the base volume
+    LabelRay lr = label_ray(o, dir, t_start, u_step); // the labels mask the base volume
 #endif
     // Two loops, as march: the inner one walks the samples where no volume
     // is visible (skipped, or transparent in every volume), reading and
@@ -167,7 +167,7 @@ vec4 overlay_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
         for (; i < u_max_steps; i++) {
             t = t_start + float(i) * u_step;
             if (t >= t1) break;
-            CUT_SKIP_REMOVED(i, t, t_start) // issue 19: cutters remove intervals from every volume
+            CUT_SKIP_REMOVED(i, t, t_start) // cutters remove intervals from every volume
             if (u_skip != 0) {
                 float t_exit = ov_empty_until(u_brick_distance, u_brick_size, o, dir, t, ba, bb);
                 for (int k = 0; k < OVERLAYS; k++)
@@ -192,7 +192,7 @@ vec4 overlay_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
                 if (cb.a > 0.0) cb = with_data_colour(cb, p); // a colour volume's own colour
 #endif
 #if defined(LABELS) && LABELS > 1
-                if (cb.a > 0.0) cb = label_mask(lr, p, cb); // issue 20: only inside visible labels
+                if (cb.a > 0.0) cb = label_mask(lr, p, cb); // only inside visible labels
 #endif
             }
             bool any = cb.a > 0.0;

@@ -2,7 +2,7 @@
 uniform mat3 u_normal_matrix; // voxel-space gradient -> view-space normal
 uniform vec4 u_material;      // ambient, diffuse, specular, shininess
 #ifdef LABELS
-// issue 20: the material of the label whose sample is being lit, set by
+// the material of the label whose sample is being lit, set by
 // lib/labels.glsl before shading it; x < 0: the frame's (u_material).
 vec4 g_label_material = vec4(-1.0);
 #define SHADE_MATERIAL (g_label_material.x >= 0.0 ? g_label_material : u_material)
@@ -82,7 +82,7 @@ vec3 shade(vec3 rgb, vec3 g, vec3 pos, RayLighting r, bool one_directional)
     return clamp_colour(acc);
 }
 
-// Shading models beyond Phong (issue 17), one per program: SHADING_MODEL 1
+// Shading models beyond Phong, one per program: SHADING_MODEL 1
 // shadowed, 2 scatter, with the formulas of voxlight.h's VXL_SHADING_*.
 // Without the define (PHONG) none of this is compiled: shade() above stays
 // today's, bit for bit.

@@ -1,5 +1,5 @@
 // shadow_maps.glsl - one light's visibility through the scene's occluders
-// (issue 18; csrc/light/shadow_maps.c): its shadow maps, one layer per view
+// (csrc/light/shadow_maps.c): its shadow maps, one layer per view
 // (one view, or six for a cube about a point light), depth compared to the
 // point's own with a bias towards the light and filtered over a footprint
 // (percentage-closer filtering on the bilinear compare the sampler makes).

@@ -9,7 +9,7 @@
 #include "lib/classify.glsl"
 #include "lib/colour.glsl" // DATA_COLOUR: a colour volume's own colour
 #include "lib/shading.glsl"
-#include "lib/cut.glsl" // issue 19 cutaways: CUT_CONVEX, CUT_CUTTERS
+#include "lib/cut.glsl" // cutaways: CUT_CONVEX, CUT_CUTTERS
 #include "lib/matcap.glsl"
 #include "lib/ray_box.glsl"
 
@@ -74,7 +74,7 @@ struct RaySetup {
 vec3 shade_at(vec3 rgb, vec3 g, float t, vec3 p, RaySetup r)
 {
 #ifdef MATCAP
-    return shade_matcap(rgb, g, r.lighting.v); // issue 19: lib/matcap.glsl
+    return shade_matcap(rgb, g, r.lighting.v); // lib/matcap.glsl
 #elif SHADING_MODEL > 0
     return shade_lit(rgb, g, r.pos0 + t * r.dpos, p, r.lighting, r.one_directional);
 #else
@@ -126,7 +126,7 @@ bool add_sample(inout Compositing s, RaySetup r, int i, float t, vec3 p, float v
     s.last_shaded = i;
     g = reuse_gradient(s.gs, g);
 #endif
-    CUT_CAP(g, t); // issue 19: the first sample behind a cut takes the cut's normal (lib/cut.glsl)
+    CUT_CAP(g, t); // the first sample behind a cut takes the cut's normal (lib/cut.glsl)
     rgb = shade_at(rgb, g, t, p, r);
 #endif
     s.acc += (1.0 - s.acc.a) * a * vec4(rgb, 1.0);
@@ -142,10 +142,10 @@ bool add_sample(inout Compositing s, RaySetup r, int i, float t, vec3 p, float v
 #endif
 
 #ifdef LABELS
-#include "lib/labels.glsl" // issue 20 label maps: label_mask, label_march
+#include "lib/labels.glsl" // label maps: label_mask, label_march
 #endif
 #ifdef OVERLAYS
-#include "lib/overlays.glsl" // issue 20 overlays: overlay_span, overlay_march
+#include "lib/overlays.glsl" // overlays: overlay_span, overlay_march
 #endif
 
 // One ray from t0 to t1 (o + t * dir in voxels): premultiplied colour, the
@@ -169,7 +169,7 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
 #endif
     taken = 0u;
 #if defined(LABELS) && LABELS > 1
-    LabelRay lr = label_ray(o, dir, t_start, u_step); // issue 20: the label bricks along the ray
+    LabelRay lr = label_ray(o, dir, t_start, u_step); // the label bricks along the ray
     uint no_label = LABEL_NONE;
 #endif
     // Two loops: the inner one walks over the samples that add nothing
@@ -188,7 +188,7 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
             t = t_start + float(i) * u_step;
             if (t >= t1) break;
 #ifdef CUT_CUTTERS
-            int cut_next = cut_leap(i, t, t_start, u_step, u_max_steps); // issue 19: removed by a cutter
+            int cut_next = cut_leap(i, t, t_start, u_step, u_max_steps); // removed by a cutter
             if (cut_next >= 0) {
 #ifdef CLASSIFY_PREINT
                 v_prev = sample_value(o + (t_start + float(cut_next) * u_step) * dir); // a segment starts as a point
@@ -215,7 +215,7 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
                 }
             }
 #if defined(LABELS) && LABELS > 1 && !defined(CLASSIFY_PREINT)
-            int label_next = label_leap(lr, i, t, label_q(p), no_label); // issue 20: no visible label here
+            int label_next = label_leap(lr, i, t, label_q(p), no_label); // no visible label here
             if (label_next >= 0) {
                 i = label_next - 1;
                 continue;
@@ -253,7 +253,7 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
 #endif
 #endif
 #if defined(LABELS) && LABELS > 1
-            if (c.a > 0.0) c = label_mask(lr, p, c); // issue 20: only inside visible labels
+            if (c.a > 0.0) c = label_mask(lr, p, c); // only inside visible labels
 #endif
             if (c.a <= 0.0) continue;
 #ifdef DEFER_VISIBLE
@@ -269,16 +269,16 @@ vec4 march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float depth, ou
     return s.acc;
 }
 
-// issue 19: MIP, MinIP, average and ISO (lib/modes.glsl) replace march in main().
+// MIP, MinIP, average and ISO (lib/modes.glsl) replace march in main().
 #include "lib/modes.glsl"
 #if MODE != 0
 #define march mode_march
 #endif
 #if defined(LABELS) && LABELS == 1
-#define march label_march // issue 20: labels as surfaces
+#define march label_march // labels as surfaces
 #endif
 #ifdef OVERLAYS
-#define march overlay_march // issue 20: several volumes in one march
+#define march overlay_march // several volumes in one march
 #endif
 #include "lib/channels.glsl" // CHANNEL_GROUPS: every channel of a multi-channel volume in one march
 #ifdef CHANNEL_GROUPS
@@ -302,7 +302,7 @@ void main()
     // The part of the ray inside the volume's box (lib/ray_box.glsl).
     float t0 = 0.0, t1 = t_far;
 #ifdef OVERLAYS
-    if (!overlay_span(o, dir, t_far, t0, t1)) { emit_nothing(); return; } // issue 20: the union of all boxes
+    if (!overlay_span(o, dir, t_far, t0, t1)) { emit_nothing(); return; } // the union of all boxes
 #else
     if (!box_clip(o, dir, vec3(-0.5), u_dims - 0.5, t0, t1)) { emit_nothing(); return; }
 #endif
@@ -315,7 +315,7 @@ void main()
     }
     if (!(t0 < t1)) { emit_nothing(); return; }
 #ifdef CUT_ANY
-    if (!cut_begin(o, dir, z0, dz, t0, t1)) { emit_nothing(); return; } // issue 19: only the kept part (lib/cut.glsl)
+    if (!cut_begin(o, dir, z0, dz, t0, t1)) { emit_nothing(); return; } // only the kept part (lib/cut.glsl)
 #endif
 
     // View-space position is affine in t too: no matrix product per sample.

@@ -1,5 +1,5 @@
-// shadow_map.vert - the scene's occluder triangles (issue 18;
-// csrc/light/shadow_maps.c) as one light's view sees them: world positions
+// shadow_map.vert - the scene's occluder triangles
+// (csrc/light/shadow_maps.c) as one light's view sees them: world positions
 // to that view's clip space. Depth only (shadow_map.frag).
 layout(location = 0) in vec3 a_position; // world
 uniform mat4 u_light_matrix;             // world -> the view's clip space

@@ -1,4 +1,4 @@
-"""Issue 19 in Blender: clip-plane Empties cut the volume in F12 and the cut
+"""In Blender: clip-plane Empties cut the volume in F12 and the cut
 follows the Empty; the viewport's frame key changes when the Empty moves;
 slice planes show the library's resample and follow the plane (in its
 image and in F12); the render mode and MatCap change F12; the new

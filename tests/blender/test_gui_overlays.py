@@ -1,5 +1,5 @@
 """GUI Blender under Xvfb: the viewport draws a base volume with its overlay
-child fused (issue 20). A red ball in its own grid, parented to the ball
+child fused. A red ball in its own grid, parented to the ball
 phantom, shows red where its affine puts it on screen; the overlay is not
 drawn on its own (no viewport state of its own, one frame per refine step
 for the pair); hiding it removes the red; its blend reaches the frame.

@@ -1,5 +1,5 @@
 """GUI Blender under Xvfb: the Voxlight object panel at the Properties
-editor's default width (issue 14).
+editor's default width.
 
 xvfb-run -a -s "-screen 0 1280x1024x24" blender --factory-startup \
     --python-exit-code 1 --python tests/blender/test_gui_panel.py

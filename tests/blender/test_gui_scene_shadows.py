@@ -1,5 +1,5 @@
 """GUI Blender under Xvfb: the volume's shadow on a floor shows in the 3D
-viewport as a multiply layer (issue 18) once the view has settled, and
+viewport as a multiply layer once the view has settled, and
 goes when Cast Shadows is switched off.
 
 xvfb-run -a -s "-screen 0 1280x1024x24" blender --factory-startup \

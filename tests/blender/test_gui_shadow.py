@@ -1,6 +1,6 @@
 """GUI Blender under Xvfb: dragging a Sun in the viewport relights the
 shadowed volume with a coarse illumination volume, and once the light
-settles the viewport refines it to the chosen Shadow Quality (issue 17).
+settles the viewport refines it to the chosen Shadow Quality.
 
 xvfb-run -a -s "-screen 0 1280x1024x24" blender --factory-startup \
     --enable-event-simulate --python-exit-code 1 --python tests/blender/test_gui_shadow.py

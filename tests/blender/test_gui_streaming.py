@@ -1,4 +1,4 @@
-"""GUI Blender under Xvfb, issue 21: the viewport shows a streamed volume
+"""GUI Blender under Xvfb: the viewport shows a streamed volume
 at once, coarser where its bricks are still loading, and keeps refining it
 by itself (the add-on's timers, no redraw from the test) until nothing is
 pending.

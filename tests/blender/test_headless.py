@@ -126,13 +126,13 @@ def every_panel_property_changes_the_render():
 @test
 def filter_choices_come_from_the_library():
     """The panel's filter enum is the library's list (vxl_filter_name), with
-    the library's VXL_FILTER_* numbers, so issue 4's 'cubic' (6) is there."""
+    the library's VXL_FILTER_* numbers, so 'cubic' (6) is there."""
     lib = vx.core.native.load_library()
     prop = bpy.types.Object.bl_rna.properties["voxlight"].fixed_type.properties["filter"]
     items = [(i.identifier, i.value) for i in prop.enum_items]
     assert items == [(n, i) for i, n in enumerate(lib.filter_names())], items
     assert ("cubic", 6) in items and len(items) == len(vx.core.native.FILTERS)
-    assert ("cubic-smooth", 7) in items  # issue 14: the approximating B-spline
+    assert ("cubic-smooth", 7) in items  # the approximating B-spline
     assert {"cubic", "cubic-smooth"} <= vx.properties.FIXED_TAP_FILTERS  # sampleDistance greyed out
 
 

@@ -1,4 +1,4 @@
-"""Issue 20 in Blender: an atlas (a label NIfTI with a FreeSurfer-style
+"""In Blender: an atlas (a label NIfTI with a FreeSurfer-style
 LUT.txt beside it) imports as a labels object with the lookup file's names
 and colours; hiding one region in F12 changes exactly that region's pixels;
 the label colours and visibility take keyframes; hiding a label changes the

@@ -1,4 +1,4 @@
-"""Issue 20 overlays in Blender: a second volume object (a small bright ball
+"""Overlays in Blender: a second volume object (a small bright ball
 in its own grid and affine, coloured red by its own ColorRamp) parented to
 a base volume is drawn inside the base's ray march. F12 shows red where the
 ball lies and not when the overlay is hidden; the pair renders in one
@@ -131,7 +131,7 @@ def a_linked_overlay_draws_as_a_child_does_and_fuse_off_draws_it_alone():
     assert [l.object for l in base.voxlight_overlays.links] == [ov]
     linked = _offline(scene)
     assert np.abs(linked - child).max() < 1e-3
-    # Fuse off: drawn on its own as before issue 20, still red
+    # Fuse off: drawn on its own as without overlays, still red
     ov.voxlight_overlays.fuse = False
     runtime = _mod("core.runtime")
     n = runtime.render_count

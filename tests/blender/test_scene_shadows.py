@@ -1,4 +1,4 @@
-"""Issue 18 in Blender: the volume casts shadows on the scene's meshes in F12
+"""In Blender: the volume casts shadows on the scene's meshes in F12
 (through the compositor: each light group's light times the transmittance)
 and receives the shadows of meshes between it and a light.
 

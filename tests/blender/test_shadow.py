@@ -1,4 +1,4 @@
-"""Issue 17 in Blender: the scene's lights cast shadows through the volume
+"""In Blender: the scene's lights cast shadows through the volume
 in F12 renders (blender -b), the lighting settings (shading model,
 occlusion, anisotropy, shadow quality) are animatable and reach the
 library, new volumes default to shadowed, files from before keep Phong,

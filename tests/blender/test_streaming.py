@@ -1,4 +1,4 @@
-"""Issue 21 in Blender: volumes read brick by brick from disk. The add-on's
+"""In Blender: volumes read brick by brick from disk. The add-on's
 preferences choose the streaming mode and the cache folder; a streamed
 volume imports (synchronously in background mode) and renders in F12 at
 full resolution like one read whole; and a sparse NIfTI larger than the
@@ -32,7 +32,7 @@ from _util import test  # noqa: E402
 vx = u.install_addon()
 SIZE = 64
 MIB = 1 << 20
-OVERHEAD = 256 * MIB  # issue 21: peak RSS <= budget + this
+OVERHEAD = 256 * MIB  # peak RSS <= budget + this
 BUDGET_MIB = 2048
 
 

@@ -1,7 +1,7 @@
 """Headless Blender: the transfer function has one editor, the ColorRamp
-(issue 14): presets load into it placed on the data, are named in the panel
+: presets load into it placed on the data, are named in the panel
 and marked when edited; files and scripts using the old "Transfer Function"
-enum keep working; classification modes and gradient opacity (issue 6).
+enum keep working; classification modes and gradient opacity.
 
 blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_tf.py
 """

@@ -1,4 +1,4 @@
-"""tools/check_includes.py (issue 15): ./build.sh test fails on an include
+"""tools/check_includes.py: ./build.sh test fails on an include
 cycle between csrc/ files or folders, or on a folder including one above it
 in the declared layer order. Each test writes a small csrc/ tree (with a
 Makefile whose CFLAGS give the -I path, as the real one does) and runs the

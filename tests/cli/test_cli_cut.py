@@ -1,4 +1,4 @@
-"""The CLI's cutaway options (issue 19): --clip-plane A,B,C,D[,T], --crop
+"""The CLI's cutaway options: --clip-plane A,B,C,D[,T], --crop
 X0:X1,Y0:Y1,Z0:Z1 and --no-caps; their errors. Through an orthographic view
 down z whose pixels are one voxel wide (--view z --ortho --size NXxNY), a
 pixel is a voxel column, so what a cut keeps can be read off the alpha."""

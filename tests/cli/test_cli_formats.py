@@ -1,4 +1,4 @@
-"""`voxlight info|render` on the formats beyond NIfTI (issue 7): NRRD,
+"""`voxlight info|render` on the formats beyond NIfTI: NRRD,
 MetaImage, multi-page TIFF and numbered PNG series, plus one clear error line
 for hostile headers. Files are written here in plain Python (struct/zlib),
 independently of the C readers."""

@@ -1,5 +1,5 @@
 """`voxlight labels FILE` prints a label lookup table as the library reads
-it (issue 20), so a user can check a file before rendering with it; a bad
+it, so a user can check a file before rendering with it; a bad
 file is one `voxlight: error:` line naming the file and line."""
 import subprocess
 from pathlib import Path

@@ -1,4 +1,4 @@
-"""`voxlight render INPUT --labels LABELS` (issue 20): the label image drawn
+"""`voxlight render INPUT --labels LABELS`: the label image drawn
 with its lookup file (given, found beside it, or a palette), --label-mode,
 --hide-labels and --label-opacity; their errors. Through an orthographic
 view down z with one pixel per voxel (--view z --ortho --size NXxNY), a

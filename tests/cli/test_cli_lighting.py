@@ -1,4 +1,4 @@
-"""The CLI's lighting options (issue 17): --light, --shading,
+"""The CLI's lighting options: --light, --shading,
 --ambient-occlusion, --anisotropy; their errors, and that shadows show on the
 two-blobs phantom (blobs at world x = +0.45 and -0.45; the default camera
 looks from +Y, so the +x blob is on the image's left half)."""

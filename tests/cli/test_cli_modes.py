@@ -1,4 +1,4 @@
-"""The CLI's options of issue 19: --mode, --iso-value, --matcap, --ortho and
+"""The CLI's options: --mode, --iso-value, --matcap, --ortho and
 --view. Through an orthographic axis view whose pixels are one voxel wide
 (--view z --ortho --size NXxNY), MIP, MinIP and average equal numpy's max,
 min and mean along that axis; ISO covers exactly the ball it should; a MatCap

@@ -1,4 +1,4 @@
-"""`voxlight render INPUT --overlay FILE[:PRESET][:LO:HI]` (issue 20): up to
+"""`voxlight render INPUT --overlay FILE[:PRESET][:LO:HI]`: up to
 three more volumes, each in its own grid and affine, in the base's ray
 march, with --overlay-blend and --overlay-opacity for the overlay given
 last; their errors. Through an orthographic view down z with one pixel per

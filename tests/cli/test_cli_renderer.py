@@ -1,5 +1,5 @@
-"""`voxlight render --renderer`: the slicing comparison modes (issue 16,
-docs/slicing.md) render what the ray caster renders, through every storage
+"""`voxlight render --renderer`: the slicing comparison modes
+(docs/slicing.md) render what the ray caster renders, through every storage
 that samples like dense storage, and an unknown renderer is one clear line
 naming the choices."""
 from test_cli import assert_clean_error, png_alpha_mean, png_size, run

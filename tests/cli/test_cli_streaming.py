@@ -1,4 +1,4 @@
-"""Data larger than memory in `voxlight` (issue 21): --streaming and
+"""Data larger than memory in `voxlight`: --streaming and
 --cache-dir, what `info` says of a streamed volume, a streamed render equal
 to a whole one, --memory-budget split between the volume and the renderer,
 the progress of a .nii.gz's first open and Ctrl-C during it leaving no

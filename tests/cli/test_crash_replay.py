@@ -1,6 +1,6 @@
 """The crash-corpus replay (tests/fuzz/run.sh, in ./build.sh test) checks
 something only when it has inputs: it must fail when the corpus is missing or
-empty, and find its corpus from any working directory (issue 15).
+empty, and find its corpus from any working directory.
 VOXLIGHT_CRASHERS points it at a temporary corpus."""
 import os
 import shutil

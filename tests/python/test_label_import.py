@@ -1,4 +1,4 @@
-"""Issue 20's bpy-free add-on parts: the importer's label decisions
+"""The bpy-free add-on parts: the importer's label decisions
 (core/label_import.py), the label volume on a renderer
 (core/label_runtime.py) and the params digest seeing the label list
 (native_tiles.params_digest)."""

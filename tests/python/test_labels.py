@@ -1,4 +1,4 @@
-"""Label maps (issue 20) through the ctypes binding, without Blender:
+"""Label maps through the ctypes binding, without Blender:
 Renderer.set_labels and make_params(labels=(mode, entries)) reach the
 library. Seen along z with one pixel per voxel, a label volume of 2x2 voxel
 columns shows each column's label colour; hiding a label empties exactly its

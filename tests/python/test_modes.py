@@ -1,4 +1,4 @@
-"""Render modes and MatCaps (issue 19) through the ctypes binding, without
+"""Render modes and MatCaps through the ctypes binding, without
 Blender: make_params(mode=..., iso_value=..., matcap=...) reaches the library.
 Through an orthographic camera looking along a world axis, with one pixel per
 voxel and rays through voxel centres, MIP, MinIP and average equal numpy's

@@ -211,7 +211,7 @@ def test_param_validation(lib):
 
 def test_filter_names_come_from_the_library(lib):
     """The add-on's filter list is read from vxl_filter_name; the fallback
-    tuple must agree with it (issue 4 added 'cubic' as VXL_FILTER_CUBIC = 6)."""
+    tuple must agree with it (added 'cubic' as VXL_FILTER_CUBIC = 6)."""
     names = lib.filter_names()
     assert names == native.FILTERS == native.filter_names(lib)
     assert names[6] == "cubic" and lib.filter_index("cubic") == 6
@@ -361,16 +361,16 @@ def test_closed_handles(lib, ball_file):
 
 
 def test_render_params_tail_matches_header():
-    """Issue 6's fields replaced the reserved slots, keeping the size (624
-    bytes up to reserved[0]) until issue 15 gave the struct new reserved room
+    """The fields replaced the reserved slots, keeping the size (624
+    bytes up to reserved[0]) until gave the struct new reserved room
     after them (offsets and sizes against the compiler: test_abi.py), from
-    which issues 16 to 19 took their fields: the oldest layout still ends
+    which to 19 took their fields: the oldest layout still ends
     where the first of them begins plus one word."""
     import ctypes
     P = native.RenderParams
     assert P.shading_model.offset + 4 == 624
-    # 688 bytes up to the reserved room's end; issue 20 appended the labels'
-    # pointer, then overlay_count and (issue 21) progressive before the
+    # 688 bytes up to the reserved room's end; appended the labels'
+    # pointer, then overlay_count and progressive before the
     # overlays' pointer, which keeps it on its 8-byte alignment; MinIP's
     # floor (flag and value) follows it, then colour volumes' colour source (and a reserved word)
     assert P.labels.offset == 688 and P.overlays.offset == 704 and P.minip_floor.offset == 716
@@ -389,7 +389,7 @@ def test_render_params_tail_matches_header():
                      "ambient_occlusion", "occlusion_strength", "anisotropy", "illumination_size",
                      "technique", "mode", "cutaway", "scene_shadows", "matcap", "reserved",
                      "labels"]
-    # the pointers of issues 18 and 19 sit on their 8-byte alignment
+    # the pointers and 19 sit on their 8-byte alignment
     assert P.cutaway.offset % 8 == 0 and P.matcap.offset + 8 == P.reserved.offset
 
 

@@ -1,4 +1,4 @@
-"""Overlays (issue 20) through the ctypes binding, without Blender:
+"""Overlays through the ctypes binding, without Blender:
 Renderer.set_overlay and make_params(overlays=[...]) reach the library.
 Seen along z with one pixel per world unit, an overlay in its own grid and
 affine shows exactly over the pixels its box covers; its blend modes

@@ -1,4 +1,4 @@
-"""Scene shadows (issue 18) through the ctypes binding, without Blender:
+"""Scene shadows through the ctypes binding, without Blender:
 make_params(scene_shadows=...) reaches the library (a plate over half of a
 ball darkens that half), Renderer.scene_transmittance gives the ball's
 shadow on a floor where the geometry puts it, bad occluders raise an error

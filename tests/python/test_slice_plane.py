@@ -1,4 +1,4 @@
-"""Slice planes and cutaways without Blender (issue 19): the pure maths of
+"""Slice planes and cutaways without Blender: the pure maths of
 core/slice_plane.py and core/cutaway_space.py, Renderer.render_slice
 against numpy, and the cutaway/MatCap structs make_params builds."""
 

@@ -1,4 +1,4 @@
-"""Issue 21 in the ctypes binding and the add-on's bpy-free runtime:
+"""in the ctypes binding and the add-on's bpy-free runtime:
 Volume.load(streaming=, cache_dir=, progress=), cancelling from the
 progress callable (VoxlightError with code ERR_CANCELLED, no partial cache),
 and one memory budget split between the volume and its renderer."""

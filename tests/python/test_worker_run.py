@@ -1,5 +1,4 @@
-"""runtime.Worker runs Jobs with `run` (the viewport's scene shadows,
-issue 18) on the renderer's thread like banded frames: the result comes
+"""runtime.Worker runs Jobs with `run` (the viewport's scene shadows) on the renderer's thread like banded frames: the result comes
 back, a newer job of the same owner replaces a queued one, and a job
 cancelled while it runs ends with no result."""
 

@@ -150,9 +150,9 @@ int vxl_channels_flags(const vxl_channels_state *s, const vxl_frame *f, uint32_t
 static int ensure_tf(vxl_channels_state *s, const vxl_frame_channel *ch)
 {
     const uint32_t c = ch->channel;
-    if (s->tf_tex[c] && s->tf_key[c] == ch->key) return VXL_OK;
+    if (s->tf_tex[c] && s->tf_key[c] == ch->table.key) return VXL_OK;
     vxl_gpu *g = s->gpu;
-    const uint64_t bytes = (uint64_t)ch->tf_size * 4 * sizeof(float);
+    const uint64_t bytes = (uint64_t)ch->table.tf_size * 4 * sizeof(float);
     int rc = vxl_holdings_ask(g, VXL_HOLD_CHANNELS, s->bytes - s->tf_entry_bytes[c] + bytes, NULL,
                               "channel %u's transfer function", c);
     if (rc) return rc;
@@ -161,11 +161,11 @@ static int ensure_tf(vxl_channels_state *s, const vxl_frame_channel *ch)
     if (!s->tf_tex[c]) s->tf_tex[c] = vxl_texture_new(g, GL_TEXTURE_1D, GL_LINEAR);
     gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
     gl->BindTexture(GL_TEXTURE_1D, s->tf_tex[c]);
-    gl->TexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, (GLsizei)ch->tf_size, 0, GL_RGBA, GL_FLOAT, ch->tf);
+    gl->TexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, (GLsizei)ch->table.tf_size, 0, GL_RGBA, GL_FLOAT, ch->table.tf);
     rc = vxl_gl_check(g, "uploading a channel's transfer function");
     if (rc) delete_tex(g, &s->tf_tex[c]);
     /* on an error the next frame uploads again */
-    s->tf_key[c] = rc ? 0 : ch->key;
+    s->tf_key[c] = rc ? 0 : ch->table.key;
     s->tf_entry_bytes[c] = rc ? 0 : bytes;
     s->tf_bytes = 0;
     for (uint32_t k = 0; k < VXL_MAX_CHANNELS; k++) s->tf_bytes += s->tf_entry_bytes[k];
@@ -181,12 +181,12 @@ static int ensure_distance(vxl_channels_state *s, const vxl_frame *f)
     uint64_t key = 0xcbf29ce484222325ull;
     for (uint32_t k = 0; k < f->channels.count; k++) {
         const vxl_frame_channel *ch = &f->channels.ch[k];
-        const vxl_occupancy_rule rule = {.table_key = ch->key,
-                                         .tf = ch->tf,
-                                         .tf_size = ch->tf_size,
-                                         .window_offset = ch->window_offset,
-                                         .window_scale = ch->window_scale,
-                                         .opacity_scale = ch->opacity_scale,
+        const vxl_occupancy_rule rule = {.table_key = ch->table.key,
+                                         .tf = ch->table.tf,
+                                         .tf_size = ch->table.tf_size,
+                                         .window_offset = ch->table.window_offset,
+                                         .window_scale = ch->table.window_scale,
+                                         .opacity_scale = ch->table.opacity_scale,
                                          .filter = VXL_FILTER_CENTRAL,
                                          .sample_distance = 1.0f};
         if (vxl_bricks_classify(&s->bricks[ch->channel], &rule) < 0)
@@ -277,7 +277,7 @@ int vxl_channels_prepare(vxl_channels_state *s, const vxl_frame *f, GLuint prog)
         drawn |= 1 << c;
         gl->ActiveTexture(GL_TEXTURE0 + VXL_CHANNEL_TF_UNIT + c);
         gl->BindTexture(GL_TEXTURE_1D, s->tf_tex[c]);
-        const float cls[4] = {ch->window_offset, ch->window_scale, (float)ch->tf_size, ch->opacity_scale};
+        const float cls[4] = {ch->table.window_offset, ch->table.window_scale, (float)ch->table.tf_size, ch->table.opacity_scale};
         gl->Uniform4fv(loc_k(gl, prog, "u_ch_class", c), 1, cls);
         gl->Uniform3fv(loc_k(gl, prog, "u_ch_color", c), 1, ch->color);
     }

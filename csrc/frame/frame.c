@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -154,6 +155,37 @@ int vxl_frame_resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_vol
     int rc = check_float(e, "opacity_scale", os, 0, 1e6);
     f->opacity_scale = os;
     return rc;
+}
+
+int vxl_frame_resolve_table(vxl_frame_table *t, const vxl_render_params *q, const vxl_volume_geom *g, const char *what,
+                            uint32_t index, vxl_err *e)
+{
+    vxl_frame *tmp = calloc(1, sizeof *tmp);
+    if (!tmp) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory resolving %s %u", what, index);
+    int rc = vxl_frame_resolve_tf(tmp, q, g, e);
+    if (rc) {
+        vxl_frame_free(tmp);
+        free(tmp);
+        char why[VXL_MSG_MAX];
+        snprintf(why, sizeof why, "%s", e ? e->msg : "");
+        return vxl_fail(e, rc, "%s[%u]: %s", what, index, why);
+    }
+    t->tf_size = tmp->tf_size;
+    if (tmp->tf_copy) {
+        t->tf_copy = tmp->tf_copy; /* ownership moves to the side volume's table */
+        tmp->tf_copy = NULL;
+        t->tf = t->tf_copy;
+    } else {
+        memcpy(t->preset_tf, tmp->preset_tf, sizeof t->preset_tf);
+        t->tf = t->preset_tf;
+    }
+    t->window_offset = tmp->window_offset;
+    t->window_scale = tmp->window_scale;
+    t->opacity_scale = tmp->opacity_scale;
+    tmp->tf = t->tf; /* the key reads the table where the side volume keeps it */
+    t->key = vxl_classification_key(tmp);
+    free(tmp);
+    return VXL_OK;
 }
 
 static int resolve_lights(vxl_frame *f, const vxl_render_params *p, vxl_err *e)

@@ -25,16 +25,23 @@ struct vxl_volume;
 vxl_volume_geom vxl_volume_geom_of(const struct vxl_volume *v);
 
 /* One overlay of a frame, resolved against its volume's geometry. */
+/* A side volume's own transfer function and value mapping (an overlay's, a
+ * channel's), resolved by vxl_frame_resolve_table as the frame resolves
+ * its own. */
+typedef struct vxl_frame_table {
+    const float *tf;            /* tf_size straight RGBA, clamped to [0,1]: tf_copy or preset_tf */
+    uint32_t tf_size;
+    float window_offset, window_scale, opacity_scale; /* as the frame's, on the side volume's normalised texels */
+    uint64_t key;               /* vxl_classification_key of the above: the GL side's table and occupancy cache */
+    float *tf_copy;             /* owned when the caller gave a table */
+    float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
+} vxl_frame_table;
+
 typedef struct vxl_frame_overlay {
     uint32_t slot, blend, interpolation; /* VXL_BLEND_*, VXL_INTERP_* */
     uint32_t shading;           /* lit (the frame shades and the overlay's shading_off is 0) */
     double model[16];           /* overlay voxel -> world */
-    const float *tf;            /* tf_size straight RGBA, clamped to [0,1]: tf_copy or preset_tf */
-    uint32_t tf_size;
-    float window_offset, window_scale, opacity_scale; /* as the frame's, on the overlay's normalised texels */
-    uint64_t key;               /* vxl_classification_key of the above: the GL side's TF and occupancy cache */
-    float *tf_copy;             /* owned when the caller gave a table */
-    float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
+    vxl_frame_table table;      /* its transfer function on its own texels */
 } vxl_frame_overlay;
 
 /* One drawn channel of a multi-channel volume (frame_channels.c), resolved
@@ -42,12 +49,7 @@ typedef struct vxl_frame_overlay {
 typedef struct vxl_frame_channel {
     uint32_t channel;           /* the volume's channel index */
     float color[3];
-    const float *tf;            /* tf_size straight RGBA, clamped to [0,1]: tf_copy or preset_tf */
-    uint32_t tf_size;
-    float window_offset, window_scale, opacity_scale; /* on the channel's normalised texels */
-    uint64_t key;               /* vxl_classification_key of the above: the GL side's table and occupancy cache */
-    float *tf_copy;             /* owned when the caller gave a table */
-    float preset_tf[VXL_PRESET_TABLE_SIZE * 4];
+    vxl_frame_table table;      /* its transfer function on the channel's normalised texels */
 } vxl_frame_channel;
 
 typedef struct vxl_frame {
@@ -262,6 +264,12 @@ void vxl_channel_default_color(uint32_t c, float rgb[3]);
  * f->tf, f->tf_size, f->window_offset/scale, f->opacity_scale (f->tf_copy
  * owned). Part of vxl_frame_resolve; overlays resolve theirs with it. */
 int vxl_frame_resolve_tf(vxl_frame *f, const vxl_render_params *p, const vxl_volume_geom *g, vxl_err *e);
+/* A side volume's table from q (preset or table, window, opacity scale) on
+ * geometry g, as vxl_frame_resolve_tf resolves the frame's, into *t (whose
+ * tf_copy, if any, the caller frees). A failure's message is prefixed
+ * "what[index]: ". */
+int vxl_frame_resolve_table(vxl_frame_table *t, const vxl_render_params *q, const vxl_volume_geom *g, const char *what,
+                            uint32_t index, vxl_err *e);
 
 /* Validates p->scene_shadows into f's occluder fields: NULL
  * arrays with counts, indices out of range, vertices not finite and map

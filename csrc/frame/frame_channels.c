@@ -39,9 +39,10 @@ static int check_combination(const vxl_frame *f, vxl_err *e)
     return VXL_OK;
 }
 
-/* Style s (index i) against its channel's mapping g into ch. */
+/* Style s (index i) against its channel's mapping g into ch, its preset's
+ * colours in the frame's colour space. */
 static int resolve_one(vxl_frame_channel *ch, const vxl_channel_style *s, uint32_t i, const vxl_volume_geom *g,
-                       vxl_err *e)
+                       uint32_t color_space, vxl_err *e)
 {
     if (s->reserved) return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "channels[%u].reserved is %u: it must be 0", i, s->reserved);
     if (s->has_color) {
@@ -65,31 +66,9 @@ static int resolve_one(vxl_frame_channel *ch, const vxl_channel_style *s, uint32
     q.window_high = s->has_window ? s->window_high : (float)g->value_max;
     if (!s->has_window && !(q.window_high > q.window_low)) q.window_high = q.window_low + 1.0f; /* a flat channel */
     q.opacity_scale = s->opacity_scale;
-    vxl_frame *tmp = calloc(1, sizeof *tmp);
-    if (!tmp) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory resolving channel %u", s->channel);
-    int rc = vxl_frame_resolve_tf(tmp, &q, g, e);
-    if (rc) {
-        vxl_frame_free(tmp);
-        free(tmp);
-        char why[VXL_MSG_MAX];
-        snprintf(why, sizeof why, "%s", e ? e->msg : "");
-        return vxl_fail(e, rc, "channels[%u]: %s", i, why);
-    }
-    ch->tf_size = tmp->tf_size;
-    if (tmp->tf_copy) {
-        ch->tf_copy = tmp->tf_copy; /* ownership moves to the channel */
-        tmp->tf_copy = NULL;
-        ch->tf = ch->tf_copy;
-    } else {
-        memcpy(ch->preset_tf, tmp->preset_tf, sizeof ch->preset_tf);
-        ch->tf = ch->preset_tf;
-    }
-    ch->window_offset = tmp->window_offset;
-    ch->window_scale = tmp->window_scale;
-    ch->opacity_scale = tmp->opacity_scale;
-    tmp->tf = ch->tf; /* the key reads the table where the channel keeps it */
-    ch->key = vxl_classification_key(tmp);
-    free(tmp);
+    q.color_space = color_space;
+    int rc = vxl_frame_resolve_table(&ch->table, &q, g, "channels", i, e);
+    if (rc) return rc;
     ch->channel = s->channel;
     return VXL_OK;
 }
@@ -141,7 +120,7 @@ int vxl_frame_resolve_channels(vxl_frame *f, const vxl_render_params *pin, const
         const vxl_channel_style *s = styles[i];
         if (s->hidden || (solo && !s->solo)) continue;
         vxl_frame_channel *ch = &f->channels.ch[f->channels.count++]; /* counted first: vxl_frame_free frees it */
-        rc = resolve_one(ch, s, i, &geoms[s->channel], e);
+        rc = resolve_one(ch, s, i, &geoms[s->channel], f->color_space, e);
     }
     if (rc) vxl_frame_channels_free(f);
     return rc;
@@ -150,8 +129,8 @@ int vxl_frame_resolve_channels(vxl_frame *f, const vxl_render_params *pin, const
 void vxl_frame_channels_free(vxl_frame *f)
 {
     for (uint32_t k = 0; k < VXL_MAX_CHANNELS; k++) {
-        free(f->channels.ch[k].tf_copy);
-        f->channels.ch[k].tf_copy = NULL;
+        free(f->channels.ch[k].table.tf_copy);
+        f->channels.ch[k].table.tf_copy = NULL;
     }
     f->channels.count = 0;
     f->channels.on = 0;

@@ -68,31 +68,8 @@ static int resolve_one(vxl_frame *f, vxl_frame_overlay *ov, const vxl_overlay_st
     q.window_high = s->window_high;
     q.opacity_scale = s->opacity_scale;
     q.color_space = f->color_space; /* a preset's colours decoded as the base volume's are */
-    vxl_frame *tmp = calloc(1, sizeof *tmp);
-    if (!tmp) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory resolving overlay %u", i);
-    int rc = vxl_frame_resolve_tf(tmp, &q, g, e);
-    if (rc) {
-        vxl_frame_free(tmp);
-        free(tmp);
-        char why[VXL_MSG_MAX];
-        snprintf(why, sizeof why, "%s", e ? e->msg : "");
-        return vxl_fail(e, rc, "overlays[%u]: %s", i, why);
-    }
-    ov->tf_size = tmp->tf_size;
-    if (tmp->tf_copy) {
-        ov->tf_copy = tmp->tf_copy; /* ownership moves to the overlay */
-        tmp->tf_copy = NULL;
-        ov->tf = ov->tf_copy;
-    } else {
-        memcpy(ov->preset_tf, tmp->preset_tf, sizeof ov->preset_tf);
-        ov->tf = ov->preset_tf;
-    }
-    ov->window_offset = tmp->window_offset;
-    ov->window_scale = tmp->window_scale;
-    ov->opacity_scale = tmp->opacity_scale;
-    tmp->tf = ov->tf; /* the key reads the table where the overlay keeps it */
-    ov->key = vxl_classification_key(tmp);
-    free(tmp);
+    int rc = vxl_frame_resolve_table(&ov->table, &q, g, "overlays", i, e);
+    if (rc) return rc;
     ov->slot = s->slot;
     ov->blend = s->blend;
     ov->interpolation = interp;
@@ -181,8 +158,8 @@ int vxl_frame_resolve_overlays(vxl_frame *f, const vxl_render_params *pin, const
 void vxl_frame_overlays_free(vxl_frame *f)
 {
     for (uint32_t k = 0; k < VXL_MAX_OVERLAYS; k++) {
-        free(f->overlays.ov[k].tf_copy);
-        f->overlays.ov[k].tf_copy = NULL;
+        free(f->overlays.ov[k].table.tf_copy);
+        f->overlays.ov[k].table.tf_copy = NULL;
     }
     f->overlays.count = 0;
 }

@@ -138,9 +138,9 @@ static int settle_upload(vxl_overlays_state *s, GLuint *tex, uint64_t *bytes, ui
 /* The overlay's transfer function on its slot, when its key changed. */
 static int ensure_tf(vxl_overlays_state *s, vxl_overlay_slot *sl, const vxl_frame_overlay *ov)
 {
-    if (sl->tf_tex && sl->tf_key == ov->key) return VXL_OK;
+    if (sl->tf_tex && sl->tf_key == ov->table.key) return VXL_OK;
     vxl_gpu *g = s->gpu;
-    const uint64_t bytes = (uint64_t)ov->tf_size * 4 * sizeof(float);
+    const uint64_t bytes = (uint64_t)ov->table.tf_size * 4 * sizeof(float);
     int rc = vxl_holdings_ask(g, VXL_HOLD_OVERLAYS, s->bytes - sl->tf_bytes + bytes, NULL, "an overlay's transfer function");
     if (rc) return rc;
     vxl_gl *gl = &g->gl;
@@ -148,8 +148,8 @@ static int ensure_tf(vxl_overlays_state *s, vxl_overlay_slot *sl, const vxl_fram
     if (!sl->tf_tex) sl->tf_tex = vxl_texture_new(g, GL_TEXTURE_1D, GL_LINEAR);
     gl->ActiveTexture(GL_TEXTURE0 + VXL_SCRATCH_UNIT);
     gl->BindTexture(GL_TEXTURE_1D, sl->tf_tex);
-    gl->TexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, (GLsizei)ov->tf_size, 0, GL_RGBA, GL_FLOAT, ov->tf);
-    if ((rc = settle_upload(s, &sl->tf_tex, &sl->tf_bytes, &sl->tf_key, bytes, ov->key,
+    gl->TexImage1D(GL_TEXTURE_1D, 0, GL_RGBA32F, (GLsizei)ov->table.tf_size, 0, GL_RGBA, GL_FLOAT, ov->table.tf);
+    if ((rc = settle_upload(s, &sl->tf_tex, &sl->tf_bytes, &sl->tf_key, bytes, ov->table.key,
                             "uploading an overlay's transfer function")))
         return rc;
     s->table_uploads++;
@@ -163,12 +163,12 @@ static int ensure_tf(vxl_overlays_state *s, vxl_overlay_slot *sl, const vxl_fram
 static int ensure_distance(vxl_overlays_state *s, vxl_overlay_slot *sl, const vxl_frame_overlay *ov)
 {
     vxl_gpu *g = s->gpu;
-    const vxl_occupancy_rule rule = {.table_key = ov->key,
-                                     .tf = ov->tf,
-                                     .tf_size = ov->tf_size,
-                                     .window_offset = ov->window_offset,
-                                     .window_scale = ov->window_scale,
-                                     .opacity_scale = ov->opacity_scale,
+    const vxl_occupancy_rule rule = {.table_key = ov->table.key,
+                                     .tf = ov->table.tf,
+                                     .tf_size = ov->table.tf_size,
+                                     .window_offset = ov->table.window_offset,
+                                     .window_scale = ov->table.window_scale,
+                                     .opacity_scale = ov->table.opacity_scale,
                                      .filter = VXL_FILTER_CENTRAL,
                                      .sample_distance = 1.0f};
     int changed = vxl_bricks_classify(&sl->bricks, &rule);
@@ -235,7 +235,7 @@ static void bind_one(vxl_overlays_state *s, const vxl_frame *f, const vxl_frame_
     gl->UniformMatrix3fv(loc_k(gl, prog, "u_ov_grad_to_vox", j), 1, GL_FALSE, gt);
     const float dims[3] = {(float)sl->geom.dims[0], (float)sl->geom.dims[1], (float)sl->geom.dims[2]};
     gl->Uniform3fv(loc_k(gl, prog, "u_ov_dims", j), 1, dims);
-    const float cls[4] = {ov->window_offset, ov->window_scale, (float)ov->tf_size, ov->opacity_scale};
+    const float cls[4] = {ov->table.window_offset, ov->table.window_scale, (float)ov->table.tf_size, ov->table.opacity_scale};
     gl->Uniform4fv(loc_k(gl, prog, "u_ov_class", j), 1, cls);
     gl->Uniform1i(loc_k(gl, prog, "u_ov_blend", j), (GLint)ov->blend);
     gl->Uniform1i(loc_k(gl, prog, "u_ov_interp", j), (GLint)ov->interpolation);

@@ -3,12 +3,12 @@
 // the box is [-0.5, dims-0.5].
 // (Included outside every #if: files go in once per program, where first named.)
 #include "lib/slots.glsl"
-#ifndef COMPRESSED_DOMAIN
 // VXL_COLOR_SPACE_LINEAR: scene-linear colour in and out, so light may
 // make a colour brighter than 1 (display colour is clamped to [0, 1]).
 uniform bool u_linear;
 vec3 clamp_colour(vec3 c) { return u_linear ? max(c, 0.0) : clamp(c, 0.0, 1.0); }
 
+#ifndef COMPRESSED_DOMAIN
 uniform sampler3D u_volume; // normalised value in [0,1], trilinear, clamp to edge
 #endif
 uniform vec3 u_dims;

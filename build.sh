@@ -319,16 +319,24 @@ run_c_tests() {
     # (LLVM compiling a shader, a parser, a codec), so a 2-core machine runs
     # two of them in little more than the time of one. Each writes its output
     # to a file of its own; the results are printed in order afterwards.
-    local out_dir i=0
+    # Only the programs' own processes are counted and waited for: the
+    # caller may have background jobs of its own (with_xvfb's Xvfb).
+    local out_dir i=0 pids=() running p
     out_dir=$(mktemp -d)
     for t in "${tests[@]}"; do
-        while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
+        while :; do
+            running=0
+            for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && running=$((running + 1)); done
+            [ "$running" -lt "$jobs" ] && break
+            sleep 0.2
+        done
         ( local t0=$SECONDS rc=0
           "$@" "$t" >"$out_dir/$i.out" 2>&1 || rc=$?
           echo "$rc $((SECONDS - t0))" >"$out_dir/$i.rc" ) &
+        pids+=($!)
         i=$((i + 1))
     done
-    wait || true
+    for p in "${pids[@]}"; do wait "$p" || true; done
     i=0
     for t in "${tests[@]}"; do
         local out rc=1 secs=0 line

@@ -97,22 +97,32 @@ finish_blender "python tests (no Blender)"
 # (finish_scripts).
 LANES=${VOXLIGHT_BLENDER_LANES:-$(nproc)}
 started_scripts=()
+script_pids=()
 start_script() {  # tag, label, command...
     local tag=$1 label=$2
     shift 2
     local out=$SANDBOX/$tag-$label.log
-    while [ "$(jobs -rp | wc -l)" -ge "$LANES" ]; do wait -n || true; done
+    local running p
+    while :; do
+        running=0
+        for p in "${script_pids[@]}"; do kill -0 "$p" 2>/dev/null && running=$((running + 1)); done
+        [ "$running" -lt "$LANES" ] && break
+        sleep 0.2
+    done
     (
         sandbox_env "$tag/$label"
         local t0=$SECONDS rc=0
         (cd "$SANDBOX" && timeout 600 "$@") >"$out" 2>&1 || rc=$?
         echo "$rc $((SECONDS - t0))" >"$out.rc"
     ) &
+    script_pids+=($!)
     started_scripts+=("$tag $label")
 }
 
 finish_scripts() {  # wait for the started scripts and count their results
-    wait || true
+    local pid
+    for pid in "${script_pids[@]}"; do wait "$pid" || true; done
+    script_pids=()
     local entry tag label out rc secs line p f
     for entry in "${started_scripts[@]}"; do
         tag=${entry%% *}

@@ -321,12 +321,12 @@ run_c_tests() {
     # to a file of its own; the results are printed in order afterwards.
     # Only the programs' own processes are counted and waited for: the
     # caller may have background jobs of its own (with_xvfb's Xvfb).
-    local out_dir i=0 pids=() running p
+    local out_dir i=0 pids=() running pid
     out_dir=$(mktemp -d)
     for t in "${tests[@]}"; do
         while :; do
             running=0
-            for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && running=$((running + 1)); done
+            for pid in "${pids[@]}"; do kill -0 "$pid" 2>/dev/null && running=$((running + 1)); done
             [ "$running" -lt "$jobs" ] && break
             sleep 0.2
         done
@@ -336,7 +336,7 @@ run_c_tests() {
         pids+=($!)
         i=$((i + 1))
     done
-    for p in "${pids[@]}"; do wait "$p" || true; done
+    for pid in "${pids[@]}"; do wait "$pid" || true; done
     i=0
     for t in "${tests[@]}"; do
         local out rc=1 secs=0 line

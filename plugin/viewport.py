@@ -919,8 +919,7 @@ def _refine_still(st, s, args, owner):
                             and st.full.key == fr.key else None)
             if offset is not None:
                 img.rgba = rgba
-                img.path_samples = (offset + 1) if st.full is not None and fr is full \
-                    and st.full.key == fr.key else 1
+                img.path_samples = offset + 1 if prev is not None else 1
             st.job = None
             if fr is full:
                 st.full = img

@@ -10,6 +10,7 @@ the editor's default width."""
 import os
 
 import bpy
+import numpy as np
 
 from . import compat, tf
 from .core import histogram_image, import_job, label_import, runtime
@@ -116,21 +117,27 @@ PICTURE_SIZE = (256, 224)  # wide enough to align, tall enough to read
 def histogram_icon(obj):
     """icon_id of the object's histogram picture (histogram_image.render),
     regenerated when the histogram, the window or the ramp changed."""
+    p = obj.voxlight
+    counts, lo, hi = tf.histogram_of(obj)
+    return picture_icon(obj.name, counts, lo, hi, p.window_low, p.window_high, tf.table(p, 64))
+
+
+def picture_icon(name, counts, lo, hi, window_low, window_high, table, size=PICTURE_SIZE):
+    """icon_id of the histogram picture `name` (histogram_image.render of
+    the other arguments), regenerated when what it shows changed."""
     global _previews
     from bpy.utils import previews
     if _previews is None:
         _previews = previews.new()
-    p = obj.voxlight
-    counts, lo, hi = tf.histogram_of(obj)
-    table = tf.table(p, 64)
-    key = (counts.tobytes(), lo, hi, p.window_low, p.window_high,
-           table.tobytes() if table is not None else b"")
-    name = obj.name
+    counts = np.asarray(counts, np.int64)
+    key = (counts.tobytes(), lo, hi, window_low, window_high,
+           table.tobytes() if table is not None else b"", tuple(size))
     if _picture_keys.get(name) != key or name not in _previews:
         if name in _previews:
             del _previews[name]  # a fresh preview: the icon cache sees the new pixels
-        w, h = PICTURE_SIZE
-        img = histogram_image.render(counts, lo, hi, p.window_low, p.window_high, table, w, h)
+        w, h = size
+        img = histogram_image.render(counts, lo, hi, window_low, window_high, table, w, h,
+                                     strip=max(8, h * 40 // PICTURE_SIZE[1]))
         pv = _previews.new(name)
         pv.image_size = (w, h)
         pv.image_pixels_float.foreach_set(img.ravel())  # 15x faster than a list

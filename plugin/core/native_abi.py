@@ -36,6 +36,8 @@ OPACITY_SOURCES = ("luminance", "channel", "alpha")  # VXL_OPACITY_SOURCE_*: a c
 COLOR_SOURCES = ("auto", "data", "tf")  # VXL_COLOR_SOURCE_*
 COLOR_SPACES = ("display", "linear")  # VXL_COLOR_SPACE_*: what render params' colours mean
 MAX_OVERLAYS = 3  # VXL_MAX_OVERLAYS
+CHANNEL_BLENDS = ("add", "max")  # VXL_CHANNEL_BLEND_*
+MAX_CHANNELS = 8  # VXL_MAX_CHANNELS
 MAX_LABEL_ID = 65535  # VXL_MAX_LABEL_ID
 NOTES_MAX = 512  # VXL_NOTES_MAX: vxl_volume_info.notes, its NUL included
 # The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
@@ -45,7 +47,8 @@ ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "st
                   "technique": ("raycast", "slices2d", "slices3d"), "mode": MODES,
                   "interpolation": INTERPOLATIONS, "label_mode": LABEL_MODES,
                   "blend": BLENDS, "streaming": STREAMING_MODES,
-                  "opacity_source": OPACITY_SOURCES, "color_source": COLOR_SOURCES}
+                  "opacity_source": OPACITY_SOURCES, "color_source": COLOR_SOURCES,
+                  "channel_blend": CHANNEL_BLENDS}
 MAX_LIGHTS = 8
 RENDER_PARAMS_RESERVED = 2  # VXL_RENDER_PARAMS_RESERVED
 MAX_CLIP_PLANES = 6  # VXL_MAX_CLIP_PLANES

@@ -107,6 +107,5 @@ class VOXLIGHT_PT_volume_channels(_VolumePanel, bpy.types.Panel):
         col.prop(ch, "ramp")
 
 
-_classes = (VOXLIGHT_UL_channels, VOXLIGHT_PT_volume_channels)
-
-register, unregister = bpy.utils.register_classes_factory(_classes)
+# registered by panels.py, between the Voxlight panel and its other sub-panels
+CLASSES = (VOXLIGHT_UL_channels, VOXLIGHT_PT_volume_channels)

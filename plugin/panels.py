@@ -400,14 +400,22 @@ _classes = (VOXLIGHT_PT_volume, VOXLIGHT_PT_volume_rendering, VOXLIGHT_PT_volume
             VOXLIGHT_PT_scene)
 
 
+def _all_classes():
+    """The panels in the order the editor shows them: a multi-channel
+    volume's Channels right under its Voxlight panel, above the Transfer
+    Function (sub-panels appear in the order they are registered)."""
+    from . import channel_ui
+    return _classes[:1] + channel_ui.CLASSES + _classes[1:]
+
+
 def register():
-    for c in _classes:
+    for c in _all_classes():
         bpy.utils.register_class(c)
 
 
 def unregister():
     global _previews
-    for c in reversed(_classes):
+    for c in reversed(_all_classes()):
         bpy.utils.unregister_class(c)
     if _previews is not None:
         from bpy.utils import previews

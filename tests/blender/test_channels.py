@@ -241,4 +241,74 @@ def settings_that_cannot_draw_channels_draw_channel_0_alone_and_say_why():
     assert cp.why_not(p) == "" and lit[..., 1].max() > 0.1
 
 
+class _Recorder:
+    """Stands in for a UILayout: records (call, first text argument or
+    property name, keyword arguments) of every call."""
+
+    def __init__(self, calls):
+        self.__dict__["calls"] = calls
+
+    def __getattr__(self, name):
+        def call(*args, **kw):
+            what = args[1] if name == "prop" and len(args) > 1 else args[0] if args else None
+            if name == "label":
+                what = kw.get("text", what)
+            self.calls.append((name, what, kw))
+            return _Recorder(self.calls)
+        return call
+
+    def __setattr__(self, name, value):
+        self.calls.append(("set", name, value))
+
+
+def _draw_panel(ob):
+    calls = []
+
+    class Ctx:
+        object = ob
+        scene = bpy.context.scene
+        region = None
+        preferences = bpy.context.preferences
+    panel = bpy.types.VOXLIGHT_PT_volume_channels
+    assert panel.poll(Ctx)
+    panel.draw(type("P", (), {"layout": _Recorder(calls)})(), Ctx)
+    return calls
+
+
+@test
+def the_panel_lists_the_channels_shows_the_active_one_and_says_why_not():
+    scene, ob = _scene()
+    ob.voxlight.active_channel = 1
+    calls = _draw_panel(ob)
+    names = [c[1] for c in calls]
+    assert "VOXLIGHT_UL_channels" in names and "channel_blend" in names
+    for prop in ("window_low", "window_high", "opacity", "ramp", "color"):
+        assert prop in names, prop
+    assert "VOXLIGHT_MT_channel_dyes" in names
+    icons = [c[2].get("icon_value") for c in calls if c[0] == "template_icon"]
+    assert len(icons) == 1  # the active channel's histogram picture, its bars in its colour
+    pv = vx.panels._previews["%s/channel 1" % ob.name]
+    w, h = pv.image_size
+    px = np.empty(w * h * 4, np.float32)
+    pv.image_pixels_float.foreach_get(px)
+    px = px.reshape(h, w, 4)
+    assert (w, h) == tuple(vx.channel_ui.CHANNEL_PICTURE)
+    assert (px[..., 1] > px[..., 0] + 0.2).sum() > 50  # green bars (channel 1 is green)
+    assert not [c for c in calls if c[0] == "set" and c[1] == "alert"]
+    ob.voxlight.shading = True
+    ob.voxlight.shading_model = "scatter"
+    texts = " ".join(str(c[1]) for c in _draw_panel(ob) if c[0] == "label")
+    assert "Channels not drawn" in texts and "Phong" in texts, texts
+    ob.voxlight.use_channels = False
+    texts = " ".join(str(c[1]) for c in _draw_panel(ob) if c[0] == "label")
+    assert "Channel 0 alone" in texts and "Channels not drawn" not in texts, texts
+    # a one-channel volume has no Channels panel
+    one = u.import_volume(u.ball_file())
+    assert len(one.voxlight.channels) == 0
+
+    class Ctx:
+        object = one
+    assert not bpy.types.VOXLIGHT_PT_volume_channels.poll(Ctx)
+
+
 u.run("test_channels")

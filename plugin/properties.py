@@ -390,7 +390,8 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     channels: CollectionProperty(type=channel_props.VoxlightChannel, name="Channels",
                                  description="The volume's channels, channels[N] is channel N "
                                              "of the file")
-    active_channel: IntProperty(name="Active Channel", default=0, options=set())
+    active_channel: IntProperty(name="Active Channel", default=0, options=set(),
+                                description="The channel the Channels panel shows below its list")
     use_channels: BoolProperty(name="Draw Channels", default=True, update=tag_redraw,
                                description="Draw every channel in its colour in one pass; off: "
                                            "channel 0 alone with the transfer function above, "

@@ -23,18 +23,23 @@ class _OnChannels(OnActiveVolume):
         return super().poll(context) and len(context.object.voxlight.channels) > 0
 
 
-def _channel(self, context):
-    """The channel `index` names (-1: the active one), or None after reporting."""
-    p = context.object.voxlight
-    i = p.active_channel if self.index < 0 else self.index
-    if not 0 <= i < len(p.channels):
-        self.report({"ERROR"}, "Voxlight: the volume has channels 0..%d, not %d"
-                    % (len(p.channels) - 1, i))
-        return None
-    return p.channels[i]
+class _OnOneChannel(_OnChannels):
+    """An operator on one channel: `index`, or the active one (-1);
+    apply(channel) does the work."""
+
+    def execute(self, context):
+        p = context.object.voxlight
+        i = p.active_channel if self.index < 0 else self.index
+        if not 0 <= i < len(p.channels):
+            self.report({"ERROR"}, "Voxlight: the volume has channels 0..%d, not %d"
+                        % (len(p.channels) - 1, i))
+            return {"CANCELLED"}
+        self.apply(p.channels[i])
+        _redraw()
+        return {"FINISHED"}
 
 
-class VOXLIGHT_OT_channel_dye(_OnChannels, bpy.types.Operator):
+class VOXLIGHT_OT_channel_dye(_OnOneChannel, bpy.types.Operator):
     """Colour the channel as its dye is usually shown"""
     bl_idname = "voxlight.channel_dye"
     bl_label = "Dye Preset"
@@ -44,16 +49,11 @@ class VOXLIGHT_OT_channel_dye(_OnChannels, bpy.types.Operator):
                        description="The channel to colour (-1: the active one)")
     dye: EnumProperty(name="Dye", items=DYE_ITEMS)
 
-    def execute(self, context):
-        ch = _channel(self, context)
-        if ch is None:
-            return {"CANCELLED"}
+    def apply(self, ch):
         ch.color = channel_defaults.DYE_COLORS[self.dye]
-        _redraw()
-        return {"FINISHED"}
 
 
-class VOXLIGHT_OT_channel_fit_window(_OnChannels, bpy.types.Operator):
+class VOXLIGHT_OT_channel_fit_window(_OnOneChannel, bpy.types.Operator):
     """Set the channel's window to its whole data range"""
     bl_idname = "voxlight.channel_fit_window"
     bl_label = "Fit Window to Data"
@@ -62,13 +62,8 @@ class VOXLIGHT_OT_channel_fit_window(_OnChannels, bpy.types.Operator):
     index: IntProperty(name="Channel", default=-1, min=-1,
                        description="The channel to fit (-1: the active one)")
 
-    def execute(self, context):
-        ch = _channel(self, context)
-        if ch is None:
-            return {"CANCELLED"}
+    def apply(self, ch):
         ch.window_low, ch.window_high = ch.data_min, ch.data_max
-        _redraw()
-        return {"FINISHED"}
 
 
 class VOXLIGHT_OT_channel_show_all(_OnChannels, bpy.types.Operator):

@@ -476,6 +476,28 @@ def _fptr(arr):
     return arr.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
 
 
+def style_table(dst, tf, what):
+    """dst.tf_size and dst.tf_rgba (an overlay's or a channel's style) from
+    an (n, 4) straight-RGBA table; returns the float32 copy they point at
+    (the caller keeps it as long as dst), None for no table."""
+    if tf is None:
+        return None
+    tf = np.ascontiguousarray(tf, dtype=np.float32).reshape(-1, 4)
+    if len(tf) < 2:
+        raise ValueError("%s's tf_rgba needs at least 2 entries" % what)
+    dst.tf_size = len(tf)
+    dst.tf_rgba = _fptr(tf)
+    return tf
+
+
+def style_digest(dst):
+    """A style struct's bytes for params_digest, its table pointer left
+    out (it differs per build; the table itself is hashed)."""
+    plain = type(dst).from_buffer_copy(dst)
+    plain.tf_rgba = None
+    return np.frombuffer(bytes(plain), np.uint8)
+
+
 def _matrix_cm(m, ctype=ctypes.c_float):
     """4x4 math matrix (m[row][col]) -> 16 column-major values."""
     a = np.asarray(m, dtype=np.float64).reshape(4, 4)

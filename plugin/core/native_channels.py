@@ -20,7 +20,7 @@ import ctypes
 
 import numpy as np
 
-from .native_abi import MAX_CHANNELS, ChannelStyle, _fptr
+from .native_abi import MAX_CHANNELS, ChannelStyle, style_digest, style_table
 
 _KEYS = {"channel", "hidden", "solo", "color", "window", "preset", "tf_rgba", "opacity_scale"}
 
@@ -42,15 +42,7 @@ def _from_dict(dst, d, lib):
     preset = d.get("preset", 0)
     dst.preset = int(preset) if isinstance(preset, (int, np.integer)) else lib.preset_index(preset)
     dst.opacity_scale = float(d.get("opacity_scale", 1.0))
-    tf = d.get("tf_rgba")
-    if tf is None:
-        return None
-    tf = np.ascontiguousarray(tf, dtype=np.float32).reshape(-1, 4)
-    if len(tf) < 2:
-        raise ValueError("a channel's tf_rgba needs at least 2 entries")
-    dst.tf_size = len(tf)
-    dst.tf_rgba = _fptr(tf)
-    return tf
+    return style_table(dst, d.get("tf_rgba"), "a channel")
 
 
 def channel_array(channels, lib):
@@ -65,8 +57,5 @@ def channel_array(channels, lib):
         dst.struct_size = ctypes.sizeof(ChannelStyle)
         if tf is not None:
             tables.append(tf)
-            digest.append(tf)
-        plain = ChannelStyle.from_buffer_copy(dst)
-        plain.tf_rgba = None  # the pointer differs per build; its table is hashed above
-        digest.append(np.frombuffer(bytes(plain), np.uint8))
+        digest.extend(([] if tf is None else [tf]) + [style_digest(dst)])
     return arr, tables, digest

@@ -121,6 +121,11 @@ def refusal(props):
     return runtime.channel_refusal(entry)
 
 
+def drawn(props):
+    """Whether this volume's frames draw its channels (not its scalar alone)."""
+    return len(props.channels) >= 2 and props.use_channels and not why_not(props)
+
+
 def look_kwargs(props):
     """make_params' channels and channel_blend for a volume object
     (props: Object.voxlight), or {} when it draws its scalar alone: one

@@ -12,7 +12,7 @@ import os
 import bpy
 import numpy as np
 
-from . import compat, tf
+from . import channel_props, compat, tf
 from .core import histogram_image, import_job, label_import, runtime
 from .operators import OnActiveVolume
 from .properties import FIXED_TAP_FILTERS
@@ -154,6 +154,8 @@ class VOXLIGHT_PT_volume_tf(_VolumePanel, bpy.types.Panel):
         obj = context.object
         p = obj.voxlight
         layout = self.layout
+        if channel_props.drawn(p):  # the channels have their own colours and windows
+            layout.label(text="Used when the channels are not drawn", icon="INFO")
         name, modified = tf.preset_state(p)
         label = (name + (" (modified)" if modified else "")) if name else "Custom"
         layout.menu("VOXLIGHT_MT_tf_presets", text=label, icon="PRESET")

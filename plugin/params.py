@@ -78,10 +78,22 @@ def environment_for(look, environment):
     return None if look.get("channels") else environment
 
 
+def _key_of(v):
+    """A hashable value for a look_kwargs value: arrays by their bytes (a
+    repr would summarise a long table), lists and dicts item by item (the
+    channel styles)."""
+    if hasattr(v, "tobytes"):
+        return v.tobytes()
+    if isinstance(v, dict):
+        return tuple(sorted((k, _key_of(x)) for k, x in v.items()))
+    if isinstance(v, (list, tuple)):
+        return tuple(_key_of(x) for x in v)
+    return repr(v)
+
+
 def look_key(props, fast=False):
     """Hashable summary of look_kwargs, for the viewport's change test."""
-    return tuple(sorted((k, v.tobytes() if hasattr(v, "tobytes") else repr(v))
-                        for k, v in look_kwargs(props, fast).items()))
+    return tuple(sorted((k, _key_of(v)) for k, v in look_kwargs(props, fast).items()))
 
 
 class _Lights(list):

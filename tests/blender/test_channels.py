@@ -295,6 +295,16 @@ def the_panel_lists_the_channels_shows_the_active_one_and_says_why_not():
     assert (w, h) == tuple(vx.channel_ui.CHANNEL_PICTURE)
     assert (px[..., 1] > px[..., 0] + 0.2).sum() > 50  # green bars (channel 1 is green)
     assert not [c for c in calls if c[0] == "set" and c[1] == "alert"]
+    # the Transfer Function panel says its ramp waits for the channels to be off
+    tf_calls = []
+    bpy.types.VOXLIGHT_PT_volume_tf.draw(type("P", (), {"layout": _Recorder(tf_calls)})(),
+                                         type("C", (), {"object": ob, "region": None,
+                                                        "preferences": bpy.context.preferences}))
+    assert "Used when the channels are not drawn" in [c[1] for c in tf_calls if c[0] == "label"]
+    # a channel's curve changes what the scene-shadow cache keys on
+    key = vx.params.look_key(ob.voxlight)
+    ob.voxlight.channels[2].ramp = "BRIGHT"
+    assert vx.params.look_key(ob.voxlight) != key
     ob.voxlight.shading = True
     ob.voxlight.shading_model = "scatter"
     texts = " ".join(str(c[1]) for c in _draw_panel(ob) if c[0] == "label")

@@ -11,7 +11,7 @@ Everything that changes the look is animatable (colour, visibility, solo,
 window, opacity), and the viewport and F12 pass them as params.channels
 (look_kwargs, called by params.look_kwargs). When the volume's other
 settings cannot go with channels (core/channel_plan.conflict), look_kwargs
-draws the scalar alone and files why, which the Channels panel shows.
+draws the scalar alone and the Channels panel shows why (why_not).
 Defaults at import: core/channel_defaults.py (fill)."""
 
 import bpy
@@ -21,9 +21,6 @@ from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorPro
 from .core import channel_defaults, channel_plan, runtime
 
 HISTOGRAM_BINS = 32  # as the scalar's, saved with the object
-
-problems = {}  # volume object name -> why its channels are not drawn ("" when they are)
-
 
 def _redraw(self, context):
     from .properties import tag_redraw
@@ -130,15 +127,7 @@ def look_kwargs(props):
     """make_params' channels and channel_blend for a volume object
     (props: Object.voxlight), or {} when it draws its scalar alone: one
     channel, Draw Channels off, or a setting that cannot go with channels
-    (filed in problems for the panel)."""
-    if len(props.channels) < 2:
-        return {}
-    name = props.id_data.name
-    if not props.use_channels:
-        problems[name] = ""
-        return {}
-    why = why_not(props)
-    problems[name] = why
-    if why:
+    (why_not, which the panel shows)."""
+    if not drawn(props):
         return {}
     return {"channels": channel_plan.styles(props.channels), "channel_blend": props.channel_blend}

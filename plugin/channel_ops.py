@@ -27,6 +27,9 @@ class _OnOneChannel(_OnChannels):
     """An operator on one channel: `index`, or the active one (-1);
     apply(channel) does the work."""
 
+    index: IntProperty(name="Channel", default=-1, min=-1,
+                       description="The channel (-1: the active one)")
+
     def execute(self, context):
         p = context.object.voxlight
         i = p.active_channel if self.index < 0 else self.index
@@ -45,8 +48,6 @@ class VOXLIGHT_OT_channel_dye(_OnOneChannel, bpy.types.Operator):
     bl_label = "Dye Preset"
     bl_options = {"REGISTER", "UNDO"}
 
-    index: IntProperty(name="Channel", default=-1, min=-1,
-                       description="The channel to colour (-1: the active one)")
     dye: EnumProperty(name="Dye", items=DYE_ITEMS)
 
     def apply(self, ch):
@@ -58,9 +59,6 @@ class VOXLIGHT_OT_channel_fit_window(_OnOneChannel, bpy.types.Operator):
     bl_idname = "voxlight.channel_fit_window"
     bl_label = "Fit Window to Data"
     bl_options = {"REGISTER", "UNDO"}
-
-    index: IntProperty(name="Channel", default=-1, min=-1,
-                       description="The channel to fit (-1: the active one)")
 
     def apply(self, ch):
         ch.window_low, ch.window_high = ch.data_min, ch.data_max

@@ -138,7 +138,7 @@ def a_channels_window_changes_only_its_pixels_and_solo_shows_one():
 
 
 @test
-def a_dye_preset_sets_the_colour():
+def a_dye_preset_sets_the_colour_and_fit_restores_the_window():
     scene, ob = _scene()
     bpy.context.view_layer.objects.active = ob
     assert bpy.ops.voxlight.channel_dye(index=0, dye="DAPI") == {"FINISHED"}
@@ -155,6 +155,11 @@ def a_dye_preset_sets_the_colour():
     img = _offline(scene)
     red = _footprint(_alone(scene, ob, 0))
     assert img[red][:, 0].max() < 1e-6 and img[red][:, 2].max() > 0.2  # DAPI: blue, no red
+    ch = ob.voxlight.channels[2]
+    ch.window_low, ch.window_high = 500.0, 600.0
+    ob.voxlight.active_channel = 2
+    assert bpy.ops.voxlight.channel_fit_window() == {"FINISHED"}
+    assert (ch.window_low, ch.window_high) == (0.0, float(PEAKS[2]))
 
 
 @test

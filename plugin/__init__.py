@@ -48,6 +48,7 @@ if UNSUPPORTED is None:
     from . import cutaway_ui, slice_planes  # noqa: E402
     from . import label_props, label_ui  # noqa: E402
     from . import overlay_props, overlay_ui  # noqa: E402  (overlays)
+    from . import channel_ops, channel_props, channel_ui  # noqa: E402,F401  (channels; panels.py registers the UI)
     from .core import (depth, import_job, lights, native, runtime, scene_geometry,  # noqa: E402,F401
                        volume_space, zbuffer)
     from .api import render_volume  # noqa: E402,F401
@@ -55,7 +56,7 @@ if UNSUPPORTED is None:
     # Registration order: properties before the UI that shows them; handlers last.
     _modules = (preferences, properties, label_props, overlay_props, tf, operators, blender_volume, importer,
                 volume_object,
-                panels, slice_planes, cutaway_ui, label_ui, overlay_ui, render_setup, render_hooks, scene_shadows,
+                channel_ops, panels, slice_planes, cutaway_ui, label_ui, overlay_ui, render_setup, render_hooks, scene_shadows,
                 world_light, viewport)
 else:
     _modules = ()

@@ -155,7 +155,9 @@ class VOXLIGHT_OT_convert_to_blender_volume(OnActiveVolume, bpy.types.Operator):
         path = bpy.path.abspath(self.filepath or default_path(src, entry.frame))
         vol = _cpu_volume(source, props, entry.frame, opts["memory_budget"])
         try:
-            p = native.make_params(model=params.model_matrix(src), **params.look_kwargs(props))
+            # the scalar is classified (a multi-channel volume's channel 0)
+            p = native.make_params(model=params.model_matrix(src),
+                                   **params.look_kwargs(props, channels=False))
             info, density, rgb = vol.classified_grid(p, dims)
         finally:
             vol.close()

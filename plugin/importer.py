@@ -18,7 +18,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
 from bpy_extras.io_utils import ImportHelper
 from mathutils import Matrix
 
-from . import label_props, mode_start, preferences, tf
+from . import channel_props, label_props, mode_start, preferences, tf
 from .core import (framing, import_job, label_import, orientation, runtime, startup_cube,
                    volume_space)
 
@@ -55,6 +55,7 @@ def fill_volume_properties(obj, path, info, v2l, unit_scale):
         p.histogram = [int(min(c, 2**31 - 1)) for c in info["histogram"]]
     p.frame_count = info.get("frame_count", 1)
     p.reader_notes = info.get("notes", "")
+    channel_props.fill(p, info)  # a multi-channel volume's channels; none otherwise
 
 
 class VOXLIGHT_OT_import_volume(bpy.types.Operator, ImportHelper):

@@ -109,8 +109,9 @@ def render(scene, depsgraph, camera, width, height, only=None, occlusion=True,
         entry = runtime.entry_for(bpy.path.abspath(ob.voxlight.filepath), ob.voxlight,
                                   scene.frame_current, **opts)
         v2l = np.array(ob.voxlight.voxel_to_local, np.float64).reshape(4, 4).T
-        return entry, dict(view=view, proj=proj, model=mw @ v2l, lights=lights, environment=environment,
-                           **params.look_kwargs(ob.voxlight))
+        look = params.look_kwargs(ob.voxlight)
+        return entry, dict(view=view, proj=proj, model=mw @ v2l, lights=lights,
+                           environment=params.environment_for(look, environment), **look)
 
     if frame_info is not None:
         frame_info.update(depth=zbuf, named_lights=named if want_shadows else [],

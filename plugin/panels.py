@@ -10,8 +10,9 @@ the editor's default width."""
 import os
 
 import bpy
+import numpy as np
 
-from . import compat, tf
+from . import channel_props, compat, tf
 from .core import histogram_image, import_job, label_import, runtime
 from .operators import OnActiveVolume
 from .properties import FIXED_TAP_FILTERS
@@ -116,21 +117,27 @@ PICTURE_SIZE = (256, 224)  # wide enough to align, tall enough to read
 def histogram_icon(obj):
     """icon_id of the object's histogram picture (histogram_image.render),
     regenerated when the histogram, the window or the ramp changed."""
+    p = obj.voxlight
+    counts, lo, hi = tf.histogram_of(obj)
+    return picture_icon(obj.name, counts, lo, hi, p.window_low, p.window_high, tf.table(p, 64))
+
+
+def picture_icon(name, counts, lo, hi, window_low, window_high, table, size=PICTURE_SIZE):
+    """icon_id of the histogram picture `name` (histogram_image.render of
+    the other arguments), regenerated when what it shows changed."""
     global _previews
     from bpy.utils import previews
     if _previews is None:
         _previews = previews.new()
-    p = obj.voxlight
-    counts, lo, hi = tf.histogram_of(obj)
-    table = tf.table(p, 64)
-    key = (counts.tobytes(), lo, hi, p.window_low, p.window_high,
-           table.tobytes() if table is not None else b"")
-    name = obj.name
+    counts = np.asarray(counts, np.int64)
+    key = (counts.tobytes(), lo, hi, window_low, window_high,
+           table.tobytes() if table is not None else b"", tuple(size))
     if _picture_keys.get(name) != key or name not in _previews:
         if name in _previews:
             del _previews[name]  # a fresh preview: the icon cache sees the new pixels
-        w, h = PICTURE_SIZE
-        img = histogram_image.render(counts, lo, hi, p.window_low, p.window_high, table, w, h)
+        w, h = size
+        img = histogram_image.render(counts, lo, hi, window_low, window_high, table, w, h,
+                                     strip=max(8, h * 40 // PICTURE_SIZE[1]))
         pv = _previews.new(name)
         pv.image_size = (w, h)
         pv.image_pixels_float.foreach_set(img.ravel())  # 15x faster than a list
@@ -147,6 +154,8 @@ class VOXLIGHT_PT_volume_tf(_VolumePanel, bpy.types.Panel):
         obj = context.object
         p = obj.voxlight
         layout = self.layout
+        if channel_props.drawn(p):  # the channels have their own colours and windows
+            layout.label(text="Used when the channels are not drawn", icon="INFO")
         name, modified = tf.preset_state(p)
         label = (name + (" (modified)" if modified else "")) if name else "Custom"
         layout.menu("VOXLIGHT_MT_tf_presets", text=label, icon="PRESET")
@@ -393,14 +402,22 @@ _classes = (VOXLIGHT_PT_volume, VOXLIGHT_PT_volume_rendering, VOXLIGHT_PT_volume
             VOXLIGHT_PT_scene)
 
 
+def _all_classes():
+    """The panels in the order the editor shows them: a multi-channel
+    volume's Channels right under its Voxlight panel, above the Transfer
+    Function (sub-panels appear in the order they are registered)."""
+    from . import channel_ui
+    return _classes[:1] + channel_ui.CLASSES + _classes[1:]
+
+
 def register():
-    for c in _classes:
+    for c in _all_classes():
         bpy.utils.register_class(c)
 
 
 def unregister():
     global _previews
-    for c in reversed(_classes):
+    for c in reversed(_all_classes()):
         bpy.utils.unregister_class(c)
     if _previews is not None:
         from bpy.utils import previews

@@ -4,10 +4,10 @@ scripting API so all three render the same thing."""
 
 import numpy as np
 
-from .core import lighting
+from .core import channel_plan, lighting
 from .core import lights as _lights
 from .core import native
-from . import cutaway
+from . import channel_props, cutaway
 from . import label_props
 from . import mode_start
 from . import tf as _tf
@@ -20,10 +20,12 @@ def model_matrix(obj):
     return np.array(obj.matrix_world, np.float64) @ v2l
 
 
-def look_kwargs(props, fast=False, dragging=False):
+def look_kwargs(props, fast=False, dragging=False, channels=True):
     """The properties that decide how the volume looks, as make_params
     keyword arguments. `fast` doubles the step for interactive frames;
-    `dragging` (a light is being dragged) coarsens the illumination volume."""
+    `dragging` (a light is being dragged) coarsens the illumination volume;
+    `channels` False leaves a multi-channel volume's channels out (its
+    scalar alone: what classifying the scalar wants)."""
     # The ColorRamp and the window are the transfer function. Volumes not
     # converted yet (tf_version 0: appended from an old file) keep the old
     # switches: library preset unless Use ColorRamp, preset window unless
@@ -31,10 +33,7 @@ def look_kwargs(props, fast=False, dragging=False):
     legacy = props.tf_version < _tf.TF_SINGLE_EDITOR
     window = None
     if props.use_window or not legacy:
-        lo, hi = sorted((props.window_low, props.window_high))
-        if hi <= lo:
-            hi = lo + max(abs(lo), 1.0) * 1e-6
-        window = (lo, hi)
+        window = channel_plan.ordered_window(props.window_low, props.window_high)
     step = props.step * (2.0 if fast else 1.0)
     return dict(
         # Blender's colours (the ramp, lights, the World, MatCaps) are
@@ -66,13 +65,35 @@ def look_kwargs(props, fast=False, dragging=False):
         **lighting.look_kwargs(props, dragging),
         **cutaway.look_kwargs(props),  # mode, MatCap, cutaway
         **label_props.look_kwargs(props),  # label map colours and visibility
+        # a multi-channel volume's channels, or {} (its scalar alone)
+        **(channel_props.look_kwargs(props) if channels else {}),
     )
+
+
+def environment_for(look, environment):
+    """make_params' environment for a frame with these look_kwargs: the
+    World's light does not light a multi-channel volume's channels (the
+    library lights them with the lights alone), so a frame that draws them
+    has none (the Channels panel says so)."""
+    return None if look.get("channels") else environment
+
+
+def _key_of(v):
+    """A hashable value for a look_kwargs value: arrays by their bytes (a
+    repr would summarise a long table), lists and dicts item by item (the
+    channel styles)."""
+    if hasattr(v, "tobytes"):
+        return v.tobytes()
+    if isinstance(v, dict):
+        return tuple(sorted((k, _key_of(x)) for k, x in v.items()))
+    if isinstance(v, (list, tuple)):
+        return tuple(_key_of(x) for x in v)
+    return repr(v)
 
 
 def look_key(props, fast=False):
     """Hashable summary of look_kwargs, for the viewport's change test."""
-    return tuple(sorted((k, v.tobytes() if hasattr(v, "tobytes") else repr(v))
-                        for k, v in look_kwargs(props, fast).items()))
+    return tuple(sorted((k, _key_of(v)) for k, v in look_kwargs(props, fast).items()))
 
 
 class _Lights(list):
@@ -104,13 +125,22 @@ def while_lights_move(lights, now, settle_time):
     return out, left
 
 
+def scalar_only(kw):
+    """make_params keyword arguments without a multi-channel volume's
+    channels: the shadow a volume casts on the scene is its scalar's (the
+    library's scene transmittance marches one scalar)."""
+    return {k: v for k, v in kw.items() if k not in ("channels", "channel_blend")}
+
+
 def build(obj, width, height, view, proj, scene_depth=None, lights=(), fast=False, lib=None,
-          scene_shadows=None, overlays=None):
+          scene_shadows=None, overlays=None, channels=True):
     """scene_shadows: the occluders (vertices, triangles, key) that shadow
     the volume, or None. overlays: make_params' overlay dicts
-    (overlay_frames.prepare), or None."""
-    kw = look_kwargs(obj.voxlight, fast, dragging=getattr(lights, "dragged", False))
-    kw["environment"] = getattr(lights, "environment", None)
+    (overlay_frames.prepare), or None. channels False: the scalar alone
+    (look_kwargs)."""
+    kw = look_kwargs(obj.voxlight, fast, dragging=getattr(lights, "dragged", False),
+                     channels=channels)
+    kw["environment"] = environment_for(kw, getattr(lights, "environment", None))
     if overlays:
         kw["overlays"] = overlays
     if scene_shadows is not None:

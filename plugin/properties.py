@@ -7,7 +7,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
                        FloatVectorProperty, IntProperty, IntVectorProperty, PointerProperty,
                        StringProperty)
 
-from . import cutaway_props, tf
+from . import channel_props, cutaway_props, tf
 from .core import lighting, native
 
 # UI names of the filters this add-on knows. The list itself comes from the
@@ -386,6 +386,19 @@ class VoxlightVolumeProperties(bpy.types.PropertyGroup):
     caps: BoolProperty(name="Caps", default=True, update=tag_redraw,
                        description="Shade a cut face with the cut's own direction, so it "
                                    "looks like a clean cut surface instead of noisy tissue")
+    # --- channels of a multi-channel volume (channel_props.py, set at import)
+    channels: CollectionProperty(type=channel_props.VoxlightChannel, name="Channels",
+                                 description="The volume's channels, channels[N] is channel N "
+                                             "of the file")
+    active_channel: IntProperty(name="Active Channel", default=0, options=set(),
+                                description="The channel the Channels panel shows below its list")
+    use_channels: BoolProperty(name="Draw Channels", default=True, update=tag_redraw,
+                               description="Draw every channel in its colour in one pass; off: "
+                                           "channel 0 alone with the transfer function above, "
+                                           "as a one-channel file")
+    channel_blend: EnumProperty(name="Blend", items=channel_props.BLEND_ITEMS, default="add",
+                                update=tag_redraw,
+                                description="How the channels combine where they overlap")
 
 
 class VoxlightSceneProperties(bpy.types.PropertyGroup):
@@ -438,7 +451,7 @@ class VoxlightSceneProperties(bpy.types.PropertyGroup):
                                                "changes)")
 
 
-_classes = cutaway_props.CLASSES + (VoxlightVolumeProperties, VoxlightSceneProperties)
+_classes = cutaway_props.CLASSES + channel_props.CLASSES + (VoxlightVolumeProperties, VoxlightSceneProperties)
 
 
 def register():

@@ -22,7 +22,7 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from . import app_handlers, compositor, id_writes
+from . import app_handlers, compositor, id_writes, params
 from .core import facing, light_shares
 from .core import lights as _lights
 from .core import native, scene_geometry, shadow_plan
@@ -316,7 +316,8 @@ def transmittances(frame, depth, width, height):
     (core/facing.py): no light it could block reaches there."""
     out = {}
     for entry, kwargs in frame["casters"]:
-        p = native.make_params(width=width, height=height, scene_depth=depth, **kwargs)
+        p = native.make_params(width=width, height=height, scene_depth=depth,
+                               **params.scalar_only(kwargs))
         for i in range(len(kwargs["lights"])):
             t = entry.renderer.scene_transmittance(p, i)
             out[i] = t if i not in out else out[i] * t

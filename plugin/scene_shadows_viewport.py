@@ -132,7 +132,8 @@ def draw_layer(scene, depsgraph, objs, window_depth, W, H, view, proj, lights, r
         else:
             win = _depth.downsample(window_depth.pixels, w, h)
             planar = _depth.window_to_planar(win, proj)
-            pairs = [(entry, params.build(ob, w, h, view, proj, scene_depth=planar, lights=lights))
+            pairs = [(entry, params.build(ob, w, h, view, proj, scene_depth=planar, lights=lights,
+                                          channels=False))
                      for ob, entry in built]
             job = runtime.Job((region_ptr, OWNER), key, None)
             job.run = lambda stop, pairs=pairs, lights=list(lights), args=(

@@ -333,6 +333,12 @@ VXL_API int vxl_volume_get_info(const vxl_volume *vol, vxl_volume_info *out);
  * loader, so a UI can show the histogram of any format. */
 VXL_API int vxl_volume_histogram(const vxl_volume *vol, uint32_t bins, double lo, double hi,
                                  uint64_t *counts);
+/* The same counts of one channel of a multi-channel volume (data units of
+ * that channel, from the 16 bits it is drawn from; docs/channels.md), for a
+ * UI's per-channel histogram. VXL_ERR_STATE for a volume without channels,
+ * VXL_ERR_INVALID_ARGUMENT for a channel it does not have. */
+VXL_API int vxl_volume_channel_histogram(const vxl_volume *vol, uint32_t channel, uint32_t bins, double lo,
+                                         double hi, uint64_t *counts);
 VXL_API void vxl_volume_destroy(vxl_volume *vol);
 
 /* ---------------------------------------------------------------- DICOM */

@@ -412,7 +412,8 @@ static int bin_streamed(const vxl_volume *v, uint32_t bins, double lo, double sc
     return rc;
 }
 
-int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double hi, uint64_t *counts)
+/* The arguments both histograms take, checked; counts zeroed. */
+static int histogram_args(const vxl_volume *v, uint32_t bins, double lo, double hi, uint64_t *counts)
 {
     if (!v || !counts || bins == 0)
         return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "histogram needs a volume, counts and bins >= 1");
@@ -420,6 +421,13 @@ int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double h
     if (!isfinite(lo) || !isfinite(hi) || !(hi > lo))
         return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "histogram range [%g, %g] is empty or not finite", lo, hi);
     memset(counts, 0, bins * sizeof *counts);
+    return VXL_OK;
+}
+
+int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double hi, uint64_t *counts)
+{
+    int rc = histogram_args(v, bins, lo, hi, counts);
+    if (rc) return rc;
     /* Stored t in [0,1] maps to tex_lo + t*(tex_hi - tex_lo): bin by t directly. */
     const double scale = bins / (hi - lo);
     if (v->source) {
@@ -435,6 +443,28 @@ int vxl_volume_histogram(const vxl_volume *v, uint32_t bins, double lo, double h
             uint64_t *c = &counts[b >= bins ? bins - 1 : (uint32_t)b];
             *c -= *c < v->nan_count ? *c : v->nan_count;
         }
+    }
+    return VXL_OK;
+}
+
+int vxl_volume_channel_histogram(const vxl_volume *v, uint32_t channel, uint32_t bins, double lo, double hi,
+                                 uint64_t *counts)
+{
+    int rc = histogram_args(v, bins, lo, hi, counts);
+    if (rc) return rc;
+    if (!v->channels)
+        return vxl_fail(NULL, VXL_ERR_STATE, "histogram of channel %u: the volume is not multi-channel", channel);
+    if (channel >= v->channel_count)
+        return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "histogram of channel %u: the volume has channels 0..%u",
+                        channel, v->channel_count - 1);
+    /* From the channel's own 16-bit texels, the values the channel march
+     * samples. A channel keeps no NaN count of its own, so its NaN voxels
+     * are counted where they were stored (its minimum). */
+    const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
+    const double tex_lo = v->ch_tex_lo[channel], span = v->ch_tex_hi[channel] - tex_lo, scale = bins / (hi - lo);
+    for (uint64_t i = 0; i < n; i++) {
+        double b = (tex_lo + vxl_channel_texel(v, channel, i) * span - lo) * scale;
+        if (b >= 0 && b <= bins) counts[b >= bins ? bins - 1 : (uint32_t)b]++;
     }
     return VXL_OK;
 }

@@ -23,6 +23,7 @@ of the add-on and the tests say `native.X`:
   native_renderer      make_params, Renderer
   native_cutaway       cutaway, MatCap and slice structs from plain data
   native_overlays      overlay styles (params.overlays) from plain data
+  native_channels      channel styles (params.channels) from plain data
 """
 
 import sys
@@ -30,7 +31,7 @@ import types
 
 from . import (native_abi, native_cutaway, native_library, native_private_copy, native_renderer,
                native_tiles, native_volume)
-from .native_abi import (ABI_VERSION, BACKENDS, CLASSIFY_MODES, ENUM_FALLBACKS, FILTERS,  # noqa: F401
+from .native_abi import (ABI_VERSION, BACKENDS, CHANNEL_BLENDS, CLASSIFY_MODES, MAX_CHANNELS, ENUM_FALLBACKS, FILTERS,  # noqa: F401
                          GRADIENT_OPACITY_MODES, MAX_LIGHTS, PRESETS, RENDER_PARAMS_RESERVED,
                          STORAGES, MAX_CLIP_PLANES, MAX_CUTTERS, MODES, INTERPOLATIONS, LABEL_MODES, LABEL_BOUNDARIES, MAX_LABEL_ID, BLENDS, STREAMING_MODES, MAX_OVERLAYS, PROGRESS_CALLBACK, OverlayStyle, ClipPlane,
                          Cutaway, Cutter, LabelEntry, LabelStyle, Matcap, Environment, SceneShadows, SliceParams, GridParams, GridInfo, DicomSeries, Light, LightShape, LibraryUnavailable, LoadOptions, PhantomDesc,
@@ -43,6 +44,7 @@ from .native_private_copy import (CACHE_DIR, HELPER_PREFIX, OLD_VDB_HELPER_NAME,
                                   helper_names, private_copy, restore_execute_bit)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct  # noqa: F401
 from .native_overlays import overlay_array  # noqa: F401
+from .native_channels import channel_array  # noqa: F401
 from .native_renderer import Renderer, make_params  # noqa: F401
 from .native_tiles import params_digest, tile_params  # noqa: F401
 from .native_volume import Volume, list_dicom_series, load_label_table, voxel_box_corners  # noqa: F401

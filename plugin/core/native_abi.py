@@ -36,6 +36,8 @@ OPACITY_SOURCES = ("luminance", "channel", "alpha")  # VXL_OPACITY_SOURCE_*: a c
 COLOR_SOURCES = ("auto", "data", "tf")  # VXL_COLOR_SOURCE_*
 COLOR_SPACES = ("display", "linear")  # VXL_COLOR_SPACE_*: what render params' colours mean
 MAX_OVERLAYS = 3  # VXL_MAX_OVERLAYS
+CHANNEL_BLENDS = ("add", "max")  # VXL_CHANNEL_BLEND_*
+MAX_CHANNELS = 8  # VXL_MAX_CHANNELS
 MAX_LABEL_ID = 65535  # VXL_MAX_LABEL_ID
 NOTES_MAX = 512  # VXL_NOTES_MAX: vxl_volume_info.notes, its NUL included
 # The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
@@ -45,7 +47,8 @@ ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "st
                   "technique": ("raycast", "slices2d", "slices3d"), "mode": MODES,
                   "interpolation": INTERPOLATIONS, "label_mode": LABEL_MODES,
                   "blend": BLENDS, "streaming": STREAMING_MODES,
-                  "opacity_source": OPACITY_SOURCES, "color_source": COLOR_SOURCES}
+                  "opacity_source": OPACITY_SOURCES, "color_source": COLOR_SOURCES,
+                  "channel_blend": CHANNEL_BLENDS}
 MAX_LIGHTS = 8
 RENDER_PARAMS_RESERVED = 2  # VXL_RENDER_PARAMS_RESERVED
 MAX_CLIP_PLANES = 6  # VXL_MAX_CLIP_PLANES
@@ -471,6 +474,28 @@ class LibraryObject:
 
 def _fptr(arr):
     return arr.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+
+
+def style_table(dst, tf, what):
+    """dst.tf_size and dst.tf_rgba (an overlay's or a channel's style) from
+    an (n, 4) straight-RGBA table; returns the float32 copy they point at
+    (the caller keeps it as long as dst), None for no table."""
+    if tf is None:
+        return None
+    tf = np.ascontiguousarray(tf, dtype=np.float32).reshape(-1, 4)
+    if len(tf) < 2:
+        raise ValueError("%s's tf_rgba needs at least 2 entries" % what)
+    dst.tf_size = len(tf)
+    dst.tf_rgba = _fptr(tf)
+    return tf
+
+
+def style_digest(dst):
+    """A style struct's bytes for params_digest, its table pointer left
+    out (it differs per build; the table itself is hashed)."""
+    plain = type(dst).from_buffer_copy(dst)
+    plain.tf_rgba = None
+    return np.frombuffer(bytes(plain), np.uint8)
 
 
 def _matrix_cm(m, ctype=ctypes.c_float):

@@ -24,7 +24,7 @@ import ctypes
 
 import numpy as np
 
-from .native_abi import MAX_OVERLAYS, OverlayStyle, _fptr, _matrix_cm
+from .native_abi import MAX_OVERLAYS, OverlayStyle, _fptr, _matrix_cm, style_digest, style_table
 
 
 def _enum(lib, kind, value):
@@ -52,15 +52,7 @@ def _from_dict(dst, d, lib):
     if d.get("model") is not None:
         dst.has_model = 1
         dst.model = _matrix_cm(d["model"])
-    tf = d.get("tf_rgba")
-    if tf is None:
-        return None
-    tf = np.ascontiguousarray(tf, dtype=np.float32).reshape(-1, 4)
-    if len(tf) < 2:
-        raise ValueError("an overlay's tf_rgba needs at least 2 entries")
-    dst.tf_size = len(tf)
-    dst.tf_rgba = _fptr(tf)
-    return tf
+    return style_table(dst, d.get("tf_rgba"), "an overlay")
 
 
 def overlay_array(overlays, lib):
@@ -83,7 +75,5 @@ def overlay_array(overlays, lib):
         if tf is not None:
             tables.append(tf)
             digest.append(tf)
-        plain = OverlayStyle.from_buffer_copy(dst)
-        plain.tf_rgba = None  # the pointer differs per build; its table is hashed above
-        digest.append(np.frombuffer(bytes(plain), np.uint8))
+        digest.append(style_digest(dst))
     return arr, tables, digest

@@ -9,10 +9,11 @@ import time
 
 import numpy as np
 
-from .native_abi import (COLOR_SOURCES, COLOR_SPACES, LABEL_BOUNDARIES, Environment, LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
-                         RendererInfo, RendererOptions, SceneShadows, VoxlightError, matrix_from_cm, _fptr,
+from .native_abi import (CHANNEL_BLENDS, COLOR_SOURCES, COLOR_SPACES, LABEL_BOUNDARIES, Environment, LabelEntry, LabelStyle, LibraryObject, OverlayStyle, LightShape, MAX_LIGHTS, RenderParams, RenderStats,
+                         ChannelStyle, RendererInfo, RendererOptions, SceneShadows, VoxlightError, matrix_from_cm, _fptr,
                          _matrix_cm, _sized)
 from .native_cutaway import cutaway_struct, matcap_struct, slice_struct
+from .native_channels import channel_array
 from .native_overlays import overlay_array
 from .native_library import load_library
 from .native_tiles import _empty_stats, _merge_stats, tile_params
@@ -48,7 +49,7 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
                 illumination_size=0, mode="dvr", matcap=None, matcap_key=0, cutaway=None,
                 scene_shadows=None, labels=None, overlays=None, minip_floor=None, environment=None,
                 color_space="display", color_source="auto", path_samples=0, path_sample_offset=0,
-                path_bounces=0, path_seed=0, lib=None):
+                path_bounces=0, path_seed=0, channels=None, channel_blend="add", lib=None):
     """Build a RenderParams. Keyword names are the Blender panel's. `lights`
     is a sequence of (position4, color3, intensity); `material` is
     (ambient, diffuse, specular, shininess) or None for the defaults;
@@ -79,7 +80,11 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
     says where a colour volume's colour comes from: "auto" (its own RGB;
     the table's for a grey volume), "data" or "tf" (COLOR_SOURCES).
     `path_samples`, `path_sample_offset`, `path_bounces` and `path_seed`
-    are the `path` shading model's (vxl_render_params; 0: its defaults)."""
+    are the `path` shading model's (vxl_render_params; 0: its defaults).
+    `channels` lists the channels of a multi-channel volume to draw in one
+    march, dicts as native_channels.py takes them (None: the scalar alone);
+    `channel_blend` is "add" or "max" (CHANNEL_BLENDS) or
+    VXL_CHANNEL_BLEND_*."""
     lib = lib or load_library()
     p = _sized(RenderParams)
     p.width, p.height = int(width), int(height)
@@ -173,6 +178,13 @@ def make_params(width=0, height=0, view=None, proj=None, model=None, scene_depth
         p._keep.extend(digest)
         p.overlay_count = len(overlays)
         p.overlays = ctypes.cast(p._overlays, ctypes.POINTER(OverlayStyle))
+    if channels:  # the struct array and its tables live as long as p
+        p._channels, p._channel_tables, digest = channel_array(channels, lib)
+        p._keep.extend(digest)
+        p.channel_count = len(channels)
+        p.channels = ctypes.cast(p._channels, ctypes.POINTER(ChannelStyle))
+    p.channel_blend = (channel_blend if isinstance(channel_blend, int)
+                       else CHANNEL_BLENDS.index(channel_blend))
     if scene_shadows is not None:
         _set_scene_shadows(p, *scene_shadows)
     if environment is not None:

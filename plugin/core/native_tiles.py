@@ -41,6 +41,7 @@ def params_digest(params, *extra):
     c.labels = None
     c.overlays = None  # their contents are in _keep
     c.environment = None  # the World's map and numbers are in _keep
+    c.channels = None  # the channel styles' contents are in _keep
     h = hashlib.blake2b(bytes(c), digest_size=16)
     h.update(labels)
     for a in getattr(params, "_keep", ()):

@@ -177,17 +177,35 @@ class Volume(LibraryObject):
             "components": max(1, int(info.components)),
             "opacity_source": OPACITY_SOURCES[info.opacity_source]
             if info.opacity_source < len(OPACITY_SOURCES) else str(info.opacity_source),
+            # 0: one scalar; 2..8: a multi-channel volume whose scalar is
+            # channel scalar_channel, each channel with its own data range
+            "channel_count": int(info.channel_count),
+            "scalar_channel": int(info.scalar_channel),
+            "channel_min": [float(v) for v in info.channel_min[:info.channel_count]],
+            "channel_max": [float(v) for v in info.channel_max[:info.channel_count]],
         }
 
-    def histogram(self, bins=32, lo=None, hi=None):
+    def histogram(self, bins=32, lo=None, hi=None, channel=None):
         """Voxel counts (NaN voxels excluded) in `bins` equal bins over
-        [lo, hi], by default the finite data range; any loaded format."""
-        lo = self.info["value_min"] if lo is None else lo
-        hi = self.info["value_max"] if hi is None else hi
+        [lo, hi], by default the finite data range; any loaded format.
+        channel: that channel of a multi-channel volume instead of the
+        scalar, over its own range by default."""
+        if channel is None:
+            lo = self.info["value_min"] if lo is None else lo
+            hi = self.info["value_max"] if hi is None else hi
+        else:
+            count = self.info["channel_count"]
+            c = int(channel)
+            lo = (self.info["channel_min"][c] if 0 <= c < count else 0.0) if lo is None else lo
+            hi = (self.info["channel_max"][c] if 0 <= c < count else 1.0) if hi is None else hi
         if not hi > lo:
             hi = lo + 1.0
         counts = (ctypes.c_uint64 * bins)()
-        self.lib.check(self.lib.cdll.vxl_volume_histogram(self.handle, bins, lo, hi, counts))
+        if channel is None:
+            self.lib.check(self.lib.cdll.vxl_volume_histogram(self.handle, bins, lo, hi, counts))
+        else:
+            self.lib.check(self.lib.cdll.vxl_volume_channel_histogram(self.handle, int(channel), bins,
+                                                                      lo, hi, counts))
         return np.frombuffer(counts, np.uint64).astype(np.int64)
 
     def classified_grid(self, params, dims=(0, 0, 0), fill=True):

@@ -136,10 +136,10 @@ class Worker:
             if not job.cancelled:
                 try:
                     stop = lambda: job.cancelled or self._stop  # noqa: E731
-                    result = job.run(stop) if job.run is not None else \
-                        self.entry.renderer.render_tiled(
-                            job.params, rect=job.rect, target_seconds=self.target_seconds,
-                            should_stop=stop)
+                    result = job.run(stop) if job.run is not None else drawing_channels(
+                        self.entry, job.params, lambda p: self.entry.renderer.render_tiled(
+                            p, rect=job.rect, target_seconds=self.target_seconds,
+                            should_stop=stop))
                 except Exception as e:  # reported by the main thread
                     error = e
             with self._cond:
@@ -216,6 +216,7 @@ class VolumeEntry:
         self.pending_frame = None  # 4D: the loaded frame, cached by adopt()
         self.frame_count = info.get("frame_count", 1)
         self.last_frame = None   # stats of the last frame rendered (panel)
+        self.channel_refusal = ""  # why the library refused the last frame's channels
         self.load_kwargs = load_kwargs(self.options.get("memory_budget", 0))  # other frames alike
         self._worker = None
         renderer.on_render = _count_call
@@ -352,7 +353,10 @@ def open_volume(path, backend="auto", progress=None, voxel_size=None, cancelled=
         # to the data (tf_fit); the library counts them for every format.
         info = dict(vol.info, histogram=vol.histogram(32),
                     histogram_fine=vol.histogram(tf_fit.HISTOGRAM_BINS),
-                    distinct_ids=label_import.distinct_ids(vol.info, vol.histogram))
+                    distinct_ids=label_import.distinct_ids(vol.info, vol.histogram),
+                    # each channel's own, for its row in the Channels panel
+                    channel_histograms=[vol.histogram(32, channel=c)
+                                        for c in range(vol.info.get("channel_count", 0))])
         if stop():
             return None
         entry = VolumeEntry(path, renderer, info, series, {"storage": storage, "memory_budget": memory_budget})
@@ -435,10 +439,36 @@ def last_failure(path, series=""):
     return f[1] if f else ""
 
 
+def drawing_channels(entry, params, draw):
+    """draw(params), for a frame that may draw a multi-channel volume's
+    channels. The add-on checks its settings before a frame
+    (channel_plan.conflict), but one thing only the library knows: AUTO
+    storage that pages a volume too large for one texture. A frame whose
+    channels the library refuses is drawn again with the scalar alone, and
+    the refusal is kept for the panel (channel_refusal): a frame, never an
+    error or a black image."""
+    if not params.channel_count:
+        return draw(params)
+    try:
+        out = draw(params)
+    except native.VoxlightError as e:
+        entry.channel_refusal = str(e)
+        params.channel_count = 0
+        params.channels = None
+        return draw(params)
+    entry.channel_refusal = ""
+    return out
+
+
+def channel_refusal(entry):
+    """Why the library refused the channels of entry's last frame ("")."""
+    return getattr(entry, "channel_refusal", "") if entry is not None else ""
+
+
 def render(entry, params, kind="render"):
     """A synchronous frame: one library call, counted."""
     t = time.perf_counter()
-    rgba, depth = entry.renderer.render(params)
+    rgba, depth = drawing_channels(entry, params, entry.renderer.render)
     stats = entry.renderer.stats()
     entry.last_frame = dict(stats, width=params.width, height=params.height, kind=kind,
                             calls=1, seconds=time.perf_counter() - t)
@@ -449,7 +479,8 @@ def render(entry, params, kind="render"):
 def render_rect(entry, params, rect, kind="interactive"):
     """A synchronous frame of which only the pixel rectangle `rect` (the
     volume's footprint) is rendered, in one library call; counted."""
-    res = entry.renderer.render_tiled(params, rect=rect, rows=params.height or 512)
+    res = drawing_channels(entry, params, lambda p: entry.renderer.render_tiled(
+        p, rect=rect, rows=params.height or 512))
     entry.last_frame = dict(res[2], width=params.width, height=params.height, kind=kind)
     _count(frames=1)
     return res

@@ -424,7 +424,8 @@ def panel_has_subpanels_ramp_picture_and_preset_name():
             if getattr(c, "bl_parent_id", "") == "VOXLIGHT_PT_volume"]
     labels = {c.bl_label: c for c in subs}
     assert set(labels) == {"Rendering", "Transfer Function", "Lighting", "Render Mode",
-                           "Cutaway", "Labels", "Overlays", "Advanced", "Statistics"}, set(labels)
+                           "Cutaway", "Labels", "Overlays", "Channels", "Advanced",
+                           "Statistics"}, set(labels)
     for name in ("Advanced", "Statistics"):
         assert "DEFAULT_CLOSED" in labels[name].bl_options
     for gop in ("off", "boundary", "iso"):

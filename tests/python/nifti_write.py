@@ -38,6 +38,24 @@ def nifti1_bytes(data, affine=None, scl_slope=0.0, scl_inter=0.0, rgb=False):
     return bytes(hdr) + np.asfortranarray(data).tobytes(order="F")
 
 
+def channels_bytes(channels, affine=None):
+    """A multi-channel NIfTI-1: the 3-D arrays in `channels` (each indexed
+    [i, j, k], one dtype) as dim[5], one after the other (dim = 5, X, Y, Z,
+    1, C), the layout microscopy exports use and the library reads as
+    channels (docs/channels.md)."""
+    stack = np.stack([np.asarray(c) for c in channels], axis=3)[:, :, :, None, :]
+    raw = bytearray(nifti1_bytes(stack, affine))
+    struct.pack_into("<h", raw, 40, 5)  # dim[0]: five dimensions
+    return bytes(raw)
+
+
+def write_channels_nifti(path, channels, affine=None):
+    raw = channels_bytes(channels, affine)
+    with (gzip.open if str(path).endswith(".gz") else open)(path, "wb") as f:
+        f.write(raw)
+    return path
+
+
 def _rgb24_bytes(rgb, affine):
     if rgb.ndim != 4 or rgb.shape[3] != 3:
         raise ValueError("RGB24 data is [i, j, k, 3], got %r" % (rgb.shape,))

@@ -126,7 +126,17 @@ public:
             if (n) memcpy(dst, mem_.data() + at, n);
             return true;
         }
-        if (n > kWindow) return vxl_file_pread(fd_, dst, n, at) == int64_t(n);
+        if (n > kWindow) { // a large value straight into place, in pieces (a read may return less)
+            uint8_t *out = static_cast<uint8_t *>(dst);
+            while (n) {
+                const int64_t got = vxl_file_pread(fd_, out, std::min<size_t>(n, size_t(1) << 30), at);
+                if (got <= 0) return false;
+                out += got;
+                at += uint64_t(got);
+                n -= size_t(got);
+            }
+            return true;
+        }
         if (at < win_at_ || at + n > win_at_ + win_.size()) {
             const size_t want = size_t(std::min<uint64_t>(kWindow, size_ - at));
             win_.resize(want);
@@ -418,8 +428,22 @@ int Dataset::open(const std::string &path, vxl_err *e)
     uint64_t pos = 0;
     if (d.src.size() >= 132 && d.src.read(0, head, 132) && !memcmp(head + 128, "DICM", 4)) {
         pos = 132;
+        // the meta header's own length when it starts with it (a deflated
+        // data set's first bytes could pass for group 0002), else up to the
+        // first element of another group
+        uint8_t g[16];
+        uint64_t meta_end = d.src.size();
+        bool bounded = false;
+        if (d.src.read(pos, g, 12) && get32(g, false) == 0x00000002u && !memcmp(g + 4, "UL", 2) &&
+            get16(g + 6, false) == 4) {
+            const uint64_t len = get32(g + 8, false);
+            if (len <= d.src.size() - pos - 12) {
+                meta_end = pos + 12 + len;
+                bounded = true;
+            }
+        }
         Item meta;
-        if (!d.parse(meta, pos, d.src.size(), false, Encoding{}, 0, true))
+        if (!d.parse(meta, pos, meta_end, false, Encoding{}, 0, !bounded))
             return vxl_fail(e, VXL_ERR_FORMAT, "'%s': not a readable DICOM file: the meta header: %s", p,
                             d.problem.c_str());
         const char *vr = nullptr;

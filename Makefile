@@ -321,10 +321,11 @@ WIN_DICOM_CXX := $(DICOM_CXX) $(DICOM_OWN_CXX)
 WIN_DICOM_OBJ := $(patsubst %,$(WIN_BUILD)/dicom_obj/%.o,$(notdir $(WIN_DICOM_HELPER_C) $(WIN_DICOM_CXX)))
 $(WIN_BUILD)/dicom_obj/%.c.o: %.c $(wildcard csrc/*/*.h)
 	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_LIB_CFLAGS) $(OPENJPEG_INC) -c $< -o $@
+	$(WIN_CC) $(WIN_LIB_CFLAGS) -c $< -o $@
 $(WIN_BUILD)/dicom_obj/%.cpp.o: %.cpp $(wildcard csrc/*/*.h csrc/*/*.hpp)
 	@mkdir -p $(@D)
-	$(WIN_CXX) -std=c++17 $(WARN) -O2 -g0 -Icsrc/include $(CSRC_INC) $(OPENJPEG_INC) -c $< -o $@
+	$(WIN_CXX) -std=c++17 $(WARN) -O2 -g0 -Icsrc/include $(CSRC_INC) -idirafter /usr/include \
+		-idirafter /usr/include/$(shell $(CC) -print-multiarch) -c $< -o $@
 $(WIN_BUILD)/voxlight-read-dicom.exe: $(WIN_DICOM_OBJ)
 	$(WIN_CXX) -static $^ -o $@ -lshell32
 

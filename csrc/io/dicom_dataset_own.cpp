@@ -122,8 +122,9 @@ public:
     bool read(uint64_t at, void *dst, size_t n)
     {
         if (at > size_ || n > size_ - at) return false;
+        if (n == 0) return true; // an empty value: nothing to copy (its buffer may be null)
         if (in_memory_) {
-            if (n) memcpy(dst, mem_.data() + at, n);
+            memcpy(dst, mem_.data() + at, n);
             return true;
         }
         if (n > kWindow) { // a large value straight into place, in pieces (a read may return less)
@@ -522,6 +523,15 @@ bool binary_value(const Element &el, unsigned long i, size_t n, uint8_t *out)
     return true;
 }
 
+// Binary value i as a T of this machine.
+template <typename T> bool binary_as(const Element &el, unsigned long i, T &out)
+{
+    uint8_t b[sizeof(T)];
+    if (!binary_value(el, i, sizeof(T), b)) return false;
+    memcpy(&out, b, sizeof(T));
+    return true;
+}
+
 } // namespace
 
 bool Dataset::string(const Item *it, Tag t, std::string &out) const
@@ -546,24 +556,20 @@ bool Dataset::number(const Item *it, Tag t, unsigned long i, double &out) const
         out = x;
         return true;
     }
-    uint8_t b[8];
-    if (!memcmp(vr, "FD", 2) && binary_value(*el, i, 8, b)) {
-        double x;
-        memcpy(&x, b, 8);
-        if (!std::isfinite(x)) return false;
-        out = x;
+    double d;
+    if (!memcmp(vr, "FD", 2) && binary_as(*el, i, d)) {
+        if (!std::isfinite(d)) return false;
+        out = d;
         return true;
     }
-    if (!memcmp(vr, "UL", 2) && binary_value(*el, i, 4, b)) {
-        uint32_t x;
-        memcpy(&x, b, 4);
-        out = x;
+    uint32_t u;
+    if (!memcmp(vr, "UL", 2) && binary_as(*el, i, u)) {
+        out = u;
         return true;
     }
-    if (!memcmp(vr, "SL", 2) && binary_value(*el, i, 4, b)) {
-        int32_t x;
-        memcpy(&x, b, 4);
-        out = x;
+    int32_t v;
+    if (!memcmp(vr, "SL", 2) && binary_as(*el, i, v)) {
+        out = v;
         return true;
     }
     return false;
@@ -573,10 +579,8 @@ bool Dataset::us(const Item *it, Tag t, unsigned long i, unsigned &out) const
 {
     const char *vr = nullptr;
     const Element *el = impl_->value_of(it, t, vr);
-    uint8_t b[2];
-    if (!el || memcmp(vr, "US", 2) || !binary_value(*el, i, 2, b)) return false;
     uint16_t x;
-    memcpy(&x, b, 2);
+    if (!el || memcmp(vr, "US", 2) || !binary_as(*el, i, x)) return false;
     out = x;
     return true;
 }
@@ -585,10 +589,8 @@ bool Dataset::ss(const Item *it, Tag t, unsigned long i, int &out) const
 {
     const char *vr = nullptr;
     const Element *el = impl_->value_of(it, t, vr);
-    uint8_t b[2];
-    if (!el || memcmp(vr, "SS", 2) || !binary_value(*el, i, 2, b)) return false;
     int16_t x;
-    memcpy(&x, b, 2);
+    if (!el || memcmp(vr, "SS", 2) || !binary_as(*el, i, x)) return false;
     out = x;
     return true;
 }
@@ -611,11 +613,7 @@ bool Dataset::words(const Item *it, Tag t, std::vector<uint16_t> &out) const
     const Element *el = impl_->value_of(it, t, vr);
     if (!el || !(!memcmp(vr, "OW", 2) || !memcmp(vr, "US", 2))) return false;
     out.resize(el->value.size() / 2);
-    uint8_t b[2];
-    for (size_t i = 0; i < out.size(); i++) {
-        binary_value(*el, i, 2, b);
-        memcpy(&out[i], b, 2);
-    }
+    for (size_t i = 0; i < out.size(); i++) binary_as(*el, i, out[i]);
     return true;
 }
 

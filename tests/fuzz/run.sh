@@ -44,7 +44,7 @@ is_own() { [[ $OWN_TARGETS == *" $1 "* ]]; }
 # does) and the one seed every run uses
 declare -A CI_RUNS=([nifti]=30000 [nrrd]=100000 [metaimage]=100000 [label_table]=100000
                     [zarr]=20000 [brick_cache]=20000 [tiff_layout]=150000 [dicom_codecs]=1000000 [hdr]=300000
-                    [dicom_own]=20000)
+                    [dicom_own]=5000)
 CI_SEED=20261207
 # Where a third-party reader's own frames are told apart from ours
 declare -A UPSTREAM_LIBS=([vdb]='openvdb' [tiff]='OpenImageIO|libtiff' [png]='OpenImageIO|libpng'

@@ -322,10 +322,17 @@ WIN_DICOM_OBJ := $(patsubst %,$(WIN_BUILD)/dicom_obj/%.o,$(notdir $(WIN_DICOM_HE
 $(WIN_BUILD)/dicom_obj/%.c.o: %.c $(wildcard csrc/*/*.h)
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_LIB_CFLAGS) -c $< -o $@
-$(WIN_BUILD)/dicom_obj/%.cpp.o: %.cpp $(wildcard csrc/*/*.h csrc/*/*.hpp)
+# zlib.h's types for zlib_api.h, from a folder holding zlib's two headers
+# alone: with all of /usr/include on its path, libc++ would take glibc's
+# mbstate_t over MinGW's. _GNU_SOURCE: M_PI, as g++ defines it on Linux.
+WIN_ZLIB_INC := $(WIN_BUILD)/zlib_include
+$(WIN_ZLIB_INC)/zlib.h: /usr/include/zlib.h /usr/include/zconf.h
 	@mkdir -p $(@D)
-	$(WIN_CXX) -std=c++17 $(WARN) -O2 -g0 -Icsrc/include $(CSRC_INC) -idirafter /usr/include \
-		-idirafter /usr/include/$(shell $(CC) -print-multiarch) -c $< -o $@
+	cp /usr/include/zlib.h /usr/include/zconf.h $(@D)/
+$(WIN_BUILD)/dicom_obj/%.cpp.o: %.cpp $(wildcard csrc/*/*.h csrc/*/*.hpp) $(WIN_ZLIB_INC)/zlib.h
+	@mkdir -p $(@D)
+	$(WIN_CXX) -std=c++17 -D_GNU_SOURCE $(WARN) -O2 -g0 -Icsrc/include $(CSRC_INC) -idirafter $(WIN_ZLIB_INC) \
+		-c $< -o $@
 $(WIN_BUILD)/voxlight-read-dicom.exe: $(WIN_DICOM_OBJ)
 	$(WIN_CXX) -static $^ -o $@ -lshell32
 

@@ -202,6 +202,8 @@ struct Dataset::Impl {
     Element *find(const Item *it, Tag t);
     bool load(Element &el);
     const Element *value_of(const Item *it, Tag t, const char *&vr);
+    template <typename T, typename Out>
+    bool binary_of(const Item *it, Tag t, const char *want, unsigned long i, Out &out);
 };
 
 // Elements of one item from pos up to end (a defined length) or up to the
@@ -575,24 +577,26 @@ bool Dataset::number(const Item *it, Tag t, unsigned long i, double &out) const
     return false;
 }
 
-bool Dataset::us(const Item *it, Tag t, unsigned long i, unsigned &out) const
+// Value i of an element of VR want, as a T of this machine.
+template <typename T, typename Out>
+bool Dataset::Impl::binary_of(const Item *it, Tag t, const char *want, unsigned long i, Out &out)
 {
     const char *vr = nullptr;
-    const Element *el = impl_->value_of(it, t, vr);
-    uint16_t x;
-    if (!el || memcmp(vr, "US", 2) || !binary_as(*el, i, x)) return false;
+    const Element *el = value_of(it, t, vr);
+    T x;
+    if (!el || memcmp(vr, want, 2) || !binary_as(*el, i, x)) return false;
     out = x;
     return true;
 }
 
+bool Dataset::us(const Item *it, Tag t, unsigned long i, unsigned &out) const
+{
+    return impl_->binary_of<uint16_t>(it, t, "US", i, out);
+}
+
 bool Dataset::ss(const Item *it, Tag t, unsigned long i, int &out) const
 {
-    const char *vr = nullptr;
-    const Element *el = impl_->value_of(it, t, vr);
-    int16_t x;
-    if (!el || memcmp(vr, "SS", 2) || !binary_as(*el, i, x)) return false;
-    out = x;
-    return true;
+    return impl_->binary_of<int16_t>(it, t, "SS", i, out);
 }
 
 size_t Dataset::items(const Item *it, Tag seq) const

@@ -46,7 +46,15 @@ DCMTK_LIBS := -ldcmjpeg -ldcmjpls -ldcmdata -loflog -lofstd
 # its own formats: voxlight-read-oiio (TIFF/PNG stacks, OpenVDB) and
 # voxlight-read-dicom (DICOM). csrc/*/helper_*.c are the helpers' own files.
 OIIO_CXX := csrc/io/image_stack.cpp csrc/io/vdb.cpp csrc/io/environment_exr.cpp
-DICOM_CXX := $(wildcard csrc/io/dicom*.cpp)
+# The DICOM reader's rooms, and the two backends of its data set seam
+# (csrc/io/dicom_dataset.hpp), one linked per helper: dcmtk's parser and
+# codecs in voxlight-read-dicom (Linux), our own parser in
+# voxlight-read-dicom.exe (Windows, where dcmtk has no build) and in the
+# test helper voxlight-read-dicom-own, which the DICOM tests compare with
+# the dcmtk one file for file.
+DICOM_CXX := $(filter-out csrc/io/dicom_dataset_%.cpp,$(wildcard csrc/io/dicom*.cpp))
+DICOM_DCMTK_CXX := csrc/io/dicom_dataset_dcmtk.cpp
+DICOM_OWN_CXX := csrc/io/dicom_dataset_own.cpp
 # the DICOM codecs in our own C, and JPEG 2000 through OpenJPEG opened at
 # run time (the helper links them; so do their tests and the fuzz build)
 DICOM_CODECS := dicom_rle dicom_jpeg_lossless dicom_j2k
@@ -72,7 +80,8 @@ OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_
 PLATFORM := dynlib dynlib_posix threads_posix files files_posix process_posix clock_posix os_posix
 HELPER_CORE_NAMES := helper_main volume colour_volume channel_volume brick_source error loader_util zlib_api
 HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,$(HELPER_CORE_NAMES) helper_self_posix $(PLATFORM))
-HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr $(BUILD)/voxlight-write-vdb
+HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-dicom-own \
+	$(BUILD)/voxlight-read-zarr $(BUILD)/voxlight-write-vdb
 # One-off measurement programs behind docs/filters_on_scans.md, built with
 # everything else so they keep compiling (run by hand; commands in the doc).
 STUDIES := $(BUILD)/filter-scan-study $(BUILD)/cubic-probe-study $(BUILD)/voxlight-slicingbench $(BUILD)/voxlight-modesbench \
@@ -154,9 +163,13 @@ $(BUILD)/voxlight-read-zarr: $(BUILD)/obj/helper_zarr.o $(patsubst %.c,$(BUILD)/
 		$(BUILD)/obj/zarr_detect.o $(HELPER_CORE) $(LIB_CC_STAMP)
 	$(LIB_CC) $(OPT) -o $@ $(filter-out $(LIB_CC_STAMP),$^) -ldl -lpthread -lm
 
-$(BUILD)/voxlight-read-dicom: $(BUILD)/obj/helper_dicom.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(DICOM_CXX))) \
-		$(DICOM_CODECS:%=$(BUILD)/obj/%.o) $(HELPER_CORE)
+DICOM_HELPER_OBJ := $(BUILD)/obj/helper_dicom.o $(patsubst %.cpp,$(BUILD)/obj/%.o,$(notdir $(DICOM_CXX))) \
+	$(DICOM_CODECS:%=$(BUILD)/obj/%.o) $(HELPER_CORE)
+$(BUILD)/voxlight-read-dicom: $(DICOM_HELPER_OBJ) $(BUILD)/obj/dicom_dataset_dcmtk.o
 	$(CXX) $(OPT) -o $@ $^ $(DCMTK_LIBS) -lz -lm
+# the same reader on our own parser: no dcmtk (zlib is opened at run time)
+$(BUILD)/voxlight-read-dicom-own: $(DICOM_HELPER_OBJ) $(BUILD)/obj/dicom_dataset_own.o
+	$(CXX) $(OPT) -o $@ $^ -ldl -lpthread -lm
 
 $(BUILD)/voxlight-bench: bench/bench.c $(BUILD)/libvoxlight.so
 	$(CC) $(CFLAGS) $< -o $@ -L$(BUILD) -lvoxlight -lm -Wl,-rpath,'$$ORIGIN'
@@ -285,7 +298,7 @@ WIN_API_TESTS := test_accuracy test_api test_budget test_classification test_cut
 windows: $(WIN_BUILD)/tests/test_platform.exe $(WIN_BUILD)/tests/child_program.exe $(WIN_BUILD)/tests/test_crc32.exe \
 	$(WIN_BUILD)/tests/test_gz_reader.exe $(WIN_BUILD)/tests/test_dicom_codecs.exe $(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/voxlight.exe $(WIN_BUILD)/render_scene.exe \
 	$(WIN_ZLIB_DLLS) $(WIN_API_TESTS:%=$(WIN_BUILD)/tests/%.exe) $(WIN_BUILD)/tests/voxlight.dll \
-	$(WIN_BUILD)/voxlight-read-zarr.exe
+	$(WIN_BUILD)/voxlight-read-zarr.exe $(WIN_BUILD)/voxlight-read-dicom.exe
 
 # The OME-Zarr helper is our C alone, so Windows has it too (its blosc and
 # zstd codecs are opened at run time, where a system has them); the
@@ -296,6 +309,32 @@ WIN_ZARR_HELPER_C := $(wildcard csrc/*/helper_zarr.c) $(ZARR_C) $(wildcard csrc/
 $(WIN_BUILD)/voxlight-read-zarr.exe: $(WIN_ZARR_HELPER_C) $(wildcard csrc/*/*.h)
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_LIB_CFLAGS) $(WIN_ZARR_HELPER_C) -o $@ -lshell32
+
+# The DICOM helper: the reader's C++ on our own parser (no dcmtk), compiled
+# by zig's clang++ with its libc++ linked in statically, so the .exe needs
+# only Windows' own DLLs (and zlib1.dll beside it, opened at run time for
+# deflated files); its C objects are compiled as the Zarr helper's are.
+WIN_CXX ?= $(subst ziglang cc ,ziglang c++ ,$(WIN_CC))
+WIN_DICOM_HELPER_C := $(wildcard csrc/*/helper_dicom.c) $(DICOM_CODECS:%=csrc/io/%.c) \
+	$(foreach n,$(HELPER_CORE_NAMES),$(wildcard csrc/*/$(n).c)) csrc/platform/helper_self_win32.c $(WIN_PLATFORM_C)
+WIN_DICOM_CXX := $(DICOM_CXX) $(DICOM_OWN_CXX)
+WIN_DICOM_OBJ := $(patsubst %,$(WIN_BUILD)/dicom_obj/%.o,$(notdir $(WIN_DICOM_HELPER_C) $(WIN_DICOM_CXX)))
+$(WIN_BUILD)/dicom_obj/%.c.o: %.c $(wildcard csrc/*/*.h)
+	@mkdir -p $(@D)
+	$(WIN_CC) $(WIN_LIB_CFLAGS) -c $< -o $@
+# zlib.h's types for zlib_api.h, from a folder holding zlib's two headers
+# alone: with all of /usr/include on its path, libc++ would take glibc's
+# mbstate_t over MinGW's. _GNU_SOURCE: M_PI, as g++ defines it on Linux.
+WIN_ZLIB_INC := $(WIN_BUILD)/zlib_include
+$(WIN_ZLIB_INC)/zlib.h: /usr/include/zlib.h /usr/include/zconf.h
+	@mkdir -p $(@D)
+	cp /usr/include/zlib.h /usr/include/zconf.h $(@D)/
+$(WIN_BUILD)/dicom_obj/%.cpp.o: %.cpp $(wildcard csrc/*/*.h csrc/*/*.hpp) $(WIN_ZLIB_INC)/zlib.h
+	@mkdir -p $(@D)
+	$(WIN_CXX) -std=c++17 -D_GNU_SOURCE $(WARN) -O2 -g0 -Icsrc/include $(CSRC_INC) -idirafter $(WIN_ZLIB_INC) \
+		-c $< -o $@
+$(WIN_BUILD)/voxlight-read-dicom.exe: $(WIN_DICOM_OBJ)
+	$(WIN_CXX) -static $^ -o $@ -lshell32
 
 $(WIN_API_TESTS:%=$(WIN_BUILD)/tests/%.exe): $(WIN_BUILD)/tests/%.exe: tests/%.c $(wildcard tests/*.h) $(WIN_PLATFORM_C) \
 		$(wildcard csrc/*/*.h) $(WIN_BUILD)/voxlight.dll $(WIN_BUILD)/libz.dll.a
@@ -403,6 +442,10 @@ FUZZ_LIB_C := $(sort $(FUZZ_LIB_C) brick_cache.c brick_cache_read.c brick_cache_
 	brick_levels.c raw_source.c stream_load.c tiff_layout.c zlib_api.c gz_reader.c crc32.c hdr_read.c \
 	$(DICOM_CODECS:%=%.c) $(PLATFORM:%=%.c))
 FUZZ_LIB_CXX := image_stack.cpp vdb.cpp $(notdir $(DICOM_CXX))
+# the data set seam's backend: dcmtk's for every target, our own parser's
+# for fuzz_dicom_own (the same reader on the parser Windows uses)
+FUZZ_DCMTK_OBJ := $(FUZZ_BUILD)/obj/dicom_dataset_dcmtk.o
+FUZZ_OWN_OBJ := $(FUZZ_BUILD)/obj/dicom_dataset_own.o
 FUZZ_OBJ := $(FUZZ_LIB_C:%.c=$(FUZZ_BUILD)/obj/%.o) $(FUZZ_LIB_CXX:%.cpp=$(FUZZ_BUILD)/obj/%.o)
 FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,$(FUZZ_BUILD)/fuzz_%,$(wildcard tests/fuzz/fuzz_*.c))
 
@@ -419,7 +462,10 @@ $(FUZZ_BUILD)/obj/%.o: %.cpp $(wildcard csrc/*/*.h csrc/*/*.hpp) | $(FUZZ_BUILD)
 $(FUZZ_BUILD)/obj/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h csrc/include/voxlight.h csrc/io/helper_main.h | $(FUZZ_BUILD)/obj
 	clang $(FUZZ_CFLAGS) -c $< -o $@
 
-$(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/fuzz_%.o $(FUZZ_OBJ)
+$(FUZZ_BUILD)/fuzz_dicom_own: $(FUZZ_BUILD)/obj/fuzz_dicom_own.o $(FUZZ_OBJ) $(FUZZ_OWN_OBJ)
+	clang++ $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@ $(LIBS) $(OIIO_LIBS)
+
+$(FUZZ_BUILD)/fuzz_%: $(FUZZ_BUILD)/obj/fuzz_%.o $(FUZZ_OBJ) $(FUZZ_DCMTK_OBJ)
 	clang++ $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@ $(LIBS) $(OIIO_LIBS) $(DCMTK_LIBS)
 
 $(FUZZ_BUILD)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/writers.h tests/fuzz/dicom_writer.h tests/nifti_writer.h \

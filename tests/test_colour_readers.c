@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "axis_view.h"
+#include "dicom_test_util.h" /* load_dicom_with: dcmtk and our own parser */
 #include "fuzz/writers.h"
 #include "harness.h"
 #include "loader_test_util.h" /* remove_tree, voxel */
@@ -174,7 +175,8 @@ TEST(rgb_nifti_tiff_dicom_mha_and_png_of_one_pattern_give_one_image)
                                         "TIFF/PNG RGB: colour"};
     vxl_volume *v[F] = {NULL};
     for (int f = 0; f < F; f++) {
-        CHECKF(vxl_volume_load(path[f], NULL, &v[f]) == VXL_OK, "%s: %s", path[f], vxl_last_error());
+        const int rc = f == 2 ? load_dicom_with(path[f], NULL, &v[f]) : vxl_volume_load(path[f], NULL, &v[f]);
+        CHECKF(rc == VXL_OK, "%s: %s", path[f], vxl_last_error());
         vxl_volume_info in = {.struct_size = sizeof in};
         CHECKF(v[f] && vxl_volume_get_info(v[f], &in) == VXL_OK && in.components == 3 &&
                    in.color_bytes == sizeof RGB && strstr(in.notes, note[f]),
@@ -237,6 +239,8 @@ TEST(rgba_mha_keeps_alpha_for_the_opacity_source)
     vxl_volume_destroy(v);
 }
 
+OWN_PARSER_TEST
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/vxl_colour_readers_XXXXXX");
@@ -247,6 +251,7 @@ int main(void)
     fill_pattern();
     RUN(rgb_nifti_tiff_dicom_mha_and_png_of_one_pattern_give_one_image);
     RUN(rgba_mha_keeps_alpha_for_the_opacity_source);
+    RUN(own_parser_agrees_with_dcmtk);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

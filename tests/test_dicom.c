@@ -207,7 +207,7 @@ TEST(several_series_are_listed_and_one_is_chosen_by_index_or_uid)
     CHECK(vxl_dicom_list_series(dir, NULL, 0, &count) == VXL_OK && count == 2);
 
     vxl_volume *v = NULL;
-    CHECK(vxl_volume_load(dir, NULL, &v) == VXL_ERR_INVALID_ARGUMENT && !v);
+    CHECK(load_dicom_with(dir, NULL, &v) == VXL_ERR_INVALID_ARGUMENT && !v);
     CHECK(contains(vxl_last_error(), "2 DICOM series") && contains(vxl_last_error(), "1.2.3.40") &&
           contains(vxl_last_error(), "1.2.3.41"));
 
@@ -302,7 +302,7 @@ TEST(time_points_at_every_position_make_a_4d_series)
     for (uint32_t t = 0; t < T; t++) {
         vxl_load_options opt = {.struct_size = sizeof opt, .frame = t};
         vxl_volume *v = NULL;
-        REQUIRE(vxl_volume_load(dir, &opt, &v) == VXL_OK);
+        REQUIRE(load_dicom_with(dir, &opt, &v) == VXL_OK);
         vxl_volume_info info = {.struct_size = sizeof info};
         vxl_volume_get_info(v, &info);
         CHECK(info.frame_count == T && info.frame == t && info.dims[2] == K);
@@ -313,7 +313,7 @@ TEST(time_points_at_every_position_make_a_4d_series)
     }
     vxl_load_options opt = {.struct_size = sizeof opt, .frame = T};
     vxl_volume *v = NULL;
-    CHECK(vxl_volume_load(dir, &opt, &v) == VXL_ERR_INVALID_ARGUMENT && contains(vxl_last_error(), "has 4"));
+    CHECK(load_dicom_with(dir, &opt, &v) == VXL_ERR_INVALID_ARGUMENT && contains(vxl_last_error(), "has 4"));
 
     /* two files at one position with the same time are duplicates */
     folder(dir, sizeof dir, "dup_time");
@@ -432,7 +432,7 @@ TEST(truncated_garbage_and_oversized_files_are_refused)
         fwrite(buf, 1, cuts[c], f);
         fclose(f);
         vxl_volume *v = NULL;
-        int rc = vxl_volume_load(p, NULL, &v);
+        int rc = load_dicom_with(p, NULL, &v);
         CHECKF(rc != VXL_OK && !v && contains(vxl_last_error(), "cut"), "cut at %zu: rc %d: %s", cuts[c], rc,
                vxl_last_error());
         unlink(p);
@@ -461,7 +461,7 @@ TEST(truncated_garbage_and_oversized_files_are_refused)
     REQUIRE(dcmw_write(p, &d) == 0);
     vxl_load_options opt = {.struct_size = sizeof opt, .memory_budget_bytes = 1u << 20};
     vxl_volume *v = NULL;
-    CHECK(vxl_volume_load(p, &opt, &v) == VXL_ERR_LIMIT && !v && contains(vxl_last_error(), "memory budget"));
+    CHECK(load_dicom_with(p, &opt, &v) == VXL_ERR_LIMIT && !v && contains(vxl_last_error(), "memory budget"));
 }
 
 TEST(dispatch_finds_dicom_folders_files_and_dicomdir)
@@ -487,7 +487,7 @@ TEST(dispatch_finds_dicom_folders_files_and_dicomdir)
     vxl_volume_destroy(v);
     /* a file of frames asked for frame 1: a DICOM series has one */
     vxl_load_options opt = {.struct_size = sizeof opt, .frame = 1};
-    CHECK(vxl_volume_load(sub, &opt, &v) == VXL_ERR_INVALID_ARGUMENT && contains(vxl_last_error(), "has 1"));
+    CHECK(load_dicom_with(sub, &opt, &v) == VXL_ERR_INVALID_ARGUMENT && contains(vxl_last_error(), "has 1"));
 }
 
 /* A 64 x 48 x 5 series of 16-bit (or signed 8-bit) values over the whole
@@ -610,6 +610,8 @@ TEST(damaged_compressed_frames_are_clear_errors)
     CHECKF(contains(vxl_last_error(), "IM0002.dcm") && contains(vxl_last_error(), "JPEG"), "%s", vxl_last_error());
 }
 
+OWN_PARSER_TEST
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/vxl_dicom_XXXXXX");
@@ -629,6 +631,7 @@ int main(void)
     RUN(dispatch_finds_dicom_folders_files_and_dicomdir);
     RUN(lossless_compressed_series_read_as_the_uncompressed_one);
     RUN(damaged_compressed_frames_are_clear_errors);
+    RUN(own_parser_agrees_with_dcmtk);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

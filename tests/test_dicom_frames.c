@@ -413,7 +413,7 @@ static vxl_volume *load_with_opacity(const char *path, uint32_t source, uint32_t
 {
     vxl_load_options opt = {.struct_size = sizeof opt, .opacity_source = source, .opacity_channel = channel};
     vxl_volume *v = NULL;
-    return vxl_volume_load(path, &opt, &v) == VXL_OK ? v : NULL;
+    return load_dicom_with(path, &opt, &v) == VXL_OK ? v : NULL;
 }
 
 /* Colour DICOM (RGB by pixel and by plane, YBR_FULL, YBR_FULL_422, JPEG
@@ -517,7 +517,7 @@ TEST(colour_dicom_opacity_source_is_the_load_option)
      * colour), 384 */
     vxl_load_options opt = {.struct_size = sizeof opt, .memory_budget_bytes = 300};
     vxl_volume *v = NULL;
-    CHECK(vxl_volume_load(path, &opt, &v) == VXL_ERR_LIMIT && !v);
+    CHECK(load_dicom_with(path, &opt, &v) == VXL_ERR_LIMIT && !v);
     CHECKF(contains(vxl_last_error(), "colour volumes are read whole"), "%s", vxl_last_error());
 }
 
@@ -587,6 +587,8 @@ TEST(enhanced_colour_frames_follow_the_slice_plan)
     }
 }
 
+OWN_PARSER_TEST
+
 int main(void)
 {
     snprintf(g_dir, sizeof g_dir, "/tmp/vxl_dicom_frames_XXXXXX");
@@ -604,6 +606,7 @@ int main(void)
     RUN(colour_dicom_opacity_source_is_the_load_option);
     RUN(colour_series_is_sorted_and_its_missing_slice_blended);
     RUN(enhanced_colour_frames_follow_the_slice_plan);
+    RUN(own_parser_agrees_with_dcmtk);
     remove_tree(g_dir);
     return TEST_SUMMARY();
 }

@@ -80,6 +80,9 @@ set -- "$LIB"
 for f in "$BUILD"/voxlight-read-* "$BUILD"/voxlight-vdb-read; do
     # A Linux helper has no extension (the add-on's rule too): never a .exe.
     case ${f##*/} in voxlight-read-*.*) continue ;; esac
+    # the DICOM reader on our own parser is a test helper here (Windows
+    # ships it as voxlight-read-dicom.exe); Linux ships the dcmtk one
+    [ "${f##*/}" = voxlight-read-dicom-own ] && continue
     [ -f "$f" ] && [ -x "$f" ] && set -- "$@" "$f"
 done
 if [ $# -lt 2 ]; then

@@ -1,4 +1,4 @@
-// dicom.cpp - DICOM series through dcmtk: a folder of images, a DICOMDIR
+// dicom.cpp - DICOM series: a folder of images, a DICOMDIR
 // (its folder, searched recursively) or one file of a series (the series of
 // that file, from its folder), as one volume. The entry points of the
 // helper voxlight-read-dicom; the rooms are named in dicom_series.hpp.
@@ -26,24 +26,21 @@
 // (dicom_detect.c): libvoxlight.so links no C++.
 #include "dicom_series.hpp"
 
-#include <dcmtk/oflog/oflog.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <dirent.h>
 #include <map>
 #include <mutex>
 #include <string>
 #include <strings.h>
-#include <sys/stat.h>
 #include <vector>
 
 extern "C" {
 #include "colour_volume.h"
+#include "files.h"
 #include "helper_main.h"
 #include "loader_util.h"
 #include "threads.h"
@@ -57,41 +54,28 @@ constexpr size_t kMaxFiles = 100000; // a folder scan stops with an error past t
 constexpr int kMaxDepth = 8;         // DICOMDIR trees are a few levels deep
 constexpr unsigned kMaxReaders = 16; // threads reading files; beyond this the disk is the limit
 
-// dcmtk's process-wide settings, once before any file is parsed: no
-// logging (dcmtk prints warnings to stderr by default; a library must never
-// print), and elements an archive rewrote as UN (unknown VR) read with
-// their dictionary VR, so a PixelSpacing stored as UN is still found.
-void configure_dcmtk()
-{
-    static std::once_flag once;
-    std::call_once(once, [] {
-        OFLog::configure(OFLogger::OFF_LOG_LEVEL);
-        dcmEnableUnknownVRConversion.set(OFTrue);
-    });
-}
-
 bool is_dicomdir_name(const std::string &p) { return strcasecmp(basename_of(p).c_str(), "DICOMDIR") == 0; }
 
 // Regular files under dir (recursively to kMaxDepth when recurse), skipping
 // dot files and DICOMDIR itself, in name order. false when over kMaxFiles.
 bool list_files(const std::string &dir, bool recurse, int depth, std::vector<std::string> &out)
 {
-    DIR *d = opendir(dir.c_str());
+    vxl_dir *d = vxl_dir_open(dir.c_str());
     if (!d) return true;
     std::vector<std::string> names;
-    while (struct dirent *ent = readdir(d)) {
-        if (ent->d_name[0] == '.') continue;
-        names.emplace_back(ent->d_name);
+    while (const char *name = vxl_dir_next(d)) {
+        if (name[0] == '.') continue;
+        names.emplace_back(name);
     }
-    closedir(d);
+    vxl_dir_close(d);
     std::sort(names.begin(), names.end());
     for (const auto &n : names) {
         std::string p = dir + "/" + n;
-        struct stat st;
-        if (stat(p.c_str(), &st) != 0) continue;
-        if (S_ISDIR(st.st_mode)) {
+        vxl_path_info st;
+        if (vxl_path_stat(p.c_str(), &st) != 0) continue;
+        if (st.kind == VXL_PATH_DIR) {
             if (recurse && depth < kMaxDepth && !list_files(p, recurse, depth + 1, out)) return false;
-        } else if (S_ISREG(st.st_mode) && !is_dicomdir_name(n)) {
+        } else if (st.kind == VXL_PATH_FILE && !is_dicomdir_name(n)) {
             if (out.size() >= kMaxFiles) return false;
             out.push_back(p);
         }
@@ -107,19 +91,20 @@ struct Scan {
 
 int scan(const std::string &path, Scan &out, vxl_err *e)
 {
-    configure_dcmtk();
-    struct stat st;
-    if (stat(path.c_str(), &st) != 0) return vxl_fail(e, VXL_ERR_IO, "'%s': %s", path.c_str(), strerror(errno));
+    Dataset::prepare();
+    vxl_path_info st;
+    if (vxl_path_stat(path.c_str(), &st) != 0)
+        return vxl_fail(e, VXL_ERR_IO, "'%s': %s", path.c_str(), strerror(errno));
     std::vector<std::string> files;
     bool complete;
     std::string where = path;
-    if (S_ISDIR(st.st_mode)) {
+    if (st.kind == VXL_PATH_DIR) {
         complete = list_files(path, true, 0, files);
     } else if (is_dicomdir_name(path)) {
         where = dirname_of(path);
         complete = list_files(where, true, 0, files);
     } else {
-        if (!S_ISREG(st.st_mode)) return vxl_fail(e, VXL_ERR_IO, "'%s' is not a regular file", path.c_str());
+        if (st.kind != VXL_PATH_FILE) return vxl_fail(e, VXL_ERR_IO, "'%s' is not a regular file", path.c_str());
         out.origin = path;
         where = dirname_of(path);
         complete = list_files(where, false, 0, files);
@@ -329,7 +314,6 @@ int load_series(const Series &s, const char *path, const vxl_load_options *opt, 
         tasks[it->second].dst.push_back(decoded.data() + i * per * elem);
     }
     split_for_cores(tasks);
-    prepare_decoders();
     rc = read_all(tasks, e);
     if (rc) return rc;
     std::vector<unsigned char> blended;

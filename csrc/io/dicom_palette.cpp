@@ -29,26 +29,26 @@ namespace {
 
 // One value of a descriptor, whose VR is US or SS (the first mapped value
 // follows the pixels' signedness).
-bool descriptor_value(DcmItem *ds, const DcmTagKey &tag, unsigned long pos, long &out)
+bool descriptor_value(const Dataset &ds, Tag t, unsigned long pos, long &out)
 {
-    Uint16 u = 0;
-    if (ds->findAndGetUint16(tag, u, pos).good()) {
-        out = u;
+    unsigned u = 0;
+    if (ds.us(ds.root(), t, pos, u)) {
+        out = long(u);
         return true;
     }
-    Sint16 s = 0;
-    if (ds->findAndGetSint16(tag, s, pos).good()) {
-        out = s;
+    int v = 0;
+    if (ds.ss(ds.root(), t, pos, v)) {
+        out = v;
         return true;
     }
     return false;
 }
 
-int read_table(DcmItem *ds, const Image &im, const DcmTagKey &desc_tag, const DcmTagKey &data_tag,
-               const DcmTagKey &segmented_tag, const char *name, std::vector<uint16_t> &out, long &first, vxl_err *e)
+int read_table(const Dataset &ds, const Image &im, Tag desc_tag, Tag data_tag, Tag segmented_tag, const char *name,
+               std::vector<uint16_t> &out, long &first, vxl_err *e)
 {
     const char *p = im.path.c_str();
-    if (ds->tagExists(segmented_tag))
+    if (ds.has(ds.root(), segmented_tag))
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': a segmented PALETTE COLOR lookup table is not supported", p);
     long entries = 0, bits = 0;
     if (!descriptor_value(ds, desc_tag, 0, entries) || !descriptor_value(ds, desc_tag, 1, first) ||
@@ -57,12 +57,11 @@ int read_table(DcmItem *ds, const Image &im, const DcmTagKey &desc_tag, const Dc
     if (entries <= 0) entries += 65536; // 0 (or a US value read as SS) means 65536
     if (bits != 8 && bits != 16)
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': the %s palette has %ld bits per entry (8 or 16)", p, name, bits);
-    // OW (or US) words in the machine's order, as dcmtk hands them over
-    DcmElement *el = nullptr;
-    Uint16 *words = nullptr;
-    if (ds->findAndGetElement(data_tag, el).bad() || !el || el->getUint16Array(words).bad() || !words)
+    // OW (or US) words in the machine's order
+    std::vector<uint16_t> words;
+    if (!ds.words(ds.root(), data_tag, words))
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': PALETTE COLOR without the %s lookup table data", p, name);
-    const size_t nwords = el->getLength() / 2, n = size_t(entries);
+    const size_t nwords = words.size(), n = size_t(entries);
     out.resize(n);
     if (bits == 16 || nwords >= n) { // a word each (8-bit entries in its low byte)
         if (nwords < n)
@@ -83,17 +82,18 @@ int read_table(DcmItem *ds, const Image &im, const DcmTagKey &desc_tag, const Dc
 
 } // namespace
 
-int read_palette(DcmItem *ds, const Image &im, Palette &pal, vxl_err *e)
+int read_palette(const Dataset &ds, const Image &im, Palette &pal, vxl_err *e)
 {
+    using namespace tags;
     long first[3] = {0, 0, 0};
-    int rc = read_table(ds, im, DCM_RedPaletteColorLookupTableDescriptor, DCM_RedPaletteColorLookupTableData,
-                        DCM_SegmentedRedPaletteColorLookupTableData, "red", pal.rgb[0], first[0], e);
+    int rc = read_table(ds, im, RedPaletteDescriptor, RedPaletteData, SegmentedRedPaletteData, "red", pal.rgb[0],
+                        first[0], e);
     if (!rc)
-        rc = read_table(ds, im, DCM_GreenPaletteColorLookupTableDescriptor, DCM_GreenPaletteColorLookupTableData,
-                        DCM_SegmentedGreenPaletteColorLookupTableData, "green", pal.rgb[1], first[1], e);
+        rc = read_table(ds, im, GreenPaletteDescriptor, GreenPaletteData, SegmentedGreenPaletteData, "green",
+                        pal.rgb[1], first[1], e);
     if (!rc)
-        rc = read_table(ds, im, DCM_BluePaletteColorLookupTableDescriptor, DCM_BluePaletteColorLookupTableData,
-                        DCM_SegmentedBluePaletteColorLookupTableData, "blue", pal.rgb[2], first[2], e);
+        rc = read_table(ds, im, BluePaletteDescriptor, BluePaletteData, SegmentedBluePaletteData, "blue", pal.rgb[2],
+                        first[2], e);
     if (rc) return rc;
     if (first[1] != first[0] || first[2] != first[0] || pal.rgb[1].size() != pal.rgb[0].size() ||
         pal.rgb[2].size() != pal.rgb[0].size())

@@ -6,24 +6,21 @@
 //
 // Who decodes what (docs/dicom.md gives the reasons):
 //   uncompressed (implicit/explicit little endian, explicit big endian,
-//     deflated): dcmtk's parser hands the values over in native order;
-//   RLE Lossless, JPEG Lossless process 14 and SV1: our C (dicom_rle.c,
-//     dicom_jpeg_lossless.c), given each frame's fragments joined;
-//   JPEG 2000 (lossless and lossy): OpenJPEG, opened on the first frame
-//     (dicom_j2k.c), given the same;
-//   JPEG Baseline and Extended, JPEG-LS lossless and near-lossless: dcmtk's
-//     own codecs (dcmjpeg on IJG, dcmjpls on CharLS), registered once.
+//     deflated): the data set seam's parser (dicom_dataset.hpp) hands the
+//     values over in native order;
+//   RLE Lossless, grey JPEG Lossless process 14 and SV1: our C
+//     (dicom_rle.c, dicom_jpeg_lossless.c), given each frame's fragments
+//     joined;
+//   JPEG 2000 and HTJ2K: OpenJPEG, opened on the first frame (dicom_j2k.c),
+//     given the same;
+//   JPEG Baseline and Extended, JPEG-LS, colour lossless JPEG: the
+//     backend's own codecs where it has them (dcmtk's dcmjpeg and dcmjpls),
+//     else refused by name with the command that decompresses them.
 #include "dicom_series.hpp"
-
-#include <dcmtk/dcmdata/dcpixseq.h>
-#include <dcmtk/dcmdata/dcpxitem.h>
-#include <dcmtk/dcmjpeg/djdecode.h>
-#include <dcmtk/dcmjpls/djdecode.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <mutex>
 #include <type_traits>
 
 extern "C" {
@@ -37,20 +34,30 @@ namespace vxl_dicom {
 
 namespace {
 
-enum class Codec { native, rle, jpeg_lossless, j2k, dcmtk, none };
+enum class Codec { native, rle, jpeg_lossless, j2k, backend, none };
 
 Codec codec_of(const Image &im)
 {
+    using namespace syntax;
+    const std::string &x = im.syntax;
     if (!im.encapsulated) return Codec::native;
-    if (im.xs == EXS_RLELossless) return Codec::rle;
-    // our lossless JPEG decoder is grey only; dcmtk's takes colour
-    if (im.xs == EXS_JPEGProcess14 || im.xs == EXS_JPEGProcess14SV1)
-        return im.samples == 1 ? Codec::jpeg_lossless : Codec::dcmtk;
-    if (im.xs == EXS_JPEG2000LosslessOnly || im.xs == EXS_JPEG2000 || im.htj2k) return Codec::j2k;
-    if (im.xs == EXS_JPEGProcess1 || im.xs == EXS_JPEGProcess2_4 || im.xs == EXS_JPEGLSLossless ||
-        im.xs == EXS_JPEGLSLossy)
-        return Codec::dcmtk;
+    if (x == Rle) return Codec::rle;
+    // our lossless JPEG decoder is grey only
+    if ((x == JpegLossless14 || x == JpegLosslessSV1) && im.samples == 1) return Codec::jpeg_lossless;
+    if (x == J2kLossless || x == J2k || x == Htj2kLossless || x == Htj2kRpclLossless || x == Htj2k) return Codec::j2k;
+    if (Dataset::has_codec(x, im.samples)) return Codec::backend;
     return Codec::none;
+}
+
+// What decompresses a syntax only the dcmtk backend decodes, for the
+// message where this build has no codec for it.
+const char *decompress_with(const std::string &x)
+{
+    using namespace syntax;
+    if (x == JpegLsLossless || x == JpegLsNearLossless) return "dcmtk's dcmdjpls or gdcmconv --raw";
+    if (x == JpegBaseline || x == JpegExtended || x == JpegLossless14 || x == JpegLosslessSV1)
+        return "dcmtk's dcmdjpeg or gdcmconv --raw";
+    return nullptr;
 }
 
 // Stored value of pixel i as a signed or unsigned integer of bits_stored.
@@ -131,50 +138,6 @@ Layout native_layout(const Image &s)
     return s.planar == 1 ? Layout::planar : Layout::interleaved;
 }
 
-// The fragments of an encapsulated PixelData (items after the basic offset
-// table), with their byte offsets as the table counts them.
-struct Fragments {
-    std::vector<std::pair<const uint8_t *, size_t>> items;
-    std::vector<uint64_t> at;  // offset of each item's tag from the first fragment's
-    std::vector<uint32_t> bot; // the basic offset table (empty when the encoder left it empty)
-};
-
-int fragments_of(const Image &s, DcmElement *el, Fragments &fr, vxl_err *e)
-{
-    const char *p = s.path.c_str();
-    DcmPixelSequence *seq = nullptr;
-    // the fragments are kept under the syntax the data set was read with:
-    // for one dcmtk does not know (HTJ2K on 3.6.7), not s.xs
-    E_TransferSyntax held = s.xs;
-    const DcmRepresentationParameter *param = nullptr;
-    if (el->ident() == EVR_PixelData && s.htj2k)
-        static_cast<DcmPixelData *>(el)->getOriginalRepresentationKey(held, param);
-    if (el->ident() != EVR_PixelData ||
-        static_cast<DcmPixelData *>(el)->getEncapsulatedRepresentation(held, param, seq).bad() || !seq ||
-        seq->card() < 1)
-        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': compressed PixelData holds no fragments", p);
-    uint64_t at = 0;
-    for (unsigned long i = 0; i < seq->card(); i++) {
-        DcmPixelItem *item = nullptr;
-        Uint8 *b = nullptr;
-        if (seq->getItem(item, i).bad() || !item || (item->getLength() && (item->getUint8Array(b).bad() || !b)))
-            return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read compressed item %lu", p, i);
-        const size_t len = item->getLength();
-        if (i == 0) {
-            if (len % 4) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': basic offset table of %zu bytes", p, len);
-            for (size_t k = 0; k < len; k += 4)
-                fr.bot.push_back(uint32_t(b[k]) | uint32_t(b[k + 1]) << 8 | uint32_t(b[k + 2]) << 16 |
-                                 uint32_t(b[k + 3]) << 24);
-            continue;
-        }
-        fr.items.emplace_back(b, len);
-        fr.at.push_back(at);
-        at += 8 + len; // item tag and length, then the value
-    }
-    if (fr.items.empty()) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': compressed PixelData holds no fragments", p);
-    return VXL_OK;
-}
-
 // Frame f's fragments joined (PS3.5 A.4): by the basic offset table when it
 // has one; else one fragment per frame when the counts agree; else, for
 // JPEG, a frame starts at each fragment that opens with an SOI marker.
@@ -200,7 +163,7 @@ int frame_bytes(const Image &s, const Fragments &fr, unsigned f, std::vector<uin
     } else if (n == frames) {
         first = f;
         end = f + 1;
-    } else if (s.xs != EXS_RLELossless) {
+    } else if (s.syntax != syntax::Rle) {
         size_t seen = 0;
         first = n;
         for (size_t i = 0; i < n; i++) {
@@ -222,31 +185,7 @@ int frame_bytes(const Image &s, const Fragments &fr, unsigned f, std::vector<uin
     return VXL_OK;
 }
 
-// 32-bit values of uncompressed PixelData in native order. dcmtk holds the
-// OW element as 16-bit words already in native order, so on a little-endian
-// host a big-endian file's values have their two halves swapped; they are
-// swapped back in place.
-OFCondition native_32(DcmElement *el, const Image &s, const void *&all)
-{
-    Uint16 *w = nullptr;
-    OFCondition c = el->getUint16Array(w);
-    all = w;
-    if (c.bad() || !w || s.xs != EXS_BigEndianExplicit || gLocalByteOrder != EBO_LittleEndian) return c;
-    const size_t words = size_t(s.rows) * s.cols * 2 * size_t(s.file_frames);
-    for (size_t i = 0; i + 1 < words; i += 2) std::swap(w[i], w[i + 1]);
-    return c;
-}
-
 } // namespace
-
-void prepare_decoders()
-{
-    static std::once_flag once;
-    std::call_once(once, [] {
-        DJDecoderRegistration::registerCodecs();
-        DJLSDecoderRegistration::registerCodecs();
-    });
-}
 
 unsigned components_of(const Image &im) { return is_colour(im) || is_palette(im) ? 3 : 1; }
 
@@ -260,6 +199,10 @@ bool is_colour(const Image &im)
 std::string decodable(const Image &im)
 {
     if (codec_of(im) != Codec::none) return "";
+    if (const char *tool = decompress_with(im.syntax))
+        return format("'%s': %s%s is not decoded on this system (no codec for it in this build): decompress the "
+                      "series first, e.g. with %s", im.path.c_str(), im.samples == 1 ? "" : "colour ",
+                      im.xfer.c_str(), tool);
     return format("'%s': compressed transfer syntax '%s' is not supported (decompress first, e.g. gdcmconv --raw)",
                   im.path.c_str(), im.xfer.c_str());
 }
@@ -267,19 +210,16 @@ std::string decodable(const Image &im)
 int read_frames(const std::vector<const Image *> &which, const std::vector<void *> &dst, vxl_err *e)
 {
     const Image &s = *which[0];
+    const Codec codec = codec_of(s);
+    Dataset ds;
+    int rc = ds.open(s.path, e);
+    if (rc) return rc;
     const char *p = s.path.c_str();
-    const Codec codec = codec_of(s); // dcmtk's decoders: registered by prepare_decoders before any thread reads
-    DcmFileFormat ff;
-    OFCondition c = ff.loadFile(p, EXS_Unknown, EGL_noChange, kHeaderReadLength, ERM_autoDetect);
-    if (c.bad()) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read: %s", p, c.text());
-    DcmDataset *ds = ff.getDataset();
-    DcmElement *el = nullptr;
-    if (ds->findAndGetElement(DCM_PixelData, el).bad() || !el)
-        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': no PixelData", p);
+    if (!ds.has(ds.root(), tags::PixelData)) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': no PixelData", p);
     const bool colour = is_colour(s);
     Palette palette;
     if (is_palette(s)) {
-        int rc = read_palette(ds, s, palette, e);
+        rc = read_palette(ds, s, palette, e);
         if (rc) return rc;
     }
     const size_t n = size_t(s.rows) * s.cols, bytes = n * (s.bits_alloc / 8);
@@ -293,40 +233,30 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
     std::vector<uint8_t> raw(codec == Codec::native ? 0 : room), joined;
     Fragments fr;
     if (codec == Codec::rle || codec == Codec::jpeg_lossless || codec == Codec::j2k) {
-        int rc = fragments_of(s, el, fr, e);
+        rc = ds.fragments(fr, e);
         if (rc) return rc;
     }
-    const void *all = nullptr;
+    const uint8_t *all = nullptr;
     if (codec == Codec::native) {
-        const size_t need = stored * size_t(s.file_frames);
-        if (el->getLength() < need)
+        const size_t need = stored * size_t(s.file_frames), have = ds.pixel_length();
+        if (have < need)
             return vxl_fail(e, VXL_ERR_FORMAT, "'%s': truncated PixelData: %zu bytes for %ld frame(s) of %ux%u "
-                            "pixels of %u bits, got %lu", p, need, s.file_frames, s.cols, s.rows, s.bits_alloc,
-                            (unsigned long)el->getLength());
-        if (s.bits_alloc == 8) {
-            Uint8 *b = nullptr;
-            c = el->getUint8Array(b);
-            all = b;
-        } else if (s.bits_alloc == 32) {
-            c = native_32(el, s, all);
-        } else {
-            Uint16 *b = nullptr;
-            c = el->getUint16Array(b);
-            all = b;
-        }
-        if (c.bad() || !all) return vxl_fail(e, VXL_ERR_FORMAT, "'%s': cannot read PixelData: %s", p, c.text());
+                            "pixels of %u bits, got %zu", p, need, s.file_frames, s.cols, s.rows, s.bits_alloc, have);
+        size_t len = 0;
+        rc = ds.pixels(s.bits_alloc, all, len, e);
+        if (rc) return rc;
     }
-    // in frame order, so that dcmtk's codecs resume their fragment walk
+    // in frame order, so that a backend's codec resumes its fragment walk
     // from the previous frame instead of starting over
     std::vector<size_t> order(which.size());
     for (size_t i = 0; i < order.size(); i++) order[i] = i;
     std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return which[a]->frame < which[b]->frame; });
-    Uint32 start_fragment = 0;
+    uint32_t start_fragment = 0;
     unsigned previous = 0;
     for (size_t i : order) {
         const unsigned f = which[i]->frame;
         if (codec == Codec::native) {
-            const uint8_t *frame = static_cast<const uint8_t *>(all) + size_t(f) * stored;
+            const uint8_t *frame = all + size_t(f) * stored;
             if (colour) rgb_of_colour(s, frame, native_layout(s), ybr, dst[i]);
             else unpack_frame(s, frame, n, dst[i]);
             if (is_palette(s)) rgb_of_palette(s, palette, dst[i]);
@@ -334,18 +264,15 @@ int read_frames(const std::vector<const Image *> &which, const std::vector<void 
         }
         Layout layout = Layout::interleaved;
         bool frame_ybr = ybr;
-        if (codec == Codec::dcmtk) {
-            OFString model; // what the codec produced: RGB, or YCbCr it left as it was
+        if (codec == Codec::backend) {
+            std::string model; // what the codec produced: RGB, or YCbCr it left as it was
             if (f == 0 || f != previous + 1) start_fragment = 0; // 0: the codec finds the frame itself
             previous = f;
-            c = static_cast<DcmPixelData *>(el)->getUncompressedFrame(ds, f, start_fragment, raw.data(), Uint32(room),
-                                                                      model);
-            if (c.bad())
-                return vxl_fail(e, VXL_ERR_FORMAT, "'%s': frame %u: %s decoder: %s", p, f + 1, s.xfer.c_str(),
-                                c.text());
-            frame_ybr = is_ybr_full(model.c_str());
+            rc = ds.decode_frame(f, start_fragment, raw.data(), room, model, e);
+            if (rc) return rc;
+            frame_ybr = is_ybr_full(model);
         } else {
-            int rc = frame_bytes(s, fr, f, joined, e);
+            rc = frame_bytes(s, fr, f, joined, e);
             if (rc) return rc;
             vxl_err codec_err = {};
             const uint8_t *b = joined.data();

@@ -5,17 +5,18 @@
 //                     files, classic multi-frame, enhanced functional groups)
 //   dicom_geometry.cpp a series' images -> their order, time points, affine
 //                     and the resampling plan for uneven spacing
-//   dicom_pixels.cpp  one file's frames -> pixels (dcmtk for the uncompressed
-//                     and the codecs it has, our C for RLE and lossless JPEG)
+//   dicom_pixels.cpp  one file's frames -> pixels (our C for RLE, lossless
+//                     JPEG and JPEG 2000; the backend's codecs for the rest)
 //   dicom_palette.cpp PALETTE COLOR indices -> their colours (RGB)
 //   dicom.cpp         folder scan, series choice, the parallel load
+// Each reads files through the data set seam (dicom_dataset.hpp), whose
+// backend (dcmtk's parser, or our own) the Makefile picks per target.
 // Only the helper process voxlight-read-dicom runs these: libvoxlight links
 // no C++.
 #ifndef VXL_DICOM_SERIES_HPP
 #define VXL_DICOM_SERIES_HPP
 
-#include <dcmtk/config/osconfig.h>
-#include <dcmtk/dcmdata/dctk.h>
+#include "dicom_dataset.hpp"
 
 #include <cstdint>
 #include <string>
@@ -26,10 +27,6 @@ extern "C" {
 }
 
 namespace vxl_dicom {
-
-// Element values longer than this stay on disk when a file is parsed: a
-// folder scan reads headers only, and PixelData is read when a frame is.
-constexpr Uint32 kHeaderReadLength = 4096;
 
 inline void cross(const double a[3], const double b[3], double o[3])
 {
@@ -49,9 +46,8 @@ struct Image {
     unsigned rows = 0, cols = 0, bits_alloc = 0, bits_stored = 0, pixel_rep = 0, samples = 1;
     unsigned planar = 0; // PlanarConfiguration of colour: 0 samples of a pixel together, 1 planes
     bool has_ipp = false, has_iop = false, has_spacing = false, encapsulated = false;
-    bool htj2k = false; // HTJ2K (1.2.840.10008.1.2.4.201-.203), known by its UID: dcmtk 3.6.7 does not know it
-    E_TransferSyntax xs = EXS_Unknown;
-    std::string xfer; // the transfer syntax's name, for messages
+    std::string syntax; // the transfer syntax's UID
+    std::string xfer;   // its name, for messages
     double ipp[3] = {0, 0, 0}, iop[6] = {1, 0, 0, 0, 1, 0}, ps[2] = {1, 1};
     double slope = 1, inter = 0, thickness = 0, between = 0; // SliceThickness, SpacingBetweenSlices
     double tkey = 0;       // time order (TemporalPosition*, TriggerTime, AcquisitionNumber, InstanceNumber)
@@ -109,8 +105,8 @@ struct Palette {
     std::vector<uint16_t> rgb[3];
     long first = 0; // the stored value of entry 0
 };
-// Reads the tables of a file's dataset; VXL_OK or a vxl_fail naming the file.
-int read_palette(DcmItem *ds, const Image &im, Palette &pal, vxl_err *e);
+// Reads the tables of a file's data set; VXL_OK or a vxl_fail naming the file.
+int read_palette(const Dataset &ds, const Image &im, Palette &pal, vxl_err *e);
 // A frame of indices (as read_frames unpacks grey pixels) in the first
 // rows*cols values of `frame`, in place, into their colours: 3 values a
 // pixel (R, G, B together) in the frame's own type, so `frame` has room for
@@ -118,9 +114,6 @@ int read_palette(DcmItem *ds, const Image &im, Palette &pal, vxl_err *e);
 // bits), 16-bit ones the entries as they are.
 void rgb_of_palette(const Image &s, const Palette &pal, void *frame);
 
-// Registers the decoders dcmtk keeps in a process-wide list: once, before
-// any thread reads, as dcmtk asks.
-void prepare_decoders();
 // Whether the pixels of this image can be decoded here; "" or the reason.
 std::string decodable(const Image &im);
 // Reads the frames `which` of one file (all images share the path), each

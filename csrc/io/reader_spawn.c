@@ -47,8 +47,8 @@ static int helper_path(const vxl_reader *r, const char *path, char *out, size_t 
     } else {
         if (!vxl_reader_runs_here(r))
             return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s are not read on Windows yet: their reader needs %s, "
-                            "which has no Windows build here (Windows reads NIfTI, NRRD, MetaImage, OME-Zarr and "
-                            "uncompressed multi-page TIFF, streamed)", path, r->formats, r->library);
+                            "which has no Windows build here (Windows reads NIfTI, NRRD, MetaImage, OME-Zarr, DICOM "
+                            "and uncompressed multi-page TIFF, streamed)", path, r->formats, r->library);
         char self[4096];
         if (vxl_dynlib_path_of((const void *)&vxl_reader_run, self, sizeof self))
             return vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot locate libvoxlight to find %s", path,

@@ -22,9 +22,11 @@ static const vxl_reader vdb_reader = {
 static const vxl_reader environment_reader = {
     VXL_HELPER_OIIO, VXL_HELPER_OIIO_ENV, "the OpenEXR reader", "OpenEXR environment maps", "OpenImageIO",
     VXL_OIIO_SONAME, VXL_OIIO_PACKAGE, 1};
+/* DICOM runs on Windows too: there its helper is built on our own Part 10
+ * parser instead of dcmtk (csrc/io/dicom_dataset.hpp). */
 static const vxl_reader dicom_reader = {
     VXL_HELPER_DICOM, VXL_HELPER_DICOM_ENV, "the DICOM reader", "DICOM series", "dcmtk",
-    VXL_DCMTK_SONAME, VXL_DCMTK_PACKAGE, 1};
+    VXL_DCMTK_SONAME, VXL_DCMTK_PACKAGE, 0};
 
 static const vxl_reader zarr_reader = {
     VXL_HELPER_ZARR, VXL_HELPER_ZARR_ENV, "the OME-Zarr reader", "OME-Zarr stores", "libblosc and libzstd",

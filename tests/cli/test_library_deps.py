@@ -92,3 +92,25 @@ def test_missing_zlib_is_a_clear_error(tmp_path):
     r = _info(vol, VOXLIGHT_LIBZ=str(tmp_path / "no-such-libz.so.1"))
     assert r.returncode != 0
     assert "zlib" in r.stderr and "cannot be loaded" in r.stderr, r.stderr
+
+
+# Windows' own DLLs and its universal C runtime: what every Windows 10 and 11
+# has, so a helper needs nothing shipped beside it (zlib1.dll is opened at
+# run time, never imported).
+WINDOWS_SYSTEM_DLL = re.compile(r"^(kernel32|shell32|user32|gdi32|advapi32|ntdll|ws2_32|bcrypt|ucrtbase|msvcrt)\.dll$"
+                                r"|^api-ms-win-[a-z0-9-]+\.dll$", re.I)
+
+
+def pe_imports(path):
+    out = subprocess.run(["objdump", "-p", str(path)], capture_output=True, text=True, check=True).stdout
+    return re.findall(r"DLL Name: (\S+)", out)
+
+
+def test_windows_helpers_import_only_windows_dlls():
+    """voxlight-read-dicom.exe is C++: zig's libc++ (and its unwinder) must
+    be linked in, never a libc++.dll, libstdc++-6.dll or libgcc_s a Windows
+    machine lacks; the Zarr helper likewise."""
+    for name in ("voxlight-read-dicom.exe", "voxlight-read-zarr.exe"):
+        dlls = pe_imports(BUILD / "windows-x64" / name)
+        assert "KERNEL32.dll" in dlls, (name, dlls)  # the parse found the imports at all
+        assert [d for d in dlls if not WINDOWS_SYSTEM_DLL.match(d)] == [], (name, dlls)

@@ -1,5 +1,6 @@
 """The CLI cross-compiled for Windows (build/windows-x64/voxlight.exe, with
-voxlight.dll, zlib1.dll and voxlight-read-zarr.exe beside it) under Wine:
+voxlight.dll, zlib1.dll, voxlight-read-zarr.exe and voxlight-read-dicom.exe
+beside it) under Wine:
 each format written in Voxlight's own C reads and renders as the Linux CLI
 does, from a folder whose name is not ASCII (UTF-8 arguments through the
 wide-character command line and file calls); the formats whose readers need
@@ -81,6 +82,41 @@ def inputs(tmp_path_factory):
     return files
 
 
+def run_tool(*args):
+    subprocess.run([str(a) for a in args], check=True, capture_output=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def dicom_inputs(tmp_path_factory):
+    """DICOM made on Linux, each in its own folder under one named José: an
+    enhanced multi-frame CT (pydicom, tests/make_enhanced_dicom.py: shuffled
+    frames, per-frame and shared functional groups) as written, deflated,
+    in RLE and in lossless JPEG (SV1) and JPEG-LS (dcmtk's encoders), and a
+    colour file (tests/make_colour_dicom.py, YBR_FULL) and a PALETTE COLOR
+    one. Windows reads them with our own parser (voxlight-read-dicom.exe),
+    Linux with dcmtk."""
+    d = tmp_path_factory.mktemp("windicom") / "Scans José DICOM"
+    d.mkdir()
+    py = "/usr/bin/python3"
+    files = {}
+
+    def folder(name):
+        (d / name).mkdir()
+        return d / name
+
+    files["enhanced"] = folder("enhanced") / "ct.dcm"
+    run_tool(py, ROOT / "tests" / "make_enhanced_dicom.py", files["enhanced"], 20, 16, 12, 1,
+             0.8, 0.6, 0, 0, 0, -1, -10, 20, 30, -1.2, 1.6, 0, 7)  # oblique, 2 mm along the normal
+    for name, tool in (("deflated", ["dcmconv", "+td"]), ("rle", ["dcmcrle"]), ("jpeg_lossless", ["dcmcjpeg"]),
+                       ("jpeg_ls", ["dcmcjpls"])):
+        files[name] = folder(name) / "ct.dcm"
+        run_tool(*tool, files["enhanced"], files[name])
+    for mode in ("ybr", "palette"):
+        files[mode] = folder(mode) / "colour.dcm"
+        run_tool(py, ROOT / "tests" / "make_colour_dicom.py", files[mode], mode)
+    return files
+
+
 def without_paths(text, *paths):
     """The report's lines that do not name the input (which each OS spells its own way)."""
     return [l for l in text.splitlines() if not any(str(p.name) in l for p in paths)]
@@ -114,6 +150,39 @@ def test_render_matches_linux(inputs, tmp_path, fmt, extra):
     b = np.frombuffer(px_w, np.uint8).astype(int)
     assert (a != 0).mean() > 0.1  # the ball is in the picture
     assert np.abs(a - b).max() <= 1, "PNG bytes differ by up to %d" % np.abs(a - b).max()
+
+
+@pytest.mark.parametrize("kind", ["enhanced", "deflated", "rle", "jpeg_lossless", "ybr", "palette"])
+def test_dicom_info_matches_linux(dicom_inputs, kind):
+    """Our own parser on Windows reports what dcmtk's does on Linux: size,
+    spacing, affine, value range, notes."""
+    src = dicom_inputs[kind]
+    lin = run_linux("info", src)
+    assert lin.returncode == 0, lin.stderr
+    win = run_windows("voxlight.exe", "info", src)
+    assert win.returncode == 0, win.stdout + win.stderr
+    assert without_paths(win.stdout, src) == without_paths(lin.stdout, src)
+
+
+@pytest.mark.parametrize("kind", ["enhanced", "rle", "ybr"])
+def test_dicom_render_matches_linux(dicom_inputs, tmp_path, kind):
+    src = dicom_inputs[kind]
+    out_l, out_w = tmp_path / "linux.png", tmp_path / "windows.png"
+    lin = run_linux("render", src, "-o", out_l, "--size", "48x48")
+    assert lin.returncode == 0, lin.stderr
+    win = run_windows("voxlight.exe", "render", src, "-o", out_w, "--size", "48x48", display=True)
+    assert win.returncode == 0, win.stdout + win.stderr
+    a = np.frombuffer(png_pixels(out_l)[4], np.uint8).astype(int)
+    b = np.frombuffer(png_pixels(out_w)[4], np.uint8).astype(int)
+    assert (a != 0).mean() > 0.05  # the volume is in the picture
+    assert np.abs(a - b).max() <= 1, "PNG bytes differ by up to %d" % np.abs(a - b).max()
+
+
+def test_jpeg_ls_dicom_is_one_clear_line_on_windows(dicom_inputs):
+    """JPEG-LS is decoded by dcmtk's codec alone: Windows names the syntax
+    and the tool that decompresses it, in one line."""
+    line = one_error_line(run_windows("voxlight.exe", "info", dicom_inputs["jpeg_ls"]))
+    assert "JPEG-LS Lossless is not decoded on this system" in line and "dcmdjpls" in line, line
 
 
 def test_an_uncompressed_tiff_streams_on_windows_without_asking(inputs):
@@ -152,14 +221,15 @@ def one_error_line(win):
 
 
 def test_formats_without_a_windows_reader_are_refused_by_name(inputs, tmp_path):
-    """TIFF read whole (streaming off) and DICOM need OpenImageIO and dcmtk;
-    zstd and blosc chunks need Debian's libzstd and libblosc."""
+    """TIFF read whole (streaming off) needs OpenImageIO; zstd and blosc
+    chunks need Debian's libzstd and libblosc. A damaged DICOM file is one
+    line from our own parser."""
+    line = one_error_line(run_windows("voxlight.exe", "info", inputs["tiff"], "--streaming", "off"))
+    assert "TIFF/PNG stacks are not read on Windows yet" in line and "OpenImageIO" in line, line
     dcm = tmp_path / "slice.dcm"
     dcm.write_bytes(b"\0" * 128 + b"DICM" + b"\0" * 64)
-    for src, formats, library in ((inputs["tiff"], "TIFF/PNG stacks", "OpenImageIO"),
-                                  (dcm, "DICOM series", "dcmtk")):
-        line = one_error_line(run_windows("voxlight.exe", "info", src, "--streaming", "off"))
-        assert "%s are not read on Windows yet" % formats in line and library in line, line
+    line = one_error_line(run_windows("voxlight.exe", "info", dcm))
+    assert "slice.dcm" in line and "not a readable DICOM file" in line, line
     ball = np.zeros((8, 8, 8), np.uint16)
     ball[2:6, 2:6, 2:6] = 1000
     for codec in ("zstd", "blosc"):

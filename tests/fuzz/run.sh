@@ -33,17 +33,18 @@ replay_only=0
 [ "$mode" = replay ] && replay_only=1
 secs=$mode
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom vdb label_table zarr brick_cache tiff_layout dicom_codecs hdr)
+[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom dicom_own vdb label_table zarr brick_cache tiff_layout dicom_codecs hdr)
 
 # Parsers written in this project's C: fuzzed in every mode. The rest read
 # through a third-party library inside a helper process.
-OWN_TARGETS=" nifti nrrd metaimage label_table zarr brick_cache tiff_layout dicom_codecs hdr "
+OWN_TARGETS=" nifti nrrd metaimage label_table zarr brick_cache tiff_layout dicom_codecs hdr dicom_own "
 is_own() { [[ $OWN_TARGETS == *" $1 "* ]]; }
 # ci: inputs per own target (about 8 s each on the 2-core CI machine;
 # VOXLIGHT_FUZZ_CI_RUNS overrides them all, as tests/cli/test_crash_replay.py
 # does) and the one seed every run uses
 declare -A CI_RUNS=([nifti]=30000 [nrrd]=100000 [metaimage]=100000 [label_table]=100000
-                    [zarr]=20000 [brick_cache]=20000 [tiff_layout]=150000 [dicom_codecs]=1000000 [hdr]=300000)
+                    [zarr]=20000 [brick_cache]=20000 [tiff_layout]=150000 [dicom_codecs]=1000000 [hdr]=300000
+                    [dicom_own]=5000)
 CI_SEED=20261207
 # Where a third-party reader's own frames are told apart from ours
 declare -A UPSTREAM_LIBS=([vdb]='openvdb' [tiff]='OpenImageIO|libtiff' [png]='OpenImageIO|libpng'
@@ -78,6 +79,8 @@ if [ $replay_only -eq 0 ]; then
     /usr/bin/python3 tests/fuzz/zarr_seeds.py build/fuzz/seeds/zarr || { echo "fuzz: zarr seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
     /usr/bin/python3 tests/fuzz/jpeg_seeds.py build/fuzz/seeds/dicom_codecs || { echo "fuzz: jpeg seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
     /usr/bin/python3 tests/fuzz/dicom_seeds.py build/fuzz/seeds/dicom || { echo "fuzz: dicom seed writer failed"; echo "0 passed, 1 failed"; exit 1; }
+    # our own DICOM parser starts from dcmtk's seeds (the same files, another parser)
+    rm -rf build/fuzz/seeds/dicom_own && cp -r build/fuzz/seeds/dicom build/fuzz/seeds/dicom_own
     # brick caches of .nii.gz files, written by the cache's own test (the format's one writer)
     rm -rf build/fuzz/seeds/brick_cache
     { make -s -j"$(nproc)" build/tests/test_brick_cache && build/tests/test_brick_cache --write-seeds build/fuzz/seeds/brick_cache; } ||

@@ -47,6 +47,8 @@ def test_windows_zip_names_its_platform_and_holds_windows_binaries_only():
         binaries = _binaries(z)
         # zlib1.dll: voxlight.dll loads it from its own folder.
         assert {"voxlight/voxlight.dll", "voxlight/zlib1.dll"} <= set(binaries), binaries
+        # the reader helpers our own C builds for Windows (DICOM on our own parser)
+        assert {"voxlight/voxlight-read-zarr.exe", "voxlight/voxlight-read-dicom.exe"} <= set(binaries), binaries
         assert not any(n.endswith(".so") or ".so." in n for n in z.namelist())
         for name in binaries:
             data = z.read(name)

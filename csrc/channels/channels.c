@@ -10,9 +10,10 @@
 #include "holdings.h"
 #include "paging.h"
 
-void vxl_channels_init(vxl_channels_state *s, vxl_gpu *g)
+void vxl_channels_init(vxl_channels_state *s, vxl_gpu *g, vxl_storage_state *storage)
 {
     s->gpu = g;
+    s->storage = storage;
     vxl_holding_register(g, VXL_HOLD_CHANNELS, vxl_holding_counter, &s->bytes);
 }
 
@@ -32,94 +33,112 @@ void vxl_channels_release(vxl_channels_state *s)
         vxl_bricks_free(&s->bricks[c]);
     }
     delete_tex(s->gpu, &s->distance_tex);
+    delete_tex(s->gpu, &s->page_tex);
     vxl_gpu *g = s->gpu;
+    vxl_storage_state *storage = s->storage;
     const uint64_t uploads = s->uploads;
     memset(s, 0, sizeof *s);
     s->gpu = g;
+    s->storage = storage;
     s->uploads = uploads;
 }
 
-int vxl_channels_plan(vxl_channels_state *s, const vxl_volume *v, uint32_t storage_mode, uint64_t storage_bytes)
+void vxl_channel_plan_free(vxl_channel_plan *p)
 {
-    /* paged storage holds the scalar only: drawing channels is refused then */
-    if (!v->channels || storage_mode != VXL_STORAGE_DENSE) return VXL_OK;
-    vxl_gpu *g = s->gpu;
-    for (int a = 0; a < 3; a++)
-        if (v->dims[a] > (uint32_t)g->info.max_3d_texture_size)
-            return vxl_fail(&g->err, VXL_ERR_LIMIT,
-                            "the channels of a %ux%ux%u volume are 3D textures and exceed this backend's limit of %d "
-                            "per axis (crop it)",
-                            v->dims[0], v->dims[1], v->dims[2], g->info.max_3d_texture_size);
-    /* a new volume releases everything derived from the old one: only what
-     * it keeps (labels, overlays, the MatCap, cutters, shadow maps) stays */
-    uint64_t held[VXL_HOLD_COUNT];
-    vxl_holdings(g, held);
-    held[VXL_HOLD_GRADIENTS] = held[VXL_HOLD_BSPLINE] = held[VXL_HOLD_CLASSIFIED] = 0;
-    held[VXL_HOLD_ILLUMINATION] = held[VXL_HOLD_MODE_BRICKS] = held[VXL_HOLD_COLOUR] = 0;
-    return vxl_budget_ask(g->budget, held, VXL_HOLD_CHANNELS, vxl_volume_channel_bytes(v) + storage_bytes, &g->err,
-                          " (a multi-channel volume's channels are stored densely, 2 bytes a channel a voxel, beside "
-                          "its scalar)",
-                          "the %ux%ux%u volume's %u channels", v->dims[0], v->dims[1], v->dims[2], v->channel_count);
+    for (uint32_t c = 0; c < VXL_MAX_CHANNELS; c++) vxl_bricks_free(&p->bricks[c]);
+    vxl_channel_pages_free(&p->pages);
+    p->bytes = 0;
 }
 
-/* Channel c of v alone as a 16-bit volume, for the brick min-max grid. */
+/* Channel c of v alone, for its brick min-max grid. */
 static int channel_minmax(vxl_gpu *g, const vxl_volume *v, uint32_t c, vxl_bricks *out)
 {
-    const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
     vxl_volume one;
-    memset(&one, 0, sizeof one);
-    memcpy(one.dims, v->dims, sizeof one.dims);
-    one.texture_bits = 16;
-    one.storage_bytes = n * 2;
-    uint16_t *t = malloc((size_t)(n * 2));
-    if (!t) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for channel %u's brick min-max", c);
-    const uint32_t grp = c / VXL_CHANNELS_PER_GROUP, w = vxl_channel_group_width(v, grp);
-    const uint16_t *src = vxl_channel_group(v, grp) + c % VXL_CHANNELS_PER_GROUP;
-    for (uint64_t i = 0; i < n; i++) t[i] = src[i * w];
-    one.texels = t;
     memset(out, 0, sizeof *out);
-    int rc = vxl_bricks_minmax_cpu(out, &one, vxl_skip_brick_size(), &g->err);
-    free(t);
+    int rc = vxl_channel_alone(v, c, &one, &g->err);
+    if (!rc) rc = vxl_bricks_minmax_cpu(out, &one, vxl_skip_brick_size(), &g->err);
+    free(one.texels);
     return rc;
 }
 
-static const GLenum group_formats[4] = {GL_R16, GL_RG16, GL_RGB16, GL_RGBA16};
-static const GLenum group_layouts[4] = {GL_RED, GL_RG, GL_RGB, GL_RGBA};
+int vxl_channels_plan(vxl_channels_state *s, const vxl_volume *v, const vxl_storage_plan *sp, vxl_channel_plan *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!v->channels) return VXL_OK;
+    vxl_gpu *g = s->gpu;
+    const int dense = sp->mode == VXL_STORAGE_DENSE;
+    for (int a = 0; dense && a < 3; a++)
+        if (v->dims[a] > (uint32_t)g->info.max_3d_texture_size)
+            return vxl_fail(&g->err, VXL_ERR_LIMIT,
+                            "the channels of a %ux%ux%u volume are 3D textures in dense storage and exceed this "
+                            "backend's limit of %d per axis (use bricked storage, or crop it)",
+                            v->dims[0], v->dims[1], v->dims[2], g->info.max_3d_texture_size);
+    int rc = VXL_OK;
+    for (uint32_t c = 0; c < v->channel_count && !rc; c++) rc = channel_minmax(g, v, c, &out->bricks[c]);
+    /* paged: the scalar's page bricks (every level has the same brick size) */
+    if (!rc && !dense) rc = vxl_channel_pages_plan(&out->pages, v, sp->levels[0].brick, s->storage);
+    if (rc) {
+        vxl_channel_plan_free(out);
+        return rc;
+    }
+    out->bytes = dense ? vxl_volume_channel_bytes(v) : out->pages.bytes;
+    /* a new volume releases everything derived from the old one and the
+     * old volume itself: only what it keeps (labels, overlays, the MatCap,
+     * cutters, shadow maps) stays, beside the new scalar's sp->bytes */
+    uint64_t held[VXL_HOLD_COUNT];
+    vxl_holdings(g, held);
+    held[VXL_HOLD_STORAGE] = 0;
+    held[VXL_HOLD_GRADIENTS] = held[VXL_HOLD_BSPLINE] = held[VXL_HOLD_CLASSIFIED] = 0;
+    held[VXL_HOLD_ILLUMINATION] = held[VXL_HOLD_MODE_BRICKS] = held[VXL_HOLD_COLOUR] = 0;
+    rc = vxl_budget_ask(g->budget, held, VXL_HOLD_CHANNELS, out->bytes + sp->bytes, &g->err,
+                        dense ? " (a multi-channel volume's channels are stored densely, 2 bytes a channel a voxel, "
+                                "beside its scalar)"
+                              : " (a multi-channel volume's channels are paged beside its scalar: every brick where "
+                                "a channel varies, 2 bytes a channel a voxel with the ghost borders)",
+                        "the %ux%ux%u volume's %u channels (%s storage)", v->dims[0], v->dims[1], v->dims[2],
+                        v->channel_count, vxl_storage_name(sp->mode));
+    if (rc) vxl_channel_plan_free(out);
+    return rc;
+}
 
-int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, uint32_t storage_mode)
+int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, vxl_channel_plan *plan)
 {
     vxl_channels_release(s);
     if (!v || !v->channels) return VXL_OK;
     vxl_gpu *g = s->gpu;
     vxl_gl *gl = &g->gl;
     s->count = v->channel_count;
-    s->storage_mode = storage_mode;
     for (uint32_t c = 0; c < v->channel_count; c++) {
         s->geom[c] = vxl_volume_geom_of(v);
         s->geom[c].tex_lo = v->ch_tex_lo[c];
         s->geom[c].tex_hi = v->ch_tex_hi[c];
         s->geom[c].value_min = v->ch_min[c];
         s->geom[c].value_max = v->ch_max[c];
+        s->bricks[c] = plan->bricks[c]; /* taken */
+        memset(&plan->bricks[c], 0, sizeof plan->bricks[c]);
     }
-    if (storage_mode != VXL_STORAGE_DENSE) return VXL_OK; /* the scalar alone (vxl_channels_flags says why) */
-    int rc = VXL_OK;
-    for (uint32_t c = 0; c < v->channel_count && !rc; c++) rc = channel_minmax(g, v, c, &s->bricks[c]);
     s->groups = vxl_channel_groups(v);
+    int rc = VXL_OK;
+    if (plan->pages.layout.brick) {
+        rc = vxl_channel_pages_upload(&plan->pages, v, s->storage, s->tex, &s->page_tex);
+        const uint32_t e = vxl_page_edge(&plan->pages.layout);
+        for (int a = 0; a < 3; a++) s->pool_dims[a] = plan->pages.slots[a] * e;
+    }
     gl->GetError();
-    for (uint32_t grp = 0; grp < s->groups && !rc; grp++) {
+    for (uint32_t grp = 0; grp < s->groups && !rc && !plan->pages.layout.brick; grp++) {
         const uint32_t w = vxl_channel_group_width(v, grp);
         /* filtered as the scalar is: trilinear between voxel centres */
         s->tex[grp] = vxl_texture_new(g, GL_TEXTURE_3D, GL_LINEAR);
         gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)group_formats[w - 1], (GLsizei)v->dims[0], (GLsizei)v->dims[1],
-                       (GLsizei)v->dims[2], 0, group_layouts[w - 1], GL_UNSIGNED_SHORT, vxl_channel_group(v, grp));
+        gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)vxl_channel_group_format(w), (GLsizei)v->dims[0], (GLsizei)v->dims[1],
+                       (GLsizei)v->dims[2], 0, vxl_channel_group_layout(w), GL_UNSIGNED_SHORT, vxl_channel_group(v, grp));
         rc = vxl_gl_check(g, "uploading a multi-channel volume's channels");
     }
     if (rc) {
         vxl_channels_release(s);
         return rc;
     }
-    s->volume_bytes = vxl_volume_channel_bytes(v);
+    s->volume_bytes = plan->bytes;
     recount(s);
     s->uploads++;
     return VXL_OK;
@@ -133,11 +152,6 @@ int vxl_channels_flags(const vxl_channels_state *s, const vxl_frame *f, uint32_t
         return vxl_fail(&s->gpu->err, VXL_ERR_STATE,
                         "params.channels lists %u channels, but the volume has none (it is not multi-channel)",
                         f->channels.listed);
-    if (s->storage_mode != VXL_STORAGE_DENSE)
-        return vxl_fail(&s->gpu->err, VXL_ERR_INVALID_ARGUMENT,
-                        "drawing channels needs dense storage: this renderer holds the volume in %s storage, which "
-                        "cannot page, compress or stream its %u channels yet (create the renderer with storage dense)",
-                        vxl_storage_name(s->storage_mode) ? vxl_storage_name(s->storage_mode) : "paged", s->count);
     for (uint32_t k = 0; k < f->channels.count; k++)
         if (f->channels.ch[k].channel >= s->count)
             return vxl_fail(&s->gpu->err, VXL_ERR_STATE, "params.channels names channel %u: the volume has channels 0..%u",
@@ -261,6 +275,14 @@ int vxl_channels_prepare(vxl_channels_state *s, const vxl_frame *f, GLuint prog)
     }
     vxl_uniform_i(s->gpu, prog, "u_ch_data0", VXL_CHANNEL_DATA_UNIT);
     vxl_uniform_i(s->gpu, prog, "u_ch_data1", VXL_CHANNEL_DATA_UNIT + 1);
+    if (s->page_tex) { /* paged: the pools' page table, read as the scalar's is */
+        gl->ActiveTexture(GL_TEXTURE0 + VXL_CHANNEL_PAGE_UNIT);
+        gl->BindTexture(GL_TEXTURE_3D, s->page_tex);
+        vxl_uniform_i(s->gpu, prog, "u_ch_page", VXL_CHANNEL_PAGE_UNIT);
+        const float pd[3] = {(float)s->pool_dims[0], (float)s->pool_dims[1], (float)s->pool_dims[2]};
+        const GLint loc = gl->GetUniformLocation(prog, "u_ch_pool_dims");
+        if (loc >= 0) gl->Uniform3fv(loc, 1, pd);
+    }
     gl->ActiveTexture(GL_TEXTURE0 + VXL_CHANNEL_DISTANCE_UNIT);
     gl->BindTexture(GL_TEXTURE_3D, s->distance_tex); /* 0 when skipping is off: never read then */
     vxl_uniform_i(s->gpu, prog, "u_ch_distance", VXL_CHANNEL_DISTANCE_UNIT);

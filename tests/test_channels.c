@@ -83,11 +83,11 @@ typedef struct fixture {
 static const uint32_t g_storages[4] = {VXL_STORAGE_DENSE, VXL_STORAGE_BRICKED, VXL_STORAGE_SPARSE,
                                        VXL_STORAGE_COMPRESSED};
 
-static int fixture_open(fixture *x, const uint16_t *data, uint32_t count, uint32_t storage)
+static int fixture_open_bricks(fixture *x, const uint16_t *data, uint32_t count, uint32_t storage, uint32_t brick)
 {
     memset(x, 0, sizeof *x);
     x->v = channels_volume(data, count, 0);
-    x->r = make_stored_renderer(storage, storage == VXL_STORAGE_DENSE ? 0 : PAGE_BRICK, 0, 0);
+    x->r = make_stored_renderer(storage, storage == VXL_STORAGE_DENSE ? 0 : brick, 0, 0);
     styles(x->st, count);
     x->p = base_params();
     x->p.channel_count = count;
@@ -96,6 +96,11 @@ static int fixture_open(fixture *x, const uint16_t *data, uint32_t count, uint32
     fprintf(stderr, "  fixture (%s storage): %s\n", vxl_storage_name(storage),
             x->r ? vxl_renderer_error(x->r) : vxl_last_error());
     return 0;
+}
+
+static int fixture_open(fixture *x, const uint16_t *data, uint32_t count, uint32_t storage)
+{
+    return fixture_open_bricks(x, data, count, storage, PAGE_BRICK);
 }
 
 static void fixture_close(fixture *x)
@@ -289,26 +294,25 @@ TEST(skipping_over_the_union_changes_nothing)
 }
 
 /* What the paged modes should hold for `count` planar channels of N^3 in
- * bricks of PAGE_BRICK, worked out here from the definition: a brick (its
- * ghost voxel each way included, clamped to the volume) where some channel
+ * bricks of P, worked out here from the definition: a brick (its ghost
+ * voxel each way included, clamped to the volume) where some channel
  * varies has a slot; the others share one slot per distinct tuple of
  * constants. Bytes: slots of (P + 2)^3 texels of 2 bytes a channel, and an
  * RGBA32F page-table texel per brick. */
-static uint64_t expected_pool_bytes(const uint16_t *data, uint32_t count, uint32_t *varying, uint32_t *constant)
+static uint64_t expected_pool_bytes(const uint16_t *data, uint32_t count, int P, uint32_t *varying, uint32_t *constant)
 {
-    enum { G = (N + PAGE_BRICK - 1) / PAGE_BRICK, E = PAGE_BRICK + 2 };
-    uint16_t tuples[G * G * G][VXL_MAX_CHANNELS];
+    const int G = (N + P - 1) / P, E = P + 2;
+    uint16_t tuples[27][VXL_MAX_CHANNELS]; /* G^3 <= 27 for P >= 8 */
     *varying = *constant = 0;
     for (int b = 0; b < G * G * G; b++) {
         const int bx = b % G, by = b / G % G, bz = b / (G * G);
         int varies = 0;
         for (uint32_t c = 0; c < count; c++) {
             const uint16_t *ch = data + (size_t)c * N * N * N;
-            tuples[*constant][c] = ch[0];
             int first = 1;
-            for (int z = bz * PAGE_BRICK - 1; z <= bz * PAGE_BRICK + PAGE_BRICK; z++)
-                for (int y = by * PAGE_BRICK - 1; y <= by * PAGE_BRICK + PAGE_BRICK; y++)
-                    for (int x = bx * PAGE_BRICK - 1; x <= bx * PAGE_BRICK + PAGE_BRICK; x++) {
+            for (int z = bz * P - 1; z <= bz * P + P; z++)
+                for (int y = by * P - 1; y <= by * P + P; y++)
+                    for (int x = bx * P - 1; x <= bx * P + P; x++) {
                         const int cx = x < 0 ? 0 : x >= N ? N - 1 : x, cy = y < 0 ? 0 : y >= N ? N - 1 : y,
                                   cz = z < 0 ? 0 : z >= N ? N - 1 : z;
                         const uint16_t val = ch[cx + N * (cy + N * cz)];
@@ -334,13 +338,13 @@ static uint64_t expected_pool_bytes(const uint16_t *data, uint32_t count, uint32
  * weights, computed from pool coordinates instead of the volume's, round
  * differently: within DENSE_TOLERANCE. */
 #define DENSE_TOLERANCE 1e-5 /* measured: 2.2e-7 (2 channels), 3.1e-7 (6, lit) */
-static void check_storages(vxl_test_ctx *T_, const uint16_t *data, uint32_t count)
+static void check_storages(vxl_test_ctx *T_, const uint16_t *data, uint32_t count, uint32_t brick)
 {
     static float img[4][NPIX * 4];
     uint64_t bytes[4] = {0}, scalar[4] = {0};
     for (int k = 0; k < 4; k++) {
         fixture x;
-        REQUIRE(fixture_open(&x, data, count, g_storages[k]));
+        REQUIRE(fixture_open_bricks(&x, data, count, g_storages[k], brick));
         x.p.shading_off = 0;
         x.st[1].hidden = 1;
         REQUIRE(render(x.r, &x.p, img[k]) == VXL_OK);
@@ -352,16 +356,17 @@ static void check_storages(vxl_test_ctx *T_, const uint16_t *data, uint32_t coun
         fixture_close(&x);
     }
     const double d = max_diff(img[0], img[1], NPIX * 4);
-    fprintf(stderr, "    %u channels: paged against dense differ by at most %.3g\n", count, d);
+    fprintf(stderr, "    %u channels, bricks of %u: paged against dense differ by at most %.3g\n", count, brick, d);
     CHECKF(d <= DENSE_TOLERANCE, "%u channels: bricked differs from dense by %g", count, d);
     CHECKF(!memcmp(img[1], img[2], sizeof img[1]), "%u channels: sparse differs from bricked", count);
     CHECKF(!memcmp(img[1], img[3], sizeof img[1]), "%u channels: compressed differs from bricked", count);
     uint32_t varying, constant;
-    const uint64_t pools = expected_pool_bytes(data, count, &varying, &constant);
-    fprintf(stderr, "    %u channels of %d^3: dense %llu bytes; paged (bricks of %d) %llu bytes: %u varying bricks and "
+    const uint64_t pools = expected_pool_bytes(data, count, (int)brick, &varying, &constant);
+    const int grid = (N + (int)brick - 1) / (int)brick;
+    fprintf(stderr, "    %u channels of %d^3: dense %llu bytes; paged (bricks of %u) %llu bytes: %u varying bricks and "
                     "%u constant slots of %d\n",
-            count, N, (unsigned long long)bytes[0], PAGE_BRICK, (unsigned long long)bytes[1], varying, constant,
-            ((N + PAGE_BRICK - 1) / PAGE_BRICK) * ((N + PAGE_BRICK - 1) / PAGE_BRICK) * ((N + PAGE_BRICK - 1) / PAGE_BRICK));
+            count, N, (unsigned long long)bytes[0], brick, (unsigned long long)bytes[1], varying, constant,
+            grid * grid * grid);
     fprintf(stderr, "    the scalar beside them: dense %llu, bricked %llu, sparse %llu, compressed %llu bytes\n",
             (unsigned long long)scalar[0], (unsigned long long)scalar[1], (unsigned long long)scalar[2],
             (unsigned long long)scalar[3]);
@@ -374,8 +379,9 @@ static void check_storages(vxl_test_ctx *T_, const uint16_t *data, uint32_t coun
 
 TEST(every_storage_draws_the_same_channels)
 {
-    check_storages(T_, g_two, 2);
-    check_storages(T_, g_six, 6); /* two groups, two pools */
+    check_storages(T_, g_two, 2, PAGE_BRICK);
+    check_storages(T_, g_six, 6, PAGE_BRICK); /* two groups, two pools */
+    check_storages(T_, g_six, 6, 16);         /* 24 = 16 + 8: the last brick of each axis reaches past the volume */
 }
 
 /* The channels' pools are charged with the scalar's pool to one budget:

@@ -92,8 +92,9 @@ int vxl_channel_pages_plan(vxl_channel_pages *cp, const vxl_volume *v, uint32_t 
     pg->data_index = malloc(n * sizeof *pg->data_index);
     uint8_t *varies = malloc(n);
     uint16_t *codes = malloc(n * nc * sizeof *codes);
-    int rc = pg->data_index && varies && codes ? VXL_OK
-                                                : vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the channels' page table");
+    int rc = VXL_OK;
+    if (!pg->data_index || !varies || !codes)
+        rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the channels' page table");
     if (!rc) rc = find_constants(pg, v, varies, codes, e);
     if (!rc) rc = assign_slots(cp, nc, varies, codes, e);
     free(varies);
@@ -101,7 +102,8 @@ int vxl_channel_pages_plan(vxl_channel_pages *cp, const vxl_volume *v, uint32_t 
     const uint64_t edge = vxl_page_edge(pg);
     if (!rc && !vxl_pool_layout(st, pg->n_data, (uint32_t)edge, cp->slots))
         rc = vxl_fail(e, VXL_ERR_LIMIT,
-                      "the channels' %u bricks of %u^3 voxels do not fit a pool texture within the 3D texture limit of %d",
+                      "the channels' %u bricks of %u^3 voxels do not fit a pool texture within the 3D texture "
+                      "limit of %d",
                       pg->n_data, (uint32_t)edge, st->gpu->info.max_3d_texture_size);
     if (rc) {
         vxl_channel_pages_free(cp);
@@ -133,7 +135,8 @@ static void fill_pool(const vxl_channel_pages *cp, const vxl_volume *v, vxl_gl *
         if (pg->data_index[i] >= (int32_t)cp->varying) continue;
         const uint32_t b[3] = {(uint32_t)(i % pg->grid[0]), (uint32_t)(i / pg->grid[0] % pg->grid[1]),
                                (uint32_t)(i / ((uint64_t)pg->grid[0] * pg->grid[1]))};
-        vxl_pages_copy_brick(vxl_channel_group(v, grp), v->dims, w * VXL_CHANNEL_BYTES, pg->brick, b, (uint8_t *)scratch);
+        vxl_pages_copy_brick(vxl_channel_group(v, grp), v->dims, w * VXL_CHANNEL_BYTES, pg->brick, b,
+                             (uint8_t *)scratch);
         put_slot(gl, cp, (uint32_t)pg->data_index[i], w, scratch);
     }
     const size_t voxels = (size_t)e * e * e;

@@ -119,20 +119,22 @@ int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, vxl_channel_pla
     }
     s->groups = vxl_channel_groups(v);
     int rc = VXL_OK;
-    if (plan->pages.layout.brick) {
+    if (plan->pages.layout.brick) { /* paged: pools behind one page table */
         rc = vxl_channel_pages_upload(&plan->pages, v, s->storage, s->tex, &s->page_tex);
         const uint32_t e = vxl_page_edge(&plan->pages.layout);
         for (int a = 0; a < 3; a++) s->pool_dims[a] = plan->pages.slots[a] * e;
-    }
-    gl->GetError();
-    for (uint32_t grp = 0; grp < s->groups && !rc && !plan->pages.layout.brick; grp++) {
-        const uint32_t w = vxl_channel_group_width(v, grp);
-        /* filtered as the scalar is: trilinear between voxel centres */
-        s->tex[grp] = vxl_texture_new(g, GL_TEXTURE_3D, GL_LINEAR);
-        gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)vxl_channel_group_format(w), (GLsizei)v->dims[0], (GLsizei)v->dims[1],
-                       (GLsizei)v->dims[2], 0, vxl_channel_group_layout(w), GL_UNSIGNED_SHORT, vxl_channel_group(v, grp));
-        rc = vxl_gl_check(g, "uploading a multi-channel volume's channels");
+    } else {
+        gl->GetError();
+        for (uint32_t grp = 0; grp < s->groups && !rc; grp++) {
+            const uint32_t w = vxl_channel_group_width(v, grp);
+            /* filtered as the scalar is: trilinear between voxel centres */
+            s->tex[grp] = vxl_texture_new(g, GL_TEXTURE_3D, GL_LINEAR);
+            gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+            gl->TexImage3D(GL_TEXTURE_3D, 0, (GLint)vxl_channel_group_format(w), (GLsizei)v->dims[0],
+                           (GLsizei)v->dims[1], (GLsizei)v->dims[2], 0, vxl_channel_group_layout(w), GL_UNSIGNED_SHORT,
+                           vxl_channel_group(v, grp));
+            rc = vxl_gl_check(g, "uploading a multi-channel volume's channels");
+        }
     }
     if (rc) {
         vxl_channels_release(s);

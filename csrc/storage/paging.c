@@ -139,7 +139,8 @@ int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl
         double mn = 1e300, mx = -1e300;
         for (uint32_t z = lo[2]; z <= hi[2]; z++)
             for (uint32_t y = lo[1]; y <= hi[1]; y++)
-                row_range(v->texels, v->texture_bits, lo[0] + (size_t)v->dims[0] * (y + (size_t)v->dims[1] * z), hi[0] - lo[0] + 1, &mn, &mx);
+                row_range(v->texels, v->texture_bits, lo[0] + (size_t)v->dims[0] * (y + (size_t)v->dims[1] * z),
+                          hi[0] - lo[0] + 1, &mn, &mx);
         b->minmax[2 * i] = (float)mn;
         b->minmax[2 * i + 1] = (float)mx;
     }

@@ -40,7 +40,8 @@ int vxl_channel_alone(const vxl_volume *v, uint32_t c, vxl_volume *one, vxl_err 
     one->texture_bits = 16;
     one->storage_bytes = n * VXL_CHANNEL_BYTES;
     uint16_t *t = malloc((size_t)(n ? n * VXL_CHANNEL_BYTES : 1));
-    if (!t) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for channel %u alone (%.1f MiB)", c, n * 2 / 1048576.0);
+    if (!t)
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for channel %u alone (%.1f MiB)", c, n * 2 / 1048576.0);
     const uint32_t g = c / VXL_CHANNELS_PER_GROUP, w = vxl_channel_group_width(v, g);
     const uint16_t *src = vxl_channel_group(v, g) + c % VXL_CHANNELS_PER_GROUP;
     for (uint64_t i = 0; i < n; i++) t[i] = src[i * w];

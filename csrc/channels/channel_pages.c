@@ -13,6 +13,8 @@ void vxl_channel_pages_free(vxl_channel_pages *cp)
 {
     vxl_pages_free(&cp->layout);
     free(cp->constants);
+    free(cp->varies);
+    free(cp->low);
     memset(cp, 0, sizeof *cp);
 }
 
@@ -41,15 +43,18 @@ static int find_constants(const vxl_pages *layout, const vxl_volume *v, uint8_t 
     return VXL_OK;
 }
 
-/* Slots: the varying bricks first, in brick order, then one per distinct
- * tuple of constants (an open-addressed table of the first brick of each). */
-static int assign_slots(vxl_channel_pages *cp, uint32_t nc, const uint8_t *varies, const uint16_t *codes, vxl_err *e)
+/* Slots: the bricks marked in own[] first, in brick order, then one per
+ * distinct tuple of the others' minima (an open-addressed table of the
+ * first brick of each): a constant brick's minima are its constants. */
+static int assign_slots(vxl_channel_pages *cp, uint32_t nc, const uint8_t *own, vxl_err *e)
 {
     const uint64_t n = vxl_page_count(&cp->layout);
+    const uint16_t *codes = cp->low;
     int32_t *slot = cp->layout.data_index;
     uint32_t varying = 0, distinct = 0;
+    free(cp->constants);
     for (uint64_t i = 0; i < n; i++)
-        if (varies[i]) slot[i] = (int32_t)varying++;
+        if (own[i]) slot[i] = (int32_t)varying++;
     uint64_t cap = 16;
     while (cap < 2 * (n - varying)) cap *= 2;
     int64_t *first = malloc(cap * sizeof *first);
@@ -61,7 +66,7 @@ static int assign_slots(vxl_channel_pages *cp, uint32_t nc, const uint8_t *varie
     for (uint64_t k = 0; k < cap; k++) first[k] = -1;
     const size_t tuple = nc * sizeof *codes;
     for (uint64_t i = 0; i < n; i++) {
-        if (varies[i]) continue;
+        if (own[i]) continue;
         const uint16_t *t = codes + i * nc;
         uint64_t h = vxl_fnv(0xcbf29ce484222325ull, t, tuple) & (cap - 1);
         while (first[h] >= 0 && memcmp(codes + (uint64_t)first[h] * nc, t, tuple)) h = (h + 1) & (cap - 1);
@@ -79,7 +84,27 @@ static int assign_slots(vxl_channel_pages *cp, uint32_t nc, const uint8_t *varie
     return VXL_OK;
 }
 
-int vxl_channel_pages_plan(vxl_channel_pages *cp, const vxl_volume *v, uint32_t brick, const vxl_storage_state *st)
+/* Slots for the bricks marked in own[] and the shared constant slots, laid
+ * out within st's texture limit, and their bytes. */
+static int lay_out(vxl_channel_pages *cp, uint32_t nc, const uint8_t *own, const vxl_storage_state *st)
+{
+    vxl_err *e = &st->gpu->err;
+    const vxl_pages *pg = &cp->layout;
+    int rc = assign_slots(cp, nc, own, e);
+    const uint64_t edge = vxl_page_edge(pg);
+    if (!rc && !vxl_pool_layout(st, pg->n_data, (uint32_t)edge, cp->slots))
+        rc = vxl_fail(e, VXL_ERR_LIMIT,
+                      "the channels' %u bricks of %u^3 voxels do not fit a pool texture within the 3D texture "
+                      "limit of %d",
+                      pg->n_data, (uint32_t)edge, st->gpu->info.max_3d_texture_size);
+    if (rc) return rc;
+    const uint64_t texels = (uint64_t)cp->slots[0] * cp->slots[1] * cp->slots[2] * edge * edge * edge;
+    cp->bytes = texels * nc * VXL_CHANNEL_BYTES + vxl_page_count(pg) * 4 * sizeof(float);
+    return VXL_OK;
+}
+
+int vxl_channel_pages_plan(vxl_channel_pages *cp, const vxl_volume *v, uint32_t brick, int sparse,
+                           const vxl_storage_state *st)
 {
     vxl_err *e = &st->gpu->err;
     memset(cp, 0, sizeof *cp);
@@ -90,28 +115,28 @@ int vxl_channel_pages_plan(vxl_channel_pages *cp, const vxl_volume *v, uint32_t 
     const uint64_t n = vxl_page_count(pg);
     const uint32_t nc = v->channel_count;
     pg->data_index = malloc(n * sizeof *pg->data_index);
-    uint8_t *varies = malloc(n);
-    uint16_t *codes = malloc(n * nc * sizeof *codes);
+    cp->varies = malloc(n);
+    cp->low = malloc(n * nc * sizeof *cp->low);
+    uint8_t *none = calloc(n, 1);
     int rc = VXL_OK;
-    if (!pg->data_index || !varies || !codes)
+    if (!pg->data_index || !cp->varies || !cp->low || !none)
         rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the channels' page table");
-    if (!rc) rc = find_constants(pg, v, varies, codes, e);
-    if (!rc) rc = assign_slots(cp, nc, varies, codes, e);
-    free(varies);
-    free(codes);
-    const uint64_t edge = vxl_page_edge(pg);
-    if (!rc && !vxl_pool_layout(st, pg->n_data, (uint32_t)edge, cp->slots))
-        rc = vxl_fail(e, VXL_ERR_LIMIT,
-                      "the channels' %u bricks of %u^3 voxels do not fit a pool texture within the 3D texture "
-                      "limit of %d",
-                      pg->n_data, (uint32_t)edge, st->gpu->info.max_3d_texture_size);
-    if (rc) {
-        vxl_channel_pages_free(cp);
-        return rc;
-    }
-    const uint64_t texels = (uint64_t)cp->slots[0] * cp->slots[1] * cp->slots[2] * edge * edge * edge;
-    cp->bytes = texels * nc * VXL_CHANNEL_BYTES + n * 4 * sizeof(float);
-    return VXL_OK;
+    if (!rc) rc = find_constants(pg, v, cp->varies, cp->low, e);
+    /* sparse: nothing of its own until a frame says what it can see */
+    if (!rc) rc = lay_out(cp, nc, sparse ? none : cp->varies, st);
+    free(none);
+    if (rc) vxl_channel_pages_free(cp);
+    return rc;
+}
+
+int vxl_channel_pages_resident(vxl_channel_pages *cp, uint32_t channels, const uint8_t *need,
+                               const vxl_storage_state *st, int force, int *changed)
+{
+    const uint64_t n = vxl_page_count(&cp->layout);
+    *changed = force;
+    for (uint64_t i = 0; i < n && !*changed; i++)
+        *changed = need[i] && cp->layout.data_index[i] >= (int32_t)cp->varying;
+    return *changed ? lay_out(cp, channels, need, st) : VXL_OK;
 }
 
 /* Writes one brick of w channels into slot k of the pool bound on the scratch unit. */

@@ -11,10 +11,12 @@
  * brick of the same constants (a background: one slot for all of it). So
  * every brick is resident in every paged mode: the scalar's "w = the
  * brick's one value" entry cannot stand for up to eight channels, and a
- * constant slot costs one brick per distinct background. Which bricks a
- * classification needs does not shrink the pools (sparse storage pages the
- * scalar by visibility, the channels by constancy), and compressed storage
- * keeps them uncompressed: its codec is one palette of one scalar per brick.
+ * constant slot costs one brick per distinct background. Sparse storage
+ * gives a slot only to the varying bricks the drawn channels' tables can
+ * see (within the gradient taps' reach), as it pages the scalar; a brick
+ * they cannot see reads its channels' minima from a shared slot, which
+ * those tables make transparent. Compressed storage keeps the groups
+ * uncompressed: its codec is one palette of one scalar per brick.
  * CPU side only until vxl_channel_pages_upload. */
 #ifndef VXL_CHANNEL_PAGES_H
 #define VXL_CHANNEL_PAGES_H
@@ -40,15 +42,26 @@ static inline GLenum vxl_channel_group_layout(uint32_t w)
 
 typedef struct vxl_channel_pages {
     vxl_pages layout;    /* brick, grid; data_index[i] = brick i's slot; n_data = slots in use */
-    uint32_t varying;    /* slots 0..varying-1: the bricks where a channel varies, in brick order */
-    uint16_t *constants; /* slot varying + k: channel_count codes of the k-th distinct constant brick */
+    uint32_t varying;    /* slots 0..varying-1: bricks with data of their own, in brick order */
+    uint16_t *constants; /* slot varying + k: channel_count codes of the k-th distinct tuple of minima */
     uint32_t slots[3];   /* the pools' slot layout (each group's pool the same) */
     uint64_t bytes;      /* the pools and the page table on the GL side */
+    uint8_t *varies;     /* per brick: some channel varies over it (ghost included) */
+    uint16_t *low;       /* per brick, channel_count codes: each channel's minimum there */
 } vxl_channel_pages;
 
 /* Cuts v's channels into page bricks of `brick` voxels and lays out the
- * slots within st's texture limit (VXL_ERR_LIMIT when they cannot fit). */
-int vxl_channel_pages_plan(vxl_channel_pages *cp, const vxl_volume *v, uint32_t brick, const vxl_storage_state *st);
+ * slots within st's texture limit (VXL_ERR_LIMIT when they cannot fit):
+ * every varying brick has its own slot, or (sparse) none yet. */
+int vxl_channel_pages_plan(vxl_channel_pages *cp, const vxl_volume *v, uint32_t brick, int sparse,
+                           const vxl_storage_state *st);
+/* Sparse: when need[] (varying bricks a frame can read) marks a brick
+ * without a slot of its own, lays the slots out anew for exactly need[]
+ * (every other brick on the slot of its channels' minima, which the frame's
+ * tables make transparent) and sets *changed (force: in any case);
+ * nothing is uploaded. */
+int vxl_channel_pages_resident(vxl_channel_pages *cp, uint32_t channels, const uint8_t *need,
+                               const vxl_storage_state *st, int force, int *changed);
 /* Uploads group g's pool into pools[g] (R16..RGBA16 by its width) for
  * every group of v, and the page table into *page_tex. */
 int vxl_channel_pages_upload(const vxl_channel_pages *cp, const vxl_volume *v, vxl_storage_state *st, GLuint *pools,

@@ -1,6 +1,7 @@
 /* channels.c - a multi-channel volume's channels on the GL side (channels.h). */
 #include "channels.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,6 +35,8 @@ void vxl_channels_release(vxl_channels_state *s)
     }
     delete_tex(s->gpu, &s->distance_tex);
     delete_tex(s->gpu, &s->page_tex);
+    vxl_channel_pages_free(&s->pages);
+    free(s->kept.channels);
     vxl_gpu *g = s->gpu;
     vxl_storage_state *storage = s->storage;
     const uint64_t uploads = s->uploads;
@@ -76,7 +79,8 @@ int vxl_channels_plan(vxl_channels_state *s, const vxl_volume *v, const vxl_stor
     int rc = VXL_OK;
     for (uint32_t c = 0; c < v->channel_count && !rc; c++) rc = channel_minmax(g, v, c, &out->bricks[c]);
     /* paged: the scalar's page bricks (every level has the same brick size) */
-    if (!rc && !dense) rc = vxl_channel_pages_plan(&out->pages, v, sp->levels[0].brick, s->storage);
+    if (!rc && !dense)
+        rc = vxl_channel_pages_plan(&out->pages, v, sp->levels[0].brick, sp->mode == VXL_STORAGE_SPARSE, s->storage);
     if (rc) {
         vxl_channel_plan_free(out);
         return rc;
@@ -101,6 +105,31 @@ int vxl_channels_plan(vxl_channels_state *s, const vxl_volume *v, const vxl_stor
     return rc;
 }
 
+/* The pools and page table of cp, replacing what is on the GL side. */
+static int upload_pools(vxl_channels_state *s, const vxl_channel_pages *cp, const vxl_volume *v)
+{
+    for (uint32_t g = 0; g < VXL_CHANNEL_GROUPS_MAX; g++) delete_tex(s->gpu, &s->tex[g]);
+    delete_tex(s->gpu, &s->page_tex);
+    const uint32_t e = vxl_page_edge(&cp->layout);
+    for (int a = 0; a < 3; a++) s->pool_dims[a] = cp->slots[a] * e;
+    return vxl_channel_pages_upload(cp, v, s->storage, s->tex, &s->page_tex);
+}
+
+/* Sparse: takes the plan's pages and copies the channels, so frames can
+ * re-page them after the caller lets go of v. */
+static int keep_for_paging(vxl_channels_state *s, vxl_channel_plan *plan, const vxl_volume *v)
+{
+    const uint64_t bytes = vxl_volume_channel_bytes(v);
+    if (!(s->kept.channels = malloc(bytes ? bytes : 1)))
+        return vxl_fail(&s->gpu->err, VXL_ERR_NO_MEMORY, "out of memory keeping the channels for sparse storage");
+    memcpy(s->kept.channels, v->channels, bytes);
+    memcpy(s->kept.dims, v->dims, sizeof s->kept.dims);
+    s->kept.channel_count = v->channel_count;
+    s->pages = plan->pages; /* taken */
+    memset(&plan->pages, 0, sizeof plan->pages);
+    return VXL_OK;
+}
+
 int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, vxl_channel_plan *plan)
 {
     vxl_channels_release(s);
@@ -120,9 +149,8 @@ int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, vxl_channel_pla
     s->groups = vxl_channel_groups(v);
     int rc = VXL_OK;
     if (plan->pages.layout.brick) { /* paged: pools behind one page table */
-        rc = vxl_channel_pages_upload(&plan->pages, v, s->storage, s->tex, &s->page_tex);
-        const uint32_t e = vxl_page_edge(&plan->pages.layout);
-        for (int a = 0; a < 3; a++) s->pool_dims[a] = plan->pages.slots[a] * e;
+        rc = upload_pools(s, &plan->pages, v);
+        if (!rc && s->storage->mode == VXL_STORAGE_SPARSE) rc = keep_for_paging(s, plan, v);
     } else {
         gl->GetError();
         for (uint32_t grp = 0; grp < s->groups && !rc; grp++) {
@@ -189,9 +217,9 @@ static int ensure_tf(vxl_channels_state *s, const vxl_frame_channel *ch)
     return rc;
 }
 
-/* The drawn channels' union occupancy as one distance map, when a drawn
- * channel's classification or the drawn set changed. */
-static int ensure_distance(vxl_channels_state *s, const vxl_frame *f)
+/* Classifies each drawn channel's skipping bricks under its table (cached
+ * by its key) and gives the key of the drawn set and their classifications. */
+static int classify_drawn(vxl_channels_state *s, const vxl_frame *f, uint64_t *drawn_key)
 {
     vxl_gpu *g = s->gpu;
     uint64_t key = 0xcbf29ce484222325ull;
@@ -210,21 +238,40 @@ static int ensure_distance(vxl_channels_state *s, const vxl_frame *f)
         const uint64_t part[2] = {ch->channel, s->bricks[ch->channel].tf_key};
         key = vxl_fnv(key, part, sizeof part);
     }
-    if (s->distance_tex && s->distance_key == key) return VXL_OK;
+    *drawn_key = key;
+    return VXL_OK;
+}
+
+/* The drawn channels' union occupancy (after classify_drawn) into d, one
+ * byte a skipping brick: 0 occupied by some drawn channel, 255 empty. */
+static void drawn_occupancy(const vxl_channels_state *s, const vxl_frame *f, uint8_t *d)
+{
     const vxl_bricks *b0 = &s->bricks[0];
     const size_t n = (size_t)b0->dims[0] * b0->dims[1] * b0->dims[2];
-    int rc = VXL_OK;
-    if (!s->distance_tex &&
-        (rc = vxl_holdings_ask(g, VXL_HOLD_CHANNELS, s->bytes + n, NULL, "the channels' brick distance map")))
-        return rc;
-    uint8_t *d = malloc(n ? n : 1);
-    if (!d) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the channels' brick distance map");
     memset(d, 255, n);
     for (uint32_t k = 0; k < f->channels.count; k++) {
         const uint8_t *dc = s->bricks[f->channels.ch[k].channel].distance;
         for (size_t i = 0; i < n; i++)
             if (dc[i] == 0) d[i] = 0;
     }
+}
+
+/* The drawn channels' union occupancy as one distance map, when a drawn
+ * channel's classification or the drawn set changed. */
+static int ensure_distance(vxl_channels_state *s, const vxl_frame *f)
+{
+    vxl_gpu *g = s->gpu;
+    uint64_t key;
+    int rc = classify_drawn(s, f, &key);
+    if (rc || (s->distance_tex && s->distance_key == key)) return rc;
+    const vxl_bricks *b0 = &s->bricks[0];
+    const size_t n = (size_t)b0->dims[0] * b0->dims[1] * b0->dims[2];
+    if (!s->distance_tex &&
+        (rc = vxl_holdings_ask(g, VXL_HOLD_CHANNELS, s->bytes + n, NULL, "the channels' brick distance map")))
+        return rc;
+    uint8_t *d = malloc(n ? n : 1);
+    if (!d) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the channels' brick distance map");
+    drawn_occupancy(s, f, d);
     uint32_t occupied = 0;
     for (size_t i = 0; i < n; i++) occupied += d[i] == 0;
     if (vxl_bricks_chebyshev(d, b0->dims) < 0) {
@@ -256,6 +303,44 @@ static int ensure_distance(vxl_channels_state *s, const vxl_frame *f)
     return VXL_OK;
 }
 
+/* Sparse storage: every varying brick the drawn channels' tables can see,
+ * within the gradient taps' reach, gets a slot of its own (the pools are
+ * laid out and uploaded anew when one lacks it), as the scalar's sparse
+ * pool follows its classification; the budget is asked first. */
+static int page_visible(vxl_channels_state *s, const vxl_frame *f)
+{
+    if (!s->kept.channels) return VXL_OK; /* not sparse */
+    vxl_gpu *g = s->gpu;
+    uint64_t key;
+    int rc = classify_drawn(s, f, &key);
+    if (rc) return rc;
+    const vxl_bricks *b0 = &s->bricks[0];
+    const size_t nb = (size_t)b0->dims[0] * b0->dims[1] * b0->dims[2];
+    const uint64_t np = vxl_page_count(&s->pages.layout);
+    uint8_t *occ = malloc(nb + np), *need = occ + nb;
+    if (!occ) return vxl_fail(&g->err, VXL_ERR_NO_MEMORY, "out of memory for the channels' visible bricks");
+    drawn_occupancy(s, f, occ);
+    vxl_bricks union_grid = *b0; /* a view: the drawn channels' occupancy on the skipping grid */
+    union_grid.distance = occ;
+    const uint32_t reach = (uint32_t)ceilf(f->sample_distance) + 1; /* gradient taps and their trilinear footprint */
+    vxl_pages_needed(&s->pages.layout, &union_grid, reach, 1, 0, s->pages.varies, need);
+    int changed;
+    rc = vxl_channel_pages_resident(&s->pages, s->count, need, s->storage, s->stale, &changed);
+    free(occ);
+    if (rc || !changed) return rc;
+    rc = vxl_holdings_ask(g, VXL_HOLD_CHANNELS, s->bytes - s->volume_bytes + s->pages.bytes, NULL,
+                          "the %u channels' visible bricks", s->count);
+    if (!rc) rc = upload_pools(s, &s->pages, &s->kept);
+    s->stale = rc != VXL_OK; /* the pools no longer match the pages: the next frame lays them out again */
+    if (rc) {
+        for (uint32_t grp = 0; grp < VXL_CHANNEL_GROUPS_MAX; grp++) delete_tex(g, &s->tex[grp]);
+        delete_tex(g, &s->page_tex);
+    }
+    s->volume_bytes = rc ? 0 : s->pages.bytes;
+    recount(s);
+    return rc;
+}
+
 static GLint loc_k(vxl_gl *gl, GLuint prog, const char *name, uint32_t k)
 {
     char buf[64];
@@ -269,6 +354,7 @@ int vxl_channels_prepare(vxl_channels_state *s, const vxl_frame *f, GLuint prog)
     int rc;
     for (uint32_t k = 0; k < f->channels.count; k++)
         if ((rc = ensure_tf(s, &f->channels.ch[k]))) return rc;
+    if ((rc = page_visible(s, f))) return rc;
     if (f->skip && (rc = ensure_distance(s, f))) return rc;
     vxl_gl *gl = &s->gpu->gl;
     for (uint32_t grp = 0; grp < s->groups; grp++) {

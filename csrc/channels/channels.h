@@ -43,6 +43,12 @@ typedef struct vxl_channels_state {
     GLuint tex[VXL_CHANNEL_GROUPS_MAX];     /* group g (channels 4g..): its texture, or (paged) its pool */
     GLuint page_tex;                        /* paged: the page table every group's pool shares; 0 dense */
     uint32_t pool_dims[3];                  /* paged: each pool's size in texels */
+    /* Sparse storage: the pages, re-laid out when a frame can see a brick
+     * without its own slot, and the channels kept on the CPU to fill them
+     * (a volume of the set one's dims and channel count, its own copy). */
+    vxl_channel_pages pages;
+    vxl_volume kept;
+    int stale;                              /* the pools failed to follow the pages: lay them out anew */
     GLuint tf_tex[VXL_MAX_CHANNELS];        /* channel c's table of the last frame that drew it */
     uint64_t tf_key[VXL_MAX_CHANNELS];
     uint64_t tf_entry_bytes[VXL_MAX_CHANNELS];

@@ -1,15 +1,19 @@
 /* test_channels.c - multi-channel volumes (docs/channels.md;
  * csrc/volume/channel_volume.c, csrc/frame/frame_channels.c,
- * csrc/channels/channels.c, shaders/lib/channels.glsl): channels with
- * disjoint blobs, where hiding one removes exactly its blob and solo shows
- * only one; additive blending equals the sum of the channels drawn one at a
- * time, lit and unlit, with two texture groups (six channels); a channel's
- * window changes only its own pixels; skipping over the union changes
- * nothing; a clip plane cuts every channel; the scalar is the chosen
- * channel, bit for bit a one-channel volume; what cannot go with channels
- * is refused with a message; NIfTI
- * 5D (dim[5] channels, dim[4] frames) and NRRD channel axes load as
- * channels by the channels mode and render as the same voxels in memory. */
+ * csrc/channels/channels.c, csrc/channels/channel_pages.c,
+ * shaders/lib/channels.glsl): channels with disjoint blobs, where hiding
+ * one removes exactly its blob and solo shows only one, in every storage
+ * mode; every storage mode draws the same image (paged pools against dense
+ * textures), with the GL bytes worked out here; sparse storage pages only
+ * what the drawn channels can see and pages in a channel shown; the budget
+ * refuses the pools before allocating; additive blending equals the sum of
+ * the channels drawn one at a time, lit and unlit, with two texture groups
+ * (six channels); a channel's window changes only its own pixels; skipping
+ * over the union changes nothing; a clip plane cuts every channel; the
+ * scalar is the chosen channel, bit for bit a one-channel volume; what
+ * cannot go with channels is refused with a message; NIfTI 5D (dim[5]
+ * channels, dim[4] frames) and NRRD channel axes load as channels by the
+ * channels mode and render as the same voxels in memory. */
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
@@ -262,23 +266,30 @@ TEST(a_channels_window_changes_only_that_channel)
     fixture_close(&x);
 }
 
+/* The six small balls (g_sparse) drawn lit, channel 2 hidden, through a
+ * table transparent over its first half: the background is empty (the
+ * occupancy rule widens by entries around a brick's range, so a ramp from
+ * 0 would occupy every brick). */
+static int open_six_balls(fixture *x, uint32_t storage)
+{
+    static const float tf[8 * 4] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+                                    1, 1, 1, 0.3f, 1, 1, 1, 0.4f, 1, 1, 1, 0.5f, 1, 1, 1, 0.6f};
+    if (!fixture_open(x, g_sparse, 6, storage)) return 0;
+    x->st[2].hidden = 1;
+    for (int c = 0; c < 6; c++) {
+        x->st[c].tf_rgba = tf;
+        x->st[c].tf_size = 8;
+    }
+    x->p.shading_off = 0;
+    return 1;
+}
+
 /* The image (into out) and the channels' GL bytes (*bytes) of the six
- * small balls, one hidden, skipping checked against no skipping. */
+ * small balls, skipping checked against no skipping. */
 static void check_skipping(vxl_test_ctx *T_, uint32_t storage, float *out, uint64_t *bytes)
 {
     fixture x;
-    REQUIRE(fixture_open(&x, g_sparse, 6, storage));
-    x.st[2].hidden = 1;
-    /* a table transparent over its first half: the background is empty
-     * (the occupancy rule widens by entries around a brick's range, so a
-     * ramp from 0 would occupy every brick) */
-    static const float tf[8 * 4] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
-                                    1, 1, 1, 0.3f, 1, 1, 1, 0.4f, 1, 1, 1, 0.5f, 1, 1, 1, 0.6f};
-    for (int c = 0; c < 6; c++) {
-        x.st[c].tf_rgba = tf;
-        x.st[c].tf_size = 8;
-    }
-    x.p.shading_off = 0;
+    REQUIRE(open_six_balls(&x, storage));
     REQUIRE(render(x.r, &x.p, A) == VXL_OK);
     vxl_render_stats s1 = renderer_stats(x.r);
     x.p.no_skip = 1;
@@ -310,6 +321,30 @@ TEST(skipping_over_the_union_changes_nothing)
     CHECKF(d <= DENSE_TOLERANCE, "sparse differs from bricked by %g", d);
     CHECKF(bytes[2] < bytes[1], "sparse holds %llu bytes of channels, bricked %llu", (unsigned long long)bytes[2],
            (unsigned long long)bytes[1]);
+}
+
+/* Sparse storage's pools follow what is drawn: showing the hidden channel
+ * pages its ball's brick in (the pools grow by that slot) and the image is
+ * bricked storage's, before and after, within DENSE_TOLERANCE. */
+TEST(sparse_storage_pages_in_a_channel_shown)
+{
+    fixture b, sp;
+    REQUIRE(open_six_balls(&b, VXL_STORAGE_BRICKED) && open_six_balls(&sp, VXL_STORAGE_SPARSE));
+    uint64_t bytes[2];
+    for (int shown = 0; shown < 2; shown++) {
+        b.st[2].hidden = sp.st[2].hidden = !shown;
+        REQUIRE(render(b.r, &b.p, A) == VXL_OK && render(sp.r, &sp.p, B) == VXL_OK);
+        bytes[shown] = renderer_stats(sp.r).channel_bytes;
+        const double d = max_diff(A, B, NPIX * 4);
+        CHECKF(d <= DENSE_TOLERANCE, "channel 2 %s: sparse differs from bricked by %g", shown ? "shown" : "hidden", d);
+        CHECK(alpha_sum(B, NPIX) > 1);
+    }
+    /* one slot more: (P + 2)^3 texels of 6 channels of 2 bytes */
+    CHECKF(bytes[1] == bytes[0] + 10 * 10 * 10 * 6 * 2, "sparse channel bytes hidden %llu, shown %llu",
+           (unsigned long long)bytes[0], (unsigned long long)bytes[1]);
+    CHECKF(bytes[1] == renderer_stats(b.r).channel_bytes, "shown: every ball's brick, as bricked");
+    fixture_close(&b);
+    fixture_close(&sp);
 }
 
 /* What the paged modes should hold for `count` planar channels of N^3 in
@@ -696,6 +731,7 @@ int main(void)
     RUN(max_blend_takes_the_dominant_channel);
     RUN(the_scalar_is_the_chosen_channel);
     RUN(every_storage_draws_the_same_channels);
+    RUN(sparse_storage_pages_in_a_channel_shown);
     RUN(the_budget_refuses_channel_pools_before_allocating);
     RUN(what_cannot_go_with_channels_is_refused);
     RUN(interleaved_and_planar_layouts_agree);

@@ -5,7 +5,8 @@
  * (shaders/lib/channels.glsl). Stored as the scalar is: dense storage holds
  * each group as one 3D texture; the paged modes (bricked, sparse,
  * compressed) hold each group as a pool of the scalar's page bricks behind
- * one page table (channel_pages.h). Beside them, per channel, the brick
+ * one page table (channel_pages.h); sparse storage gives a brick its own
+ * slot only when a frame's drawn channels can see it. Beside them, per channel, the brick
  * min-max grid (CPU, planned with the volume) and, per frame, its transfer
  * function texture; the drawn channels' occupancies are joined into one
  * distance map (empty-space skipping over the union), re-derived only when
@@ -78,7 +79,8 @@ int vxl_channels_set(vxl_channels_state *s, const vxl_volume *v, vxl_channel_pla
  * *flags: VXL_ERR_STATE when f draws channels of a volume without them or
  * names a channel it does not have. */
 int vxl_channels_flags(const vxl_channels_state *s, const vxl_frame *f, uint32_t *flags);
-/* Uploads what f's channels need (tables, the union map when f->skip),
+/* Uploads what f's channels need (tables, in sparse storage the bricks the
+ * drawn channels can see, the union map when f->skip),
  * binds the textures and sets prog's channel uniforms. Nothing when f draws
  * no channels. */
 int vxl_channels_prepare(vxl_channels_state *s, const vxl_frame *f, GLuint prog);

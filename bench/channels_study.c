@@ -10,9 +10,12 @@
  *     before multi-channel volumes,
  * emission only and lit, empty-space skipping on. Prints the median frame
  * time, its ratio to one channel and each image's alpha sum (a frame that
- * draws nothing would be cheap and wrong). The times mean nothing on a
- * loaded machine. Command:
- *   make -j1 build/voxlight-channelsbench && ./build/voxlight-channelsbench [--size 512] [--frames 5] [--dims 512x512x128] */
+ * draws nothing would be cheap and wrong), and the GL memory of the scalar
+ * and of the channels in the storage mode asked for (--storage, dense by
+ * default; the paged modes page the channels too). The times mean nothing
+ * on a loaded machine; the bytes are the same on any. Command:
+ *   make -j1 build/voxlight-channelsbench && ./build/voxlight-channelsbench [--size 512] [--frames 5] [--dims 512x512x128]
+ *       [--storage dense|bricked|sparse|compressed] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,8 +40,8 @@ static uint16_t voxel(uint32_t c, uint32_t x, uint32_t y, uint32_t z, const uint
     return (uint16_t)(300 + (f > 0 ? (20000.0 + 8000.0 * c) * f : 0));
 }
 
-/* --size S --frames F --dims XxYxZ; 0 on anything else or out of range. */
-static int parse_args(int argc, char **argv, uint32_t *size, int *frames, uint32_t d[3])
+/* --size S --frames F --dims XxYxZ --storage NAME; 0 on anything else or out of range. */
+static int parse_args(int argc, char **argv, uint32_t *size, int *frames, uint32_t d[3], uint32_t *storage)
 {
     for (int i = 1; i < argc; i++) {
         const int has_value = i + 1 < argc;
@@ -46,6 +49,8 @@ static int parse_args(int argc, char **argv, uint32_t *size, int *frames, uint32
         else if (has_value && !strcmp(argv[i], "--frames")) *frames = (int)strtol(argv[++i], NULL, 10);
         else if (has_value && !strcmp(argv[i], "--dims")) {
             if (sscanf(argv[++i], "%ux%ux%u", &d[0], &d[1], &d[2]) != 3) return 0;
+        } else if (has_value && !strcmp(argv[i], "--storage")) {
+            if (vxl_storage_from_name(argv[++i], storage) || *storage == VXL_STORAGE_AUTO) return 0;
         } else return 0;
     }
     for (int a = 0; a < 3; a++)
@@ -64,8 +69,10 @@ int main(int argc, char **argv)
 {
     uint32_t size = 512, d[3] = {512, 512, 128};
     int frames = 5;
-    if (!parse_args(argc, argv, &size, &frames, d)) {
-        fprintf(stderr, "usage: voxlight-channelsbench [--size 16..4096] [--frames 1..64] [--dims XxYxZ]\n");
+    uint32_t storage = VXL_STORAGE_DENSE;
+    if (!parse_args(argc, argv, &size, &frames, d, &storage)) {
+        fprintf(stderr, "usage: voxlight-channelsbench [--size 16..4096] [--frames 1..64] [--dims XxYxZ] "
+                        "[--storage dense|bricked|sparse|compressed]\n");
         return 2;
     }
     const size_t n = (size_t)d[0] * d[1] * d[2];
@@ -87,7 +94,7 @@ int main(int argc, char **argv)
         rc = vxl_volume_create(&od, NULL, &one[c]);
     }
     free(planes);
-    const vxl_renderer_options o = {.struct_size = sizeof o, .storage = VXL_STORAGE_DENSE};
+    const vxl_renderer_options o = {.struct_size = sizeof o, .storage = storage};
     vxl_renderer *r = NULL;
     if (!rc) rc = vxl_renderer_create(&o, &r);
     if (rc) {
@@ -105,7 +112,8 @@ int main(int argc, char **argv)
                                                .tf_rgba = tf, .tf_size = 4, .has_window = 1, .window_low = 2000,
                                                .window_high = 50000};
     }
-    printf("4 channels of %ux%ux%u uint16, %u^2 frames, median of %d\n\n", d[0], d[1], d[2], size, frames);
+    printf("4 channels of %ux%ux%u uint16, %s storage, %u^2 frames, median of %d\n\n", d[0], d[1], d[2],
+           vxl_storage_name(storage), size, frames);
     printf("| drawn | shading | frame ms | x one channel | alpha sum |\n|---|---|---|---|---|\n");
     for (uint32_t lit = 0; lit < 2 && !rc; lit++) {
         vxl_render_params p = base_params(size);
@@ -146,6 +154,11 @@ int main(int argc, char **argv)
             if (t < 0) rc = 1;
             else printf("| %s | %s | %.1f | %.2f | %.0f |\n", rows[k].name, shade, t, t / base, alpha_sum(img, size));
         }
+        vxl_render_stats s = {.struct_size = sizeof s};
+        if (!lit && !rc && !vxl_renderer_get_stats(r, &s))
+            printf("| GL memory | %s storage | scalar %.2f MiB | channels %.2f MiB | dense channels %.2f MiB |\n",
+                   vxl_storage_name(storage), s.resident_bytes / 1048576.0, s.channel_bytes / 1048576.0,
+                   n * C * 2 / 1048576.0);
         if (base < 0 || rc) rc = 1;
     }
     if (rc) fprintf(stderr, "voxlight-channelsbench: %s\n", vxl_renderer_error(r));

@@ -41,6 +41,7 @@
 #define VXL_CHANNEL_DATA_UNIT 41     /* raycast: channel group g's texture (four 16-bit channels) on unit 41 + g, g < 2 */
 #define VXL_CHANNEL_TF_UNIT 43       /* raycast: channel c's transfer function on unit 43 + c, c < VXL_MAX_CHANNELS */
 #define VXL_CHANNEL_DISTANCE_UNIT 51 /* raycast: the drawn channels' union brick distance map */
+#define VXL_CHANNEL_PAGE_UNIT 52     /* raycast, paged storage: the page table of the channel groups' pools */
 #define VXL_BRICK_MINMAX_UNIT 17  /* raycast: the brick min-max grid the modes skip by (render/mode_bricks.c) */
 #define VXL_MAJORANT_UNIT 24      /* path.frag: the extinction majorant per skipping brick (render/path.c) */
 
@@ -59,7 +60,8 @@
      VXL_UNIT_BIT_(VXL_COLOUR_UNIT) + VXL_UNIT_BIT_(VXL_LABEL_BRICKS_UNIT) + VXL_UNIT_BIT_(VXL_BRICK_MINMAX_UNIT) +    \
      VXL_UNIT_BIT_(VXL_MAJORANT_UNIT) +    \
      (7ull << VXL_OVERLAY_VOLUME_UNIT) + (7ull << VXL_OVERLAY_TF_UNIT) + (7ull << VXL_OVERLAY_DISTANCE_UNIT) +      \
-     (3ull << VXL_CHANNEL_DATA_UNIT) + (255ull << VXL_CHANNEL_TF_UNIT) + VXL_UNIT_BIT_(VXL_CHANNEL_DISTANCE_UNIT))
+     (3ull << VXL_CHANNEL_DATA_UNIT) + (255ull << VXL_CHANNEL_TF_UNIT) + VXL_UNIT_BIT_(VXL_CHANNEL_DISTANCE_UNIT) +    \
+     VXL_UNIT_BIT_(VXL_CHANNEL_PAGE_UNIT))
 #define VXL_UNITS_UNION_                                                                                             \
     (VXL_UNIT_BIT_(VXL_VOLUME_UNIT) | VXL_UNIT_BIT_(VXL_DERIVED_UNIT) | VXL_UNIT_BIT_(VXL_TF_UNIT) |                  \
      VXL_UNIT_BIT_(VXL_SCENE_DEPTH_UNIT) | VXL_UNIT_BIT_(VXL_DISTANCE_UNIT) | VXL_UNIT_BIT_(VXL_CLASSIFIED_UNIT) |    \
@@ -71,7 +73,8 @@
      VXL_UNIT_BIT_(VXL_COLOUR_UNIT) | VXL_UNIT_BIT_(VXL_LABEL_BRICKS_UNIT) | VXL_UNIT_BIT_(VXL_BRICK_MINMAX_UNIT) |    \
      VXL_UNIT_BIT_(VXL_MAJORANT_UNIT) |    \
      (7ull << VXL_OVERLAY_VOLUME_UNIT) | (7ull << VXL_OVERLAY_TF_UNIT) | (7ull << VXL_OVERLAY_DISTANCE_UNIT) |      \
-     (3ull << VXL_CHANNEL_DATA_UNIT) | (255ull << VXL_CHANNEL_TF_UNIT) | VXL_UNIT_BIT_(VXL_CHANNEL_DISTANCE_UNIT))
+     (3ull << VXL_CHANNEL_DATA_UNIT) | (255ull << VXL_CHANNEL_TF_UNIT) | VXL_UNIT_BIT_(VXL_CHANNEL_DISTANCE_UNIT) |    \
+     VXL_UNIT_BIT_(VXL_CHANNEL_PAGE_UNIT))
 _Static_assert(VXL_UNITS_SUM_ == VXL_UNITS_UNION_, "two texture units share a number (gl_bindings.h)");
 
 /* Image units. */

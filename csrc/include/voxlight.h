@@ -1034,6 +1034,10 @@ typedef struct vxl_render_stats {
     uint64_t bytes_read;        /* bytes the frame read from the file or cache */
     double load_ms;             /* milliseconds the frame waited for bricks (progressive: only for the
                                    coarsest level's visible bricks, read once, small) */
+    /* Appended: a multi-channel volume's channels on the GL side (0 without):
+     * dense textures, or (paged storage) the groups' pools and their page
+     * table, as set with the volume (docs/channels.md). */
+    uint64_t channel_bytes;
 } vxl_render_stats;
 
 VXL_API int vxl_renderer_get_stats(vxl_renderer *r, vxl_render_stats *out);

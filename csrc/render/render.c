@@ -278,6 +278,7 @@ static int draw(vxl_renderer *r, const vxl_frame *f, float *rgba, float *depth)
     }
     r->stats.storage = r->storage.mode;
     r->stats.resident_bytes = r->storage.ops->resident_bytes(&r->storage);
+    r->stats.channel_bytes = r->channels.volume_bytes;
     r->storage.ops->report(&r->storage, &r->stats);
     vxl_illumination_report(&r->illumination, &r->stats);
     return VXL_OK;

@@ -129,7 +129,7 @@ int vxl_renderer_create(const vxl_renderer_options *opt, vxl_renderer **out)
     r->illumination.labels_ctx = r;
     vxl_overlays_init(&r->overlays, &r->gpu); /* overlays */
     vxl_colour_init(&r->colour, &r->gpu); /* colour volumes */
-    vxl_channels_init(&r->channels, &r->gpu); /* multi-channel volumes */
+    vxl_channels_init(&r->channels, &r->gpu, &r->storage); /* multi-channel volumes */
     r->gpu.budget = (opt && opt->memory_budget_bytes) ? opt->memory_budget_bytes : VXL_DEFAULT_BUDGET;
     if (opt && opt->struct_size >= offsetof(vxl_renderer_options, page_brick) + sizeof opt->page_brick) {
         if (opt->storage >= VXL_STORAGE_COUNT) {
@@ -231,9 +231,10 @@ static int job_set_volume(void *p)
     if (rc) return rc;
     rc = vxl_storage_ops_for_volume(v, asked)->plan(&r->storage, v, asked, &plan);
     if (rc) return rc;
-    /* a multi-channel volume's channels: with dense storage, within the budget */
-    if ((rc = vxl_channels_plan(&r->channels, v, plan.mode, plan.mode == VXL_STORAGE_DENSE ? v->storage_bytes : 0))) {
-        vxl_bricks_free(&plan.bricks);
+    /* a multi-channel volume's channels, stored as the plan stores the scalar, within the budget */
+    vxl_channel_plan channel_plan;
+    if ((rc = vxl_channels_plan(&r->channels, v, &plan, &channel_plan))) {
+        vxl_storage_plan_free(&plan);
         return rc;
     }
     const vxl_storage_ops *ops = vxl_storage_ops_for_volume(v, plan.mode);
@@ -242,7 +243,8 @@ static int job_set_volume(void *p)
     r->storage.ops = ops;
     rc = ops->install(&r->storage, v, &plan);
     if (!rc) rc = vxl_colour_set(&r->colour, v);
-    if (!rc) rc = vxl_channels_set(&r->channels, v, plan.mode);
+    if (!rc) rc = vxl_channels_set(&r->channels, v, &channel_plan);
+    vxl_channel_plan_free(&channel_plan);
     if (rc) {
         vxl_bricks_free(&plan.bricks);
         ops->release(&r->storage);

@@ -130,12 +130,6 @@ static uint64_t resident_bytes_for(const vxl_storage_state *st, const vxl_pages 
     return pool_layout(st, pg, n, slots) ? pool_bytes_for(pg, slots) + page_table_bytes(pg) : UINT64_MAX;
 }
 
-static void plan_free(vxl_storage_plan *pv)
-{
-    for (int k = 0; k < VXL_LOD_LEVELS; k++) vxl_pages_free(&pv->levels[k]);
-    vxl_bricks_free(&pv->bricks);
-}
-
 /* Sparse storage keeps coarser levels for the LOD fallback: each a 2x
  * downsampled copy, cut into bricks the same way. */
 static int plan_levels(vxl_storage_state *st, const vxl_volume *v, uint32_t brick, vxl_storage_plan *out)
@@ -167,7 +161,7 @@ int vxl_paged_plan(vxl_storage_state *st, const vxl_volume *v, uint32_t storage,
     memcpy(out->level_dims[0], v->dims, sizeof out->level_dims[0]);
     out->n_levels = 1;
     if (rc) {
-        plan_free(out);
+        vxl_storage_plan_free(out);
         return rc;
     }
     uint64_t all = resident_bytes_for(st, pg, pg->n_data), none = resident_bytes_for(st, pg, 0);
@@ -178,7 +172,7 @@ int vxl_paged_plan(vxl_storage_state *st, const vxl_volume *v, uint32_t storage,
         storage = vxl_budget_fits(st->gpu->budget, NULL, VXL_HOLD_STORAGE, all) ? VXL_STORAGE_BRICKED : VXL_STORAGE_SPARSE;
     out->mode = storage;
     if (storage == VXL_STORAGE_SPARSE && (rc = plan_levels(st, v, brick, out))) {
-        plan_free(out);
+        vxl_storage_plan_free(out);
         return rc;
     }
     uint64_t need = storage == VXL_STORAGE_BRICKED ? all : none;
@@ -186,6 +180,7 @@ int vxl_paged_plan(vxl_storage_state *st, const vxl_volume *v, uint32_t storage,
         uint64_t codes = vxl_code_bytes_for(st, pg), rest = st->compressed_domain ? page_table_bytes(pg) : none;
         need = codes == UINT64_MAX || rest == UINT64_MAX ? UINT64_MAX : codes + rest;
     }
+    out->bytes = need;
     if (!vxl_budget_fits(st->gpu->budget, NULL, VXL_HOLD_STORAGE, need)) {
         const char *hint = storage == VXL_STORAGE_BRICKED ? "; sparse storage keeps only the visible bricks" : "";
         rc = need == UINT64_MAX
@@ -193,7 +188,7 @@ int vxl_paged_plan(vxl_storage_state *st, const vxl_volume *v, uint32_t storage,
                             pg->n_data, vxl_page_edge(pg), st->gpu->info.max_3d_texture_size, hint)
                  : vxl_budget_ask(st->gpu->budget, NULL, VXL_HOLD_STORAGE, need, &st->gpu->err, hint, "%s storage of %ux%ux%u",
                                   vxl_storage_name(storage), v->dims[0], v->dims[1], v->dims[2]);
-        plan_free(out);
+        vxl_storage_plan_free(out);
     }
     return rc;
 }

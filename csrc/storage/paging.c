@@ -9,23 +9,23 @@ static uint32_t clampi(int64_t i, uint32_t n) { return i < 0 ? 0 : i >= (int64_t
 
 /* Range of n consecutive stored values from index i, in typed loops: this
  * runs over every voxel of volumes of billions. */
-static void row_range(const vxl_volume *v, size_t i, uint32_t n, double *lo, double *hi)
+static void row_range(const void *texels, uint32_t bits, size_t i, uint32_t n, double *lo, double *hi)
 {
     double mn = *lo, mx = *hi;
-    if (v->texture_bits == 8) {
-        const uint8_t *t = (const uint8_t *)v->texels + i;
+    if (bits == 8) {
+        const uint8_t *t = (const uint8_t *)texels + i;
         uint8_t a = t[0], b = t[0];
         for (uint32_t k = 1; k < n; k++) { a = t[k] < a ? t[k] : a; b = t[k] > b ? t[k] : b; }
         mn = vxl_unorm_value(a, 8) < mn ? vxl_unorm_value(a, 8) : mn;
         mx = vxl_unorm_value(b, 8) > mx ? vxl_unorm_value(b, 8) : mx;
-    } else if (v->texture_bits == 16) {
-        const uint16_t *t = (const uint16_t *)v->texels + i;
+    } else if (bits == 16) {
+        const uint16_t *t = (const uint16_t *)texels + i;
         uint16_t a = t[0], b = t[0];
         for (uint32_t k = 1; k < n; k++) { a = t[k] < a ? t[k] : a; b = t[k] > b ? t[k] : b; }
         mn = vxl_unorm_value(a, 16) < mn ? vxl_unorm_value(a, 16) : mn;
         mx = vxl_unorm_value(b, 16) > mx ? vxl_unorm_value(b, 16) : mx;
     } else {
-        const float *t = (const float *)v->texels + i;
+        const float *t = (const float *)texels + i;
         float a = t[0], b = t[0];
         for (uint32_t k = 1; k < n; k++) { a = t[k] < a ? t[k] : a; b = t[k] > b ? t[k] : b; }
         mn = a < mn ? a : mn;
@@ -35,30 +35,38 @@ static void row_range(const vxl_volume *v, size_t i, uint32_t n, double *lo, dou
     *hi = mx;
 }
 
-/* Copies brick b with its ghost into dst; out-of-volume voxels take the
- * nearest edge voxel, as clamp-to-edge sampling of one texture does. */
-static void gather(const vxl_volume *v, const vxl_pages *pg, const uint32_t b[3], uint8_t *dst, double *lo,
-                   double *hi)
+void vxl_pages_copy_brick(const void *texels, const uint32_t dims[3], uint32_t bytes_per_voxel, uint32_t brick,
+                          const uint32_t b[3], uint8_t *dst)
 {
-    const uint32_t e = vxl_page_edge(pg), bpv = pg->bytes_per_voxel;
-    const uint8_t *src = v->texels;
-    const int64_t x0 = (int64_t)b[0] * pg->brick - VXL_PAGE_GHOST;
+    const uint32_t e = brick + 2 * VXL_PAGE_GHOST, bpv = bytes_per_voxel;
+    const uint8_t *src = texels;
+    const int64_t x0 = (int64_t)b[0] * brick - VXL_PAGE_GHOST;
     /* the run of x inside the volume, copied in one go */
-    const uint32_t in0 = clampi(x0, v->dims[0]), in1 = clampi(x0 + e - 1, v->dims[0]);
+    const uint32_t in0 = clampi(x0, dims[0]), in1 = clampi(x0 + e - 1, dims[0]);
     const uint32_t pre = (uint32_t)((int64_t)in0 - x0), run = in1 - in0 + 1;
-    *lo = 1e300;
-    *hi = -1e300;
     for (uint32_t z = 0; z < e; z++) {
-        uint32_t vz = clampi((int64_t)b[2] * pg->brick + z - VXL_PAGE_GHOST, v->dims[2]);
+        uint32_t vz = clampi((int64_t)b[2] * brick + z - VXL_PAGE_GHOST, dims[2]);
         for (uint32_t y = 0; y < e; y++, dst += (size_t)e * bpv) {
-            uint32_t vy = clampi((int64_t)b[1] * pg->brick + y - VXL_PAGE_GHOST, v->dims[1]);
-            size_t row = (size_t)v->dims[0] * (vy + (size_t)v->dims[1] * vz);
+            uint32_t vy = clampi((int64_t)b[1] * brick + y - VXL_PAGE_GHOST, dims[1]);
+            size_t row = (size_t)dims[0] * (vy + (size_t)dims[1] * vz);
             for (uint32_t x = 0; x < pre; x++) memcpy(dst + (size_t)x * bpv, src + (row + in0) * bpv, bpv);
             memcpy(dst + (size_t)pre * bpv, src + (row + in0) * bpv, (size_t)run * bpv);
             for (uint32_t x = pre + run; x < e; x++) memcpy(dst + (size_t)x * bpv, src + (row + in1) * bpv, bpv);
-            row_range(v, row + in0, run, lo, hi); /* the clamped copies repeat the run's ends */
         }
     }
+}
+
+/* Brick b of v with its ghost into dst, and the range of what was copied
+ * (the clamped copies repeat values of the volume, so it is the range of
+ * the voxels the brick's samples read). */
+static void gather(const vxl_volume *v, const vxl_pages *pg, const uint32_t b[3], uint8_t *dst, double *lo,
+                   double *hi)
+{
+    const uint32_t e = vxl_page_edge(pg);
+    vxl_pages_copy_brick(v->texels, v->dims, pg->bytes_per_voxel, pg->brick, b, dst);
+    *lo = 1e300;
+    *hi = -1e300;
+    for (uint32_t r = 0; r < e * e; r++) row_range(dst, v->texture_bits, (size_t)r * e, e, lo, hi);
 }
 
 int vxl_pages_build(vxl_pages *pg, const vxl_volume *v, uint32_t brick, vxl_err *e)
@@ -131,7 +139,8 @@ int vxl_bricks_minmax_cpu(vxl_bricks *b, const vxl_volume *v, uint32_t size, vxl
         double mn = 1e300, mx = -1e300;
         for (uint32_t z = lo[2]; z <= hi[2]; z++)
             for (uint32_t y = lo[1]; y <= hi[1]; y++)
-                row_range(v, lo[0] + (size_t)v->dims[0] * (y + (size_t)v->dims[1] * z), hi[0] - lo[0] + 1, &mn, &mx);
+                row_range(v->texels, v->texture_bits, lo[0] + (size_t)v->dims[0] * (y + (size_t)v->dims[1] * z),
+                          hi[0] - lo[0] + 1, &mn, &mx);
         b->minmax[2 * i] = (float)mn;
         b->minmax[2 * i + 1] = (float)mx;
     }

@@ -38,6 +38,13 @@ static inline uint64_t vxl_page_count(const vxl_pages *pg)
 /* Cuts v into bricks of `brick` voxels (8, 16, 32 or 64). */
 int vxl_pages_build(vxl_pages *pg, const vxl_volume *v, uint32_t brick, vxl_err *e);
 void vxl_pages_free(vxl_pages *pg);
+/* Copies page brick b (its grid position) of `brick` voxels with its ghost
+ * border from texels of `dims` voxels into dst (edge^3 voxels, x fastest);
+ * voxels outside the volume take the nearest edge voxel, as clamp-to-edge
+ * sampling of one texture does. A voxel is bytes_per_voxel bytes copied as
+ * one: one scalar, or several interleaved components (channel groups). */
+void vxl_pages_copy_brick(const void *texels, const uint32_t dims[3], uint32_t bytes_per_voxel, uint32_t brick,
+                          const uint32_t b[3], uint8_t *dst);
 
 /* The value of a normalised integer texel, code / (2^bits - 1), in double
  * (the grid rounds it to float once). GL leaves the division's last bit to

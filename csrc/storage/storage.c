@@ -27,6 +27,12 @@ uint32_t vxl_storage_choose(const vxl_storage_state *st, const vxl_volume *v)
     return vxl_budget_fits(st->gpu->budget, NULL, VXL_HOLD_STORAGE, v->storage_bytes) ? VXL_STORAGE_DENSE : VXL_STORAGE_AUTO;
 }
 
+void vxl_storage_plan_free(vxl_storage_plan *plan)
+{
+    for (int k = 0; k < VXL_LOD_LEVELS; k++) vxl_pages_free(&plan->levels[k]);
+    vxl_bricks_free(&plan->bricks);
+}
+
 static uint64_t held_bytes(const void *state)
 {
     const vxl_storage_state *st = state;

@@ -68,6 +68,8 @@ typedef struct vxl_storage_plan {
     uint32_t level_dims[VXL_LOD_LEVELS][3];
     uint32_t n_levels;
     vxl_bricks bricks;  /* the skipping grid's min-max (bricked modes: from the CPU voxels) */
+    uint64_t bytes;     /* what the plan asked the budget for (GL side, at set_volume); what is
+                           planned beside the volume (a multi-channel volume's channels) adds to it */
 } vxl_storage_plan;
 
 typedef struct vxl_storage_ops {
@@ -170,6 +172,9 @@ void vxl_storage_init(vxl_storage_state *st, vxl_gpu *g);
  * filters' derived volumes are the caller's (render.c binds them). */
 int vxl_storage_bind_sampling(vxl_storage_state *st, GLuint prog);
 
+/* storage.c: frees what a plan holds (a plan that was not installed, or
+ * what install left in it). */
+void vxl_storage_plan_free(vxl_storage_plan *plan);
 /* storage.c: the table of a mode (AUTO: the bricked table, whose plan
  * decides), NULL for an unknown mode. */
 const vxl_storage_ops *vxl_storage_ops_for(uint32_t mode);

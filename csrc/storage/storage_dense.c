@@ -18,6 +18,7 @@ static int plan(vxl_storage_state *st, const vxl_volume *v, uint32_t asked, vxl_
                             "volume %ux%ux%u exceeds this backend's 3D texture limit of %d per axis (bricked "
                             "storage has no such limit)",
                             v->dims[0], v->dims[1], v->dims[2], st->gpu->info.max_3d_texture_size);
+    out->bytes = v->storage_bytes;
     return vxl_budget_ask(st->gpu->budget, NULL, VXL_HOLD_STORAGE, v->storage_bytes, &st->gpu->err, NULL,
                           "the volume %ux%ux%u (dense storage)", v->dims[0], v->dims[1], v->dims[2]);
 }

@@ -21,6 +21,11 @@ int vxl_pool_layout(const vxl_storage_state *st, uint32_t n, uint32_t e, uint32_
     uint32_t rows = (n + slots[0] - 1) / slots[0];
     slots[1] = rows < m ? rows : m;
     slots[2] = (rows + slots[1] - 1) / slots[1];
+    /* the fewest slots per row and rows per layer that still hold n: the
+     * last row and layer are then nearly full (128 bricks of 34 under a
+     * limit of 2048 take 43 x 3 slots, not 60 x 3, which left 52 empty) */
+    slots[1] = (rows + slots[2] - 1) / slots[2];
+    slots[0] = (n + slots[1] * slots[2] - 1) / (slots[1] * slots[2]);
     return slots[2] <= m;
 }
 

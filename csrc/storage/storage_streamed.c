@@ -180,12 +180,6 @@ static uint64_t pool_bytes_for(const vxl_storage_state *st, const vxl_pages *pg,
     return slots[0] * e * slots[1] * e * slots[2] * e * pg->bytes_per_voxel;
 }
 
-static void plan_free(vxl_storage_plan *pv)
-{
-    for (int k = 0; k < VXL_LOD_LEVELS; k++) vxl_pages_free(&pv->levels[k]);
-    vxl_bricks_free(&pv->bricks);
-}
-
 static int plan_streamed(vxl_storage_state *st, const vxl_volume *v, uint32_t asked, vxl_storage_plan *out)
 {
     memset(out, 0, sizeof *out);
@@ -229,7 +223,7 @@ static int plan_streamed(vxl_storage_state *st, const vxl_volume *v, uint32_t as
                             "the page tables and staging queue of a streamed %ux%ux%u volume", v->dims[0], v->dims[1],
                             v->dims[2]);
     }
-    if (rc) plan_free(out);
+    if (rc) vxl_storage_plan_free(out);
     return rc;
 }
 

@@ -32,6 +32,23 @@ double vxl_channel_texel(const vxl_volume *v, uint32_t c, uint64_t i)
     return vxl_channel_group(v, g)[i * w + c % VXL_CHANNELS_PER_GROUP] / 65535.0;
 }
 
+int vxl_channel_alone(const vxl_volume *v, uint32_t c, vxl_volume *one, vxl_err *e)
+{
+    const uint64_t n = (uint64_t)v->dims[0] * v->dims[1] * v->dims[2];
+    memset(one, 0, sizeof *one);
+    memcpy(one->dims, v->dims, sizeof one->dims);
+    one->texture_bits = 16;
+    one->storage_bytes = n * VXL_CHANNEL_BYTES;
+    uint16_t *t = malloc((size_t)(n ? n * VXL_CHANNEL_BYTES : 1));
+    if (!t)
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for channel %u alone (%.1f MiB)", c, n * 2 / 1048576.0);
+    const uint32_t g = c / VXL_CHANNELS_PER_GROUP, w = vxl_channel_group_width(v, g);
+    const uint16_t *src = vxl_channel_group(v, g) + c % VXL_CHANNELS_PER_GROUP;
+    for (uint64_t i = 0; i < n; i++) t[i] = src[i * w];
+    one->texels = t;
+    return VXL_OK;
+}
+
 /* One channel's texels (texture format of its dtype, as vxl_volume_build
  * makes them) into its 16-bit slot of the group: 8-bit codes widen
  * exactly (c * 257 / 65535 = c / 255), 16-bit stay, float rounds. */

@@ -48,6 +48,11 @@ static inline const uint16_t *vxl_channel_group(const vxl_volume *v, uint32_t g)
 /* The stored normalised value in [0, 1] of channel c at voxel i. */
 double vxl_channel_texel(const vxl_volume *v, uint32_t c, uint64_t i);
 
+/* Channel c of v alone as a 16-bit volume of v's dims (texels and dims
+ * only: what the CPU passes over its voxels read, the brick min-max and the
+ * page bricks); the caller frees one->texels. */
+int vxl_channel_alone(const vxl_volume *v, uint32_t c, vxl_volume *one, vxl_err *e);
+
 /* Bytes of v's channels (0 without). */
 uint64_t vxl_volume_channel_bytes(const vxl_volume *v);
 

@@ -425,7 +425,8 @@ class RenderStats(ctypes.Structure):
                 ("refine_pending", ctypes.c_uint32),     # appended
                 ("stream_level", ctypes.c_uint32),
                 ("bytes_read", ctypes.c_uint64),
-                ("load_ms", ctypes.c_double)]
+                ("load_ms", ctypes.c_double),
+                ("channel_bytes", ctypes.c_uint64)]       # appended: multi-channel volumes' GL memory
 
 
 def _sized(struct_type):

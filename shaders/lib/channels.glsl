@@ -1,6 +1,7 @@
 // channels.glsl - multi-channel volumes (docs/channels.md; the GL side is
 // csrc/channels/channels.c). CHANNEL_GROUPS (1 or 2) textures hold up to
-// four 16-bit channels each on the volume's grid; channel_march replaces
+// four 16-bit channels each on the volume's grid (dense storage), or as
+// pools of page bricks (PAGED, below); channel_march replaces
 // march. At each step one fetch per group samples every channel; each
 // drawn channel (bit c of u_ch_drawn) is classified by its own table,
 // window and opacity scale, coloured by its colour and lit with its own
@@ -27,13 +28,34 @@ uniform int u_ch_blend;                 // VXL_CHANNEL_BLEND_*: 0 add, 1 max
 uniform usampler3D u_ch_distance;       // 0 occupied by a drawn channel; k: bricks within k-1 are empty
 uniform int u_ch_brick_size;
 
-vec4 ch_fetch(int grp, vec3 p)
+#ifdef PAGED
+// Paged storage (csrc/channels/channel_pages.c): each group's texture is a
+// pool of the scalar's page bricks with their ghost borders, every pool
+// with the same slots, so one page table serves all groups. Every brick is
+// resident (a brick constant in every channel points at a slot of its
+// constants), so the lookup is the scalar's without its w >= 0 branch, at
+// full resolution (u_dims) whatever level the scalar's pool holds.
+uniform sampler3D u_ch_page;
+uniform vec3 u_ch_pool_dims;
+
+vec3 ch_coord(vec3 p)
+{
+    page_entry_at(u_ch_page, u_dims, p);
+    return (p + 0.5) / u_ch_pool_dims;
+}
+#else
+vec3 ch_coord(vec3 p) { return voxel_to_tex(p); }
+#endif
+
+// Group grp at texture coordinate t (ch_coord: one page lookup serves every group).
+vec4 ch_fetch_at(int grp, vec3 t)
 {
 #if CHANNEL_GROUPS > 1
-    if (grp == 1) return textureLod(u_ch_data1, voxel_to_tex(p), 0.0);
+    if (grp == 1) return textureLod(u_ch_data1, t, 0.0);
 #endif
-    return textureLod(u_ch_data0, voxel_to_tex(p), 0.0);
+    return textureLod(u_ch_data0, t, 0.0);
 }
+vec4 ch_fetch(int grp, vec3 p) { return ch_fetch_at(grp, ch_coord(p)); }
 
 bool ch_drawn(int c) { return ((u_ch_drawn >> c) & 1) != 0; }
 
@@ -84,7 +106,8 @@ vec4 channel_march(vec3 o, vec3 dir, float t0, float t1, RaySetup r, out float d
         }
         taken++;
         vec4 s[CHANNEL_GROUPS];
-        for (int grp = 0; grp < CHANNEL_GROUPS; grp++) s[grp] = ch_fetch(grp, p);
+        vec3 tc = ch_coord(p);
+        for (int grp = 0; grp < CHANNEL_GROUPS; grp++) s[grp] = ch_fetch_at(grp, tc);
         vec4 cs[CH_SLOTS];
         bool any = false;
         for (int c = 0; c < CH_SLOTS; c++) {

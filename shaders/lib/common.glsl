@@ -68,11 +68,13 @@ vec3 level_position(vec3 p) { return u_lod_scale > 1.0 ? (p + 0.5) / u_lod_scale
 // The entry of `table` (the page table, or that of a pool derived from the
 // data: gradients, spline coefficients, all laid out brick for brick) for
 // level position q, and q moved to its texel position in that pool (texel
-// centres at integers). Clamping q to the voxel centres first reproduces
+// centres at integers). page_entry_at takes the level's size: a
+// multi-channel volume's pools (lib/channels.glsl) stay at full resolution
+// while the scalar's may fall back to a coarser level. Clamping q to the voxel centres first reproduces
 // clamp-to-edge sampling of one texture.
-vec4 page_entry(sampler3D table, inout vec3 q)
+vec4 page_entry_at(sampler3D table, vec3 page_dims, inout vec3 q)
 {
-    q = clamp(q, vec3(0.0), u_page_dims - 1.0);
+    q = clamp(q, vec3(0.0), page_dims - 1.0);
     ivec3 b = ivec3(floor((q + 0.5) / u_page_brick));
     vec4 e = texelFetch(table, b, 0);
 #ifdef PAGED_MIXED
@@ -82,6 +84,7 @@ vec4 page_entry(sampler3D table, inout vec3 q)
 #endif
     return e;
 }
+vec4 page_entry(sampler3D table, inout vec3 q) { return page_entry_at(table, u_page_dims, q); }
 
 float sample_value(vec3 p)
 {

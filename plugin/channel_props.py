@@ -91,24 +91,15 @@ def fill(props, info):
         props.shading = False
 
 
-def _scene_storage():
-    scene = getattr(bpy.context, "scene", None)
-    s = getattr(scene, "voxlight", None)
-    return getattr(s, "storage", "auto")
-
-
 def why_not(props):
     """Why this volume's channels are not drawn now ("" when they are)."""
     from . import label_props, overlay_props
     ob = props.id_data
-    entry = runtime.find_entry(bpy.path.abspath(props.filepath), props.series)
-    last = (entry.last_frame or {}).get("storage_name") if entry is not None else None
     return channel_plan.conflict(
         render_mode=props.render_mode, classify=props.classify,
         gradient_opacity=props.gradient_opacity, shading=props.shading,
         shading_model=props.shading_model, labels=bool(label_props.look_kwargs(props)),
-        overlays=bool(overlay_props.listed(ob.original if ob.original is not None else ob)),
-        storage=_scene_storage(), last_storage=last)
+        overlays=bool(overlay_props.listed(ob.original if ob.original is not None else ob)))
 
 
 def refusal(props):

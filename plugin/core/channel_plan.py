@@ -28,8 +28,6 @@ RAMPS = (
 _RAMP_CURVES = {r[0]: r[3] for r in RAMPS}
 GRAY_OPACITY = 0.1  # the GRAY preset's opacity at its top (frame/transfer.c)
 TABLE_SIZE = 256
-# Storage modes that page the volume: the channels are whole textures.
-PAGED_STORAGE = ("bricked", "sparse", "compressed")
 
 
 def ordered_window(lo, hi):
@@ -53,13 +51,10 @@ def ramp_table(ramp, n=TABLE_SIZE):
 
 
 def conflict(render_mode="dvr", classify="post", gradient_opacity="off", shading=True,
-             shading_model="phong", labels=False, overlays=False, storage="auto",
-             last_storage=None):
+             shading_model="phong", labels=False, overlays=False):
     """Why the library cannot draw channels with these settings ("" when it
     can), as a sentence the panel shows. The same rules as frame_channels.c
-    (check_combination) and channels.c (dense storage); `last_storage` is
-    the storage the volume's last frame used (AUTO picks bricked for a
-    volume over the texture limit or budget)."""
+    (check_combination); every storage mode draws channels."""
     if render_mode != "dvr":
         return "channels are drawn in the DVR render mode only (MIP, MinIP, Average and ISO " \
                "project one scalar)"
@@ -73,9 +68,6 @@ def conflict(render_mode="dvr", classify="post", gradient_opacity="off", shading
         return "channels are not drawn together with labels"
     if overlays:
         return "channels are not drawn together with overlays"
-    if storage in PAGED_STORAGE or (last_storage or "dense") in PAGED_STORAGE:
-        return "channels need dense storage, the volume is held %s (Render tab: Storage " \
-               "Dense or Auto)" % (storage if storage in PAGED_STORAGE else last_storage)
     return ""
 
 

@@ -442,8 +442,8 @@ def last_failure(path, series=""):
 def drawing_channels(entry, params, draw):
     """draw(params), for a frame that may draw a multi-channel volume's
     channels. The add-on checks its settings before a frame
-    (channel_plan.conflict), but one thing only the library knows: AUTO
-    storage that pages a volume too large for one texture. A frame whose
+    (channel_plan.conflict), but the library has the last word (a budget
+    its pools do not fit, a setting the add-on's rules missed). A frame whose
     channels the library refuses is drawn again with the scalar alone, and
     the refusal is kept for the panel (channel_refusal): a frame, never an
     error or a black image."""

@@ -20,14 +20,12 @@ def channel(**kw):
 def test_no_conflict_with_the_defaults_and_unlit_shadow_models():
     assert cp.conflict() == ""
     assert cp.conflict(shading=False, shading_model="shadowed") == ""  # unlit: any model
-    assert cp.conflict(storage="dense", last_storage="dense") == ""
 
 
 @pytest.mark.parametrize("kw, word", [
     (dict(render_mode="mip"), "DVR"), (dict(classify="preint"), "Post"),
     (dict(gradient_opacity="boundary"), "Edges"), (dict(shading_model="scatter"), "Phong"),
-    (dict(labels=True), "labels"), (dict(overlays=True), "overlays"),
-    (dict(storage="bricked"), "bricked"), (dict(storage="auto", last_storage="sparse"), "sparse")])
+    (dict(labels=True), "labels"), (dict(overlays=True), "overlays")])
 def test_each_conflict_is_named(kw, word):
     assert word in cp.conflict(**kw)
 

@@ -70,7 +70,7 @@ OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_
 # The platform room's files for this OS (csrc/platform/), for whatever links
 # library objects without the library.
 PLATFORM := dynlib dynlib_posix threads_posix files files_posix process_posix clock_posix os_posix
-HELPER_CORE_NAMES := helper_main volume colour_volume channel_volume brick_source error loader_util zlib_api
+HELPER_CORE_NAMES := helper_main volume colour_volume channel_volume channel_meta ome_xml brick_source error loader_util zlib_api
 HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,$(HELPER_CORE_NAMES) helper_self_posix $(PLATFORM))
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-zarr $(BUILD)/voxlight-write-vdb
 # One-off measurement programs behind docs/filters_on_scans.md, built with

@@ -65,15 +65,18 @@ static uint64_t input_bytes(const char *path, const vxl_path_info *st, int reads
     return st->size + folder_bytes(dir, 0, &entries);
 }
 
-/* The reply's volume, taking ownership of the texels and colour: the same
- * vxl_volume the helper's reader built (a colour volume's scalar and RGB8,
- * colour_volume.h). */
-static int volume_from(const vxl_reader_header *h, void *texels, uint8_t *colour, vxl_volume **out, vxl_err *e)
+/* The reply's volume, taking ownership of the texels, colour and channels:
+ * the same vxl_volume the helper's reader built (a colour volume's scalar
+ * and RGB8, colour_volume.h; a multi-channel volume's scalar and packed
+ * channels, channel_volume.h). */
+static int volume_from(const vxl_reader_header *h, void *texels, uint8_t *colour, uint16_t *channels,
+                       vxl_volume **out, vxl_err *e)
 {
     vxl_volume *v = calloc(1, sizeof *v);
     if (!v) {
         free(texels);
         free(colour);
+        free(channels);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the volume header");
     }
     memcpy(v->dims, h->dims, sizeof v->dims);
@@ -97,6 +100,16 @@ static int volume_from(const vxl_reader_header *h, void *texels, uint8_t *colour
     v->colour = colour;
     v->components = h->components;
     v->opacity_source = h->opacity_source;
+    if (channels) {
+        v->channels = channels;
+        v->channel_count = h->channel_count;
+        v->scalar_channel = h->scalar_channel;
+        memcpy(v->ch_tex_lo, h->ch_tex_lo, sizeof v->ch_tex_lo);
+        memcpy(v->ch_tex_hi, h->ch_tex_hi, sizeof v->ch_tex_hi);
+        memcpy(v->ch_min, h->ch_min, sizeof v->ch_min);
+        memcpy(v->ch_max, h->ch_max, sizeof v->ch_max);
+        memcpy(v->ch_meta, h->ch_meta, sizeof v->ch_meta); /* names terminated: checked on receipt */
+    }
     *out = v;
     return VXL_OK;
 }
@@ -112,10 +125,11 @@ static int load_remote(const vxl_reader *r, const char *command, int reads_sibli
     vxl_reader_header h;
     void *body = NULL;
     uint8_t *colour = NULL;
+    uint16_t *channels = NULL;
     int rc = vxl_reader_run(r, command, path, opt, VXL_REPLY_VOLUME, input_bytes(path, &st, reads_siblings, depth),
-                            &h, &body, &colour, e);
+                            &h, &body, &colour, &channels, e);
     if (rc) return rc;
-    return volume_from(&h, body, colour, out, e);
+    return volume_from(&h, body, colour, channels, out, e);
 }
 
 int vxl_image_stack_reader_runs_here(void) { return vxl_reader_runs_here(&stack_reader); }
@@ -157,10 +171,11 @@ int vxl_zarr_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
     vxl_reader_header h;
     void *body = NULL;
     uint8_t *colour = NULL;
+    uint16_t *channels = NULL;
     int rc = vxl_reader_run(&zarr_reader, VXL_CMD_ZARR, path, opt, VXL_REPLY_VOLUME,
-                            input_bytes(folder, &st, 0, ZARR_DEPTH), &h, &body, &colour, e);
+                            input_bytes(folder, &st, 0, ZARR_DEPTH), &h, &body, &colour, &channels, e);
     if (rc) return rc;
-    return volume_from(&h, body, colour, out, e);
+    return volume_from(&h, body, colour, channels, out, e);
 }
 
 VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint32_t max, uint32_t *count)
@@ -182,7 +197,7 @@ VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint3
     vxl_reader_header h;
     void *body = NULL;
     int rc = vxl_reader_run(&dicom_reader, VXL_CMD_DICOM_SERIES, path, NULL, VXL_REPLY_SERIES,
-                            input_bytes(path, &st, 1, DICOM_DEPTH), &h, &body, NULL, NULL);
+                            input_bytes(path, &st, 1, DICOM_DEPTH), &h, &body, NULL, NULL, NULL);
     if (rc) return rc;
     const vxl_dicom_series *all = body;
     const size_t stride = max && out->struct_size ? out->struct_size : sizeof(vxl_dicom_series);

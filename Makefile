@@ -395,7 +395,7 @@ FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc
 	$(shell pkg-config --cflags OpenImageIO)
 # the core's loaders and dispatch (the helper-run readers are called
 # in-process by their targets: libFuzzer sees coverage in its own process only)
-FUZZ_LIB_C := volume.c colour_volume.c channel_volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
+FUZZ_LIB_C := volume.c colour_volume.c channel_volume.c channel_meta.c ome_xml.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
 	reader_spawn.c remote_readers.c label_table.c zarr_detect.c $(notdir $(ZARR_C)) zarr_source.c brick_source.c
 # the brick cache of .nii.gz files and the TIFF directory walk: opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout; the Radiance reader of World maps, read by fuzz_hdr

@@ -221,11 +221,16 @@ typedef struct vxl_load_options {
      * report) is channel scalar_channel. Which inputs load as channels:
      *   AUTO (0)  an axis that cannot be colour: NIfTI 5D whose dim[5] > 1
      *             is not an RGB(A) vector (dim[4] counts the frames), NRRD
-     *             whose component axis has more than 4 entries
+     *             whose component axis and MetaImage whose
+     *             ElementNumberOfChannels is 2 or 5..8, an OME-Zarr c axis
+     *             of 2..8 (without "#c=N"), a TIFF of 2..8 grey samples,
+     *             an OME-TIFF whose OME-XML says SizeC 2..8
      *   ON        also a 2..4-entry axis that AUTO leaves as it was (colour,
-     *             or a 5D NIfTI's frames)
-     *   OFF       none: NIfTI 5D counts every volume as a frame and NRRD
-     *             refuses a component axis over 4, as before channels
+     *             RGB(A) or grey+alpha samples, or a 5D NIfTI's frames)
+     *   OFF       none: NIfTI 5D counts every volume as a frame, NRRD and
+     *             MetaImage refuse what cannot be colour, OME-Zarr reads
+     *             channel 0, TIFF its first samples and OME-TIFF its pages
+     *             as slices, as before channels
      * The volume's notes say which was chosen and why. */
     uint32_t channels;            /* VXL_CHANNELS_* */
     uint32_t scalar_channel;      /* which channel is the scalar; 0 = the first */

@@ -125,13 +125,7 @@ static void volume_header(const vxl_volume *v, vxl_reader_header *h)
     /* a reader's notes are terminated; a full array is cut, not sent open */
     snprintf(h->notes, sizeof h->notes, "%s", v->notes);
     if (v->channels) {
-        h->channel_count = v->channel_count;
-        h->scalar_channel = v->scalar_channel;
-        memcpy(h->ch_tex_lo, v->ch_tex_lo, sizeof h->ch_tex_lo);
-        memcpy(h->ch_tex_hi, v->ch_tex_hi, sizeof h->ch_tex_hi);
-        memcpy(h->ch_min, v->ch_min, sizeof h->ch_min);
-        memcpy(h->ch_max, v->ch_max, sizeof h->ch_max);
-        memcpy(h->ch_meta, v->ch_meta, sizeof h->ch_meta);
+        vxl_reader_channel_fields(h, (vxl_volume *)v, 1);
         h->channel_bytes = vxl_volume_channel_bytes(v);
     }
 }

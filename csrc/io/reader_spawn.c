@@ -216,6 +216,19 @@ static int check_volume_header(const vxl_reader *r, const char *path, const vxl_
     return VXL_OK;
 }
 
+/* A part of the body after the texels (colour, channels): *buf of len
+ * bytes, or NULL for none. */
+static int make_room(const char *path, uint64_t len, const char *what, void **buf, uint64_t *buf_len, vxl_err *e)
+{
+    *buf_len = len;
+    if (!len) return VXL_OK;
+    *buf = malloc((size_t)len);
+    if (!*buf)
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': out of memory for %llu bytes of %s", path,
+                        (unsigned long long)len, what);
+    return VXL_OK;
+}
+
 /* Checks a complete header and makes room for what follows it. */
 static int accept_header(const vxl_reader *r, const char *path, reply *rp, uint32_t kind,
                          const vxl_load_options *opt, vxl_err *e)
@@ -235,20 +248,11 @@ static int accept_header(const vxl_reader *r, const char *path, reply *rp, uint3
         int rc = check_volume_header(r, path, h, opt, e);
         if (rc) return rc;
         rp->body_len = h->nbytes;
-        if (h->colour_bytes) {
-            rp->colour_len = h->colour_bytes;
-            rp->colour = malloc((size_t)rp->colour_len);
-            if (!rp->colour)
-                return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': out of memory for %llu bytes of colour",
-                                path, (unsigned long long)rp->colour_len);
-        }
-        if (h->channel_bytes) {
-            rp->channels_len = h->channel_bytes;
-            rp->channels = malloc((size_t)rp->channels_len);
-            if (!rp->channels)
-                return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': out of memory for %llu bytes of channels",
-                                path, (unsigned long long)rp->channels_len);
-        }
+        void *colour = NULL, *channels = NULL;
+        if ((rc = make_room(path, h->colour_bytes, "colour", &colour, &rp->colour_len, e))) return rc;
+        rp->colour = colour;
+        if ((rc = make_room(path, h->channel_bytes, "channels", &channels, &rp->channels_len, e))) return rc;
+        rp->channels = channels;
     } else {
         if (h->record_size != sizeof(vxl_dicom_series) || h->count > MAX_SERIES ||
             h->nbytes != (uint64_t)h->count * sizeof(vxl_dicom_series))

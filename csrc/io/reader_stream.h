@@ -14,6 +14,7 @@
 #define VXL_READER_STREAM_H
 
 #include <stdint.h>
+#include <string.h>
 
 #include "volume.h" /* VXL_VOLUME_NOTES_MAX */
 
@@ -95,6 +96,21 @@ typedef struct vxl_reader_header {
     uint64_t channel_bytes; /* packed channel bytes after the colour */
     vxl_channel_meta ch_meta[VXL_MAX_CHANNELS];
 } vxl_reader_header;
+
+/* Copies a multi-channel volume's fields between the header and the
+ * volume (to_header 1: v -> h, the helper's side; 0: h -> v, the
+ * library's); the channels themselves travel after the colour. */
+static inline void vxl_reader_channel_fields(vxl_reader_header *h, vxl_volume *v, int to_header)
+{
+    const struct { void *h, *v; size_t n; } f[] = {
+        {&h->channel_count, &v->channel_count, sizeof h->channel_count},
+        {&h->scalar_channel, &v->scalar_channel, sizeof h->scalar_channel},
+        {h->ch_tex_lo, v->ch_tex_lo, sizeof h->ch_tex_lo}, {h->ch_tex_hi, v->ch_tex_hi, sizeof h->ch_tex_hi},
+        {h->ch_min, v->ch_min, sizeof h->ch_min}, {h->ch_max, v->ch_max, sizeof h->ch_max},
+        {h->ch_meta, v->ch_meta, sizeof h->ch_meta}};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++)
+        memcpy(to_header ? f[i].h : f[i].v, to_header ? f[i].v : f[i].h, f[i].n);
+}
 
 /* tests/python/test_vdb_isolation.py packs this layout by hand. */
 _Static_assert(sizeof(vxl_channel_meta) == 96, "vxl_channel_meta has padding: the stream would carry junk");

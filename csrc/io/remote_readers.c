@@ -100,15 +100,9 @@ static int volume_from(const vxl_reader_header *h, void *texels, uint8_t *colour
     v->colour = colour;
     v->components = h->components;
     v->opacity_source = h->opacity_source;
-    if (channels) {
+    if (channels) { /* names terminated, ranges finite: checked on receipt */
         v->channels = channels;
-        v->channel_count = h->channel_count;
-        v->scalar_channel = h->scalar_channel;
-        memcpy(v->ch_tex_lo, h->ch_tex_lo, sizeof v->ch_tex_lo);
-        memcpy(v->ch_tex_hi, h->ch_tex_hi, sizeof v->ch_tex_hi);
-        memcpy(v->ch_min, h->ch_min, sizeof v->ch_min);
-        memcpy(v->ch_max, h->ch_max, sizeof v->ch_max);
-        memcpy(v->ch_meta, h->ch_meta, sizeof v->ch_meta); /* names terminated: checked on receipt */
+        vxl_reader_channel_fields((vxl_reader_header *)h, v, 0);
     }
     *out = v;
     return VXL_OK;

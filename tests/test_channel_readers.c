@@ -9,7 +9,6 @@
  * the helper stream; `#c=1` and channels OFF still read one channel; 3
  * samples of an RGB photometric stay colour; an over-budget file is refused
  * before allocating, saying why. */
-#include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -18,6 +17,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "loader_test_util.h"
 #include "volume.h"
 #include "voxlight.h"
 
@@ -184,22 +184,15 @@ TEST(over_budget_files_are_refused_before_allocating)
 
 int main(void)
 {
-    snprintf(g_dir, sizeof g_dir, "/tmp/vxl_test_chanread_XXXXXX");
-    if (!mkdtemp(g_dir)) {
-        fprintf(stderr, "mkdtemp: %s\n", strerror(errno));
-        return 1;
-    }
     char cmd[256];
+    snprintf(g_dir, sizeof g_dir, "/tmp/vxl_test_chanread_XXXXXX");
+    if (!mkdtemp(g_dir)) return perror("mkdtemp"), 1;
     snprintf(cmd, sizeof cmd, "/usr/bin/python3 tests/channel_files_write.py %s", g_dir);
-    if (system(cmd) != 0) {
-        fprintf(stderr, "tests/channel_files_write.py failed\n");
-        return 1;
-    }
+    if (system(cmd) != 0) return fprintf(stderr, "tests/channel_files_write.py failed\n"), 1;
     RUN(ome_zarr_c_axis_loads_as_channels_with_omero_metadata);
     RUN(tiff_samples_and_ome_tiff_planes_load_as_channels);
     RUN(metaimage_element_channels_load_as_channels);
     RUN(over_budget_files_are_refused_before_allocating);
-    snprintf(cmd, sizeof cmd, "rm -rf %s", g_dir);
-    if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", g_dir);
+    remove_tree(g_dir);
     return TEST_SUMMARY();
 }

@@ -255,6 +255,9 @@ int vxl_zarr_read(const char *path, const vxl_load_options *opt, vxl_volume **ou
         goto done;
     }
     rc = read_level(path, s, a, sel, dims, opt, raw, e);
+    /* channel by channel, each into its plane: a chunk that spans several
+     * channels is decoded once for each (simple, and only the whole read
+     * runs this; the chunk buffer stays one chunk) */
     for (uint32_t c = 1; c < channels && !rc; c++) { /* channel 0 was sel's */
         sel[VXL_ZARR_C] = c;
         rc = read_level(path, s, a, sel, dims, opt, raw + c * nbytes, e);

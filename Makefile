@@ -45,7 +45,7 @@ DCMTK_LIBS := -ldcmjpeg -ldcmjpls -ldcmdata -loflog -lofstd
 # (csrc/io/reader_stream.h), one per library, so a missing library breaks only
 # its own formats: voxlight-read-oiio (TIFF/PNG stacks, OpenVDB) and
 # voxlight-read-dicom (DICOM). csrc/*/helper_*.c are the helpers' own files.
-OIIO_CXX := csrc/io/image_stack.cpp csrc/io/vdb.cpp
+OIIO_CXX := csrc/io/image_stack.cpp csrc/io/vdb.cpp csrc/io/environment_exr.cpp
 DICOM_CXX := $(wildcard csrc/io/dicom*.cpp)
 # the DICOM codecs in our own C, and JPEG 2000 through OpenJPEG opened at
 # run time (the helper links them; so do their tests and the fuzz build)

@@ -39,13 +39,14 @@ ROOT=$(pwd)
 # libopenvdb-dev: OpenVDB's headers and library for the helper
 # voxlight-write-vdb (csrc/io/vdb_write.cpp), which writes the add-on's
 # Convert to Blender Volume files (Debian 12: OpenVDB 10, 13: OpenVDB 12;
-# the same name on both).
+# the same name on both). openimageio-tools: oiiotool writes the OpenEXR
+# World maps tests/cli/test_cli_environment.py reads back.
 NEEDS=(gcc g++ make pkg-config zlib1g-dev libgl-dev libegl-dev libegl1 libegl-mesa0
        libgl1-mesa-dri "?libosmesa6" libopenimageio-dev libdcmtk-dev libzstd-dev libblosc-dev mricron-data blender
        xvfb xauth python3 python3-numpy python3-pytest zip unzip clang clang-rt llvm
        python3-matplotlib "python3-vtk9|python3-vtk" python3-openvdb "?python3.11-venv" "?python3.13-venv"
        "?wine64|wine" libz-mingw-w64 dcmtk libopenjp2-7-dev libopenjp2-tools python3-pydicom dcm2niix
-       libopenvdb-dev)
+       libopenvdb-dev openimageio-tools)
 
 # (output captured, not piped into grep -q: under pipefail an early grep exit
 # would fail the pipeline)

@@ -38,7 +38,7 @@ static const char usage_format[] =
     "                  [--light dir:X,Y,Z[,INTENSITY] | point:X,Y,Z[,INTENSITY]]... [--shading %s]\n"
     "                  [--ambient-occlusion RADIUS] [--anisotropy G] [--samples N] [--sample-offset K]\n"
     "                  [--bounces B] [--seed S]\n"
-    "                  [--environment FILE.hdr|R,G,B[,STRENGTH]] [--environment-rotation DEG]\n"
+    "                  [--environment FILE.hdr|FILE.exr|R,G,B[,STRENGTH]] [--environment-rotation DEG]\n"
     "                  [--mode %s] [--iso-value V] [--matcap FILE.png] [--ortho]\n"
     "                  [--view x|-x|y|-y|z|-z] [--streaming %s] [--cache-dir DIR]\n"
     "                  [--clip-plane A,B,C,D[,T]]... [--crop X0:X1,Y0:Y1,Z0:Z1] [--no-caps]\n"

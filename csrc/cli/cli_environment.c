@@ -1,7 +1,8 @@
 /* cli_environment.c - --environment and --environment-rotation
  * (cli_environment.h). A value of three or four numbers is a uniform colour
  * (and strength); anything else names a map file, read by the library
- * (vxl_environment_image_load: Radiance .hdr; .exr refused with a way round). */
+ * (vxl_environment_image_load: Radiance .hdr, or OpenEXR .exr through the
+ * library's OpenImageIO helper). */
 #include "cli_environment.h"
 
 #include <math.h>

@@ -821,8 +821,12 @@ typedef struct vxl_environment {
  * size; rgb NULL (max_pixels ignored) reads the header only, so a caller
  * can size the buffer: rgb then holds width*height*3 floats, and a map of
  * more than max_pixels pixels is VXL_ERR_LIMIT. A corrupt or truncated file
- * is VXL_ERR_FORMAT saying what is wrong; OpenEXR (.exr) is VXL_ERR_FORMAT
- * saying how to convert it. */
+ * is VXL_ERR_FORMAT saying what is wrong. OpenEXR (.exr, any of its codecs;
+ * the first three channels, or a grey one) is read by the OpenImageIO helper
+ * process, as TIFF stacks are: negative values read as 0, NaN or infinity is
+ * VXL_ERR_FORMAT; where that helper cannot run (Windows, OpenImageIO
+ * missing) the error names what to install. Each call reads the whole
+ * file, the header-only call too. */
 VXL_API int vxl_environment_image_load(const char *path, float *rgb, uint64_t max_pixels, uint32_t *width,
                                        uint32_t *height);
 

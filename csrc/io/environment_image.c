@@ -1,7 +1,7 @@
-/* environment_image.c - vxl_environment_image_load: a World map file read
- * whole under a size cap and decoded by the Radiance reader (hdr_read.c).
- * OpenEXR is refused with a way round it: the library reads EXR only
- * through its OpenImageIO helper, which reduces images to grey volumes. */
+/* environment_image.c - vxl_environment_image_load: a World map file. A
+ * Radiance .hdr is read whole under a size cap and decoded by our own reader
+ * (hdr_read.c); an OpenEXR .exr goes to the OpenImageIO helper process
+ * (loaders.h, environment_exr.cpp), whose codecs stay out of the library. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,6 +10,7 @@
 #include "error.h"
 #include "files.h"
 #include "hdr_read.h"
+#include "loaders.h"
 #include "voxlight.h"
 
 /* As vxl_environment's limit: 2^26 pixels, 4 bytes each flat, plus the header. */
@@ -61,6 +62,25 @@ static int read_whole(const char *path, uint8_t **data, size_t *size, vxl_err *e
     return VXL_OK;
 }
 
+/* The helper sends the whole image; a caller asking for its size only
+ * (rgb NULL) gets it from the same read. */
+static int exr_load(const char *path, float *rgb, uint64_t max_pixels, uint32_t *width, uint32_t *height)
+{
+    vxl_err e = {0};
+    float *px = NULL;
+    uint32_t w = 0, h = 0;
+    int rc = vxl_environment_exr_load(path, MAX_PIXELS, &px, &w, &h, &e);
+    if (!rc && rgb && (uint64_t)w * h > max_pixels)
+        rc = vxl_fail(&e, VXL_ERR_LIMIT, "%s: %ux%u pixels, more than the %llu given room for", path, w, h,
+                      (unsigned long long)max_pixels);
+    if (!rc && rgb) memcpy(rgb, px, (size_t)w * h * 3 * sizeof(float));
+    free(px);
+    if (rc) return vxl_fail(NULL, rc, "%s", e.msg);
+    *width = w;
+    *height = h;
+    return VXL_OK;
+}
+
 VXL_API int vxl_environment_image_load(const char *path, float *rgb, uint64_t max_pixels, uint32_t *width,
                                        uint32_t *height)
 {
@@ -68,11 +88,7 @@ VXL_API int vxl_environment_image_load(const char *path, float *rgb, uint64_t ma
     if (!path || !*path || !width || !height)
         return vxl_fail(NULL, VXL_ERR_INVALID_ARGUMENT, "path, width or height is missing");
     *width = *height = 0;
-    if (has_ext(path, ".exr"))
-        return vxl_fail(NULL, VXL_ERR_FORMAT,
-                        "%s: OpenEXR environment maps are not read yet; convert it to Radiance .hdr "
-                        "(e.g. oiiotool in.exr -o out.hdr)",
-                        path);
+    if (has_ext(path, ".exr")) return exr_load(path, rgb, max_pixels, width, height);
     uint8_t *data = NULL;
     size_t size = 0;
     int rc = read_whole(path, &data, &size, &e);

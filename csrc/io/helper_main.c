@@ -169,6 +169,7 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
     vxl_err e = {0};
     vxl_volume *v = NULL;
     vxl_dicom_series *list = NULL;
+    float *image = NULL;
     const void *body = NULL, *colour = NULL, *channels = NULL;
     if (cmd->read) {
         h.status = (uint32_t)cmd->read(path, &opt, &v, &e);
@@ -177,6 +178,19 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
             body = v->texels;
             colour = v->colour;
             channels = v->channels;
+        }
+    } else if (cmd->image) {
+        uint32_t w = 0, ht = 0;
+        float *rgb = NULL;
+        h.status = (uint32_t)cmd->image(path, opt.memory_budget_bytes / (3 * sizeof(float)), &rgb, &w, &ht, &e);
+        if (h.status == VXL_OK) {
+            h.kind = VXL_REPLY_IMAGE;
+            h.dims[0] = w;
+            h.dims[1] = ht;
+            h.dims[2] = 1;
+            h.components = 3;
+            h.nbytes = (uint64_t)w * ht * 3 * sizeof(float);
+            body = image = rgb;
         }
     } else {
         uint32_t count = 0;
@@ -203,5 +217,6 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
     }
     vxl_volume_destroy(v);
     free(list);
+    free(image);
     return rc;
 }

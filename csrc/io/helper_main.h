@@ -15,6 +15,9 @@ typedef struct vxl_helper_command {
     /* exactly one of: */
     int (*read)(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
     int (*list)(const char *path, vxl_dicom_series **out, uint32_t *count, vxl_err *e);
+    /* an image of at most max_pixels pixels as malloc'd linear RGB float
+     * (3 a pixel, row 0 at the bottom) */
+    int (*image)(const char *path, uint64_t max_pixels, float **rgb, uint32_t *width, uint32_t *height, vxl_err *e);
 } vxl_helper_command;
 
 /* main() of a helper: parses argv (reader_stream.h), runs the command and
@@ -29,6 +32,9 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
 int vxl_image_stack_read(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 /* OpenVDB scalar grid through OpenImageIO's OpenVDB reader; in vdb.cpp. */
 int vxl_vdb_read(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* An OpenEXR World map through OpenImageIO; in environment_exr.cpp. */
+int vxl_environment_exr_read(const char *path, uint64_t max_pixels, float **rgb, uint32_t *width, uint32_t *height,
+                             vxl_err *e);
 /* DICOM through dcmtk: a folder, a DICOMDIR or one file of a series; in
  * dicom.cpp. */
 int vxl_dicom_read(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);

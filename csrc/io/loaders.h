@@ -31,6 +31,11 @@ int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volu
 int vxl_image_stack_reader_runs_here(void);
 /* OpenVDB scalar grid (vdb.cpp in voxlight-read-oiio). */
 int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
+/* An OpenEXR World map of at most max_pixels pixels (environment_exr.cpp in
+ * voxlight-read-oiio): *rgb is malloc'd linear RGB float, 3 a pixel, row 0
+ * at the bottom (free() it). */
+int vxl_environment_exr_load(const char *path, uint64_t max_pixels, float **rgb, uint32_t *width, uint32_t *height,
+                             vxl_err *e);
 /* DICOM: a folder, a DICOMDIR or one file of a series (dicom.cpp in
  * voxlight-read-dicom). */
 int vxl_dicom_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);

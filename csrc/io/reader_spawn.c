@@ -17,6 +17,7 @@
 #include "reader_spawn.h"
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -253,6 +254,16 @@ static int accept_header(const vxl_reader *r, const char *path, reply *rp, uint3
         rp->colour = colour;
         if ((rc = make_room(path, h->channel_bytes, "channels", &channels, &rp->channels_len, e))) return rc;
         rp->channels = channels;
+    } else if (kind == VXL_REPLY_IMAGE) {
+        /* the budget the library asked for is the image's bytes */
+        const uint64_t pixels = (uint64_t)h->dims[0] * h->dims[1];
+        if (h->dims[0] == 0 || h->dims[1] == 0 || h->dims[2] != 1 || h->components != 3 || h->colour_bytes ||
+            h->channel_count || h->channel_bytes ||
+            pixels > vxl_load_budget(opt) / (3 * sizeof(float)) || h->nbytes != pixels * 3 * sizeof(float))
+            return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s announced a %ux%ux%u image of %u components "
+                            "in %llu bytes", path, r->name, h->dims[0], h->dims[1], h->dims[2], h->components,
+                            (unsigned long long)h->nbytes);
+        rp->body_len = h->nbytes;
     } else {
         if (h->record_size != sizeof(vxl_dicom_series) || h->count > MAX_SERIES ||
             h->nbytes != (uint64_t)h->count * sizeof(vxl_dicom_series))
@@ -267,8 +278,9 @@ static int accept_header(const vxl_reader *r, const char *path, reply *rp, uint3
     return VXL_OK;
 }
 
-/* What a header cannot say: float texels in [0, 1], series records with
- * terminated strings and sane fields. */
+/* What a header cannot say: float texels in [0, 1], an image's radiance
+ * finite and not negative, series records with terminated strings and sane
+ * fields. */
 static int check_body(const vxl_reader *r, const char *path, const reply *rp, vxl_err *e)
 {
     const vxl_reader_header *h = &rp->h;
@@ -279,6 +291,14 @@ static int check_body(const vxl_reader *r, const char *path, const reply *rp, vx
             if (!(t[i] >= 0.0f && t[i] <= 1.0f))
                 return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent a texel outside [0, 1] at voxel "
                                 "%llu", path, r->name, (unsigned long long)i);
+        return VXL_OK;
+    }
+    if (h->kind == VXL_REPLY_IMAGE) {
+        const float *p = (const float *)rp->body;
+        for (uint64_t i = 0; i < h->nbytes / sizeof(float); i++)
+            if (!(p[i] >= 0.0f && p[i] <= FLT_MAX))
+                return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent a pixel value that is negative or not "
+                                "finite at %llu", path, r->name, (unsigned long long)i);
         return VXL_OK;
     }
     const vxl_dicom_series *s = (const vxl_dicom_series *)rp->body;

@@ -36,6 +36,7 @@
 #define VXL_CMD_DICOM "dicom"              /* DICOM series -> a volume */
 #define VXL_CMD_DICOM_SERIES "dicom-series" /* DICOM folder -> vxl_dicom_series[] */
 #define VXL_CMD_ZARR "zarr"                /* OME-Zarr level -> a volume */
+#define VXL_CMD_ENVIRONMENT "environment"  /* OpenEXR World map -> an image */
 
 /* argv: HELPER COMMAND PATH MAX_DIM BUDGET_BYTES VOXEL_X VOXEL_Y VOXEL_Z
  * FRAME SERIES OPACITY_SOURCE OPACITY_CHANNEL CHANNELS SCALAR_CHANNEL
@@ -54,6 +55,9 @@
 
 #define VXL_REPLY_VOLUME 1u /* body: the volume's texels */
 #define VXL_REPLY_SERIES 2u /* body: count vxl_dicom_series records */
+/* body: dims[0] x dims[1] pixels of linear RGB float (components 3, dims[2]
+ * 1), row 0 at the bottom; at most BUDGET_BYTES / 12 pixels */
+#define VXL_REPLY_IMAGE 3u
 
 /* The helper writes this header to stdout, then either msg_len bytes of
  * error message (status != 0) or nbytes of body, colour_bytes of colour and

@@ -1,7 +1,7 @@
 /* remote_readers.c - the loaders whose libraries (OpenImageIO, dcmtk) stay
  * out of libvoxlight.so: each runs its reader in a helper process
  * (reader_spawn.c, reader_stream.h) and rebuilds the volume from the
- * checked reply; vxl_dicom_list_series likewise. */
+ * checked reply; vxl_dicom_list_series and OpenEXR World maps likewise. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,6 +18,9 @@ static const vxl_reader stack_reader = {
     VXL_OIIO_SONAME, VXL_OIIO_PACKAGE, 1};
 static const vxl_reader vdb_reader = {
     VXL_HELPER_OIIO, VXL_HELPER_OIIO_ENV, "the OpenVDB reader", "OpenVDB files", "OpenImageIO",
+    VXL_OIIO_SONAME, VXL_OIIO_PACKAGE, 1};
+static const vxl_reader environment_reader = {
+    VXL_HELPER_OIIO, VXL_HELPER_OIIO_ENV, "the OpenEXR reader", "OpenEXR environment maps", "OpenImageIO",
     VXL_OIIO_SONAME, VXL_OIIO_PACKAGE, 1};
 static const vxl_reader dicom_reader = {
     VXL_HELPER_DICOM, VXL_HELPER_DICOM_ENV, "the DICOM reader", "DICOM series", "dcmtk",
@@ -136,6 +139,26 @@ int vxl_image_stack_load(const char *path, const vxl_load_options *opt, vxl_volu
 int vxl_vdb_load(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     return load_remote(&vdb_reader, VXL_CMD_VDB, 0, 0, path, opt, out, e);
+}
+
+int vxl_environment_exr_load(const char *path, uint64_t max_pixels, float **rgb, uint32_t *width, uint32_t *height,
+                             vxl_err *e)
+{
+    *rgb = NULL;
+    *width = *height = 0;
+    vxl_path_info st;
+    if (vxl_path_stat(path, &st)) return vxl_fail(e, VXL_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    /* the helper's budget is the image's bytes (VXL_REPLY_IMAGE) */
+    vxl_load_options opt = {.struct_size = sizeof opt, .memory_budget_bytes = max_pixels * 3 * sizeof(float)};
+    vxl_reader_header h;
+    void *body = NULL;
+    int rc = vxl_reader_run(&environment_reader, VXL_CMD_ENVIRONMENT, path, &opt, VXL_REPLY_IMAGE,
+                            input_bytes(path, &st, 0, 0), &h, &body, NULL, NULL, e);
+    if (rc) return rc;
+    *rgb = body;
+    *width = h.dims[0];
+    *height = h.dims[1];
+    return VXL_OK;
 }
 
 /* DICOMDIR trees are searched a few levels deep (dicom.cpp). */

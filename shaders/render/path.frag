@@ -6,13 +6,19 @@
 //    skipping brick (render/path.c; a brick of majorant 0 is crossed at
 //    once), with the extinction -ln(1 - a) per voxel of path of the table's
 //    opacity a, the medium the ray caster composites;
-//  - at each collision, SCATTER's lighting there (lib/shading.glsl's
-//    shade_lit_sum: the lamps times their transmittance from the
-//    illumination volumes, which carry the scene's mesh shadows, the ambient
-//    term or the World's irradiance, the surface term where the gradient is
-//    strong), unclamped, times the path's throughput: next-event estimation
-//    through the same volumes `scatter` reads, so one collision is exactly
-//    `scatter`'s sum, integrated along the ray instead of in steps;
+//  - at each collision after the first, SCATTER's lighting there
+//    (lib/shading.glsl's shade_lit_sum: the lamps times their transmittance
+//    from the illumination volumes, which carry the scene's mesh shadows, the
+//    ambient term or the World's irradiance, the surface term where the
+//    gradient is strong), unclamped, times the path's throughput: next-event
+//    estimation through the same volumes `scatter` reads;
+//  - the first collision's lighting is not sampled but integrated along the
+//    eye ray by the deterministic march that also gives alpha (the same sum,
+//    T a S per step, that `scatter` composites, unclamped): it is most of the
+//    light in all but thick, bright media, and a free flight that may or may
+//    not collide was most of a sample's noise (on the Blender tests' ball,
+//    RMSE 0.083 a sample against Cycles; docs/lighting.md). The random walk
+//    still starts with a free flight from the eye, to carry the bounces;
 //  - then, up to u_path_bounces collisions, a new direction: the surface
 //    lobe with probability w (cosine-weighted about the normal, throughput
 //    times min(diffuse, 1) * colour: a material's diffuse above 1 brightens
@@ -20,9 +26,9 @@
 //    the Henyey-Greenstein lobe (throughput times the colour, the
 //    single-scattering albedo), so the throughput never exceeds 1.
 // A path that leaves the volume adds nothing more: the lamps and the World
-// were counted at every collision already. Alpha and depth come from a
-// deterministic emission-absorption march of the same opacity, so they are
-// free of noise and the same in every call.
+// were counted at every collision already. Alpha and depth come from the
+// same deterministic march of the same opacity, so they are free of noise
+// and the same in every call.
 // Random numbers: each sample's first 16 dimensions (4 per collision: the
 // first free flight, the lobe, the direction's two) are a rank-1 lattice
 // over the sample index (a Kronecker sequence with the fractional parts of
@@ -192,8 +198,20 @@ float hg_cos(float g, float u)
 
 // ---- one sample -------------------------------------------------------------
 
+// The medium's albedo at p of value v: the table's colour, or a colour
+// volume's own.
+vec3 albedo_at(vec3 p, float v)
+{
+#ifdef DATA_COLOUR
+    return data_colour(p);
+#else
+    return classify(v).rgb;
+#endif
+}
+
 // Radiance (premultiplied: 0 where the path leaves without colliding) of one
-// random walk from o along d over [t0, t1], all in voxel space.
+// random walk from o along d over [t0, t1], all in voxel space, without the
+// light of its first collision (path_primary integrates that).
 vec3 path_sample(vec3 o, vec3 d, float t0, float t1, mat3 to_voxel, bool one_directional, inout PathRng rng)
 {
     vec3 radiance = vec3(0.0), throughput = vec3(1.0);
@@ -201,14 +219,13 @@ vec3 path_sample(vec3 o, vec3 d, float t0, float t1, mat3 to_voxel, bool one_dir
         float t, v;
         if (!track(o, d, t0, t1, path_stratified(rng, k, 0), rng, t, v)) break;
         vec3 p = o + t * d;
-        vec3 rgb = classify(v).rgb;
-#ifdef DATA_COLOUR
-        rgb = data_colour(p);
-#endif
+        vec3 rgb = albedo_at(p, v);
         vec3 g = gradient_at(p, v);
         vec3 travel = normalize(mat3(u_mv) * d); // view space
-        RayLighting rl = ray_lighting(-travel);
-        radiance += throughput * shade_lit_sum(rgb, g, (u_mv * vec4(p, 1.0)).xyz, p, rl, one_directional);
+        if (k > 0) {
+            RayLighting rl = ray_lighting(-travel);
+            radiance += throughput * shade_lit_sum(rgb, g, (u_mv * vec4(p, 1.0)).xyz, p, rl, one_directional);
+        }
         if (k + 1 == u_path_bounces) break;
         vec3 n = u_normal_matrix * g;
         float len = length(n);
@@ -234,11 +251,18 @@ vec3 path_sample(vec3 o, vec3 d, float t0, float t1, mat3 to_voxel, bool one_dir
 }
 
 // The ray's opacity and depth as the emission-absorption march composites
-// them (raycast.frag without jitter), over bricks of majorant 0 at once.
-float path_alpha(vec3 o, vec3 d, float t0, float t1, float z0, float dz, out float depth)
+// them (raycast.frag without jitter), over bricks of majorant 0 at once, and
+// the light of the first collision along it: the sum over steps of the
+// transmittance before the step, the step's opacity and SCATTER's lighting
+// there (unclamped), which is what the first collision's next-event
+// estimate averages to, up to the step.
+float path_primary(vec3 o, vec3 d, float t0, float t1, float z0, float dz, bool one_directional, out float depth,
+                   out vec3 direct)
 {
     float T = 1.0;
     depth = PATH_INF;
+    direct = vec3(0.0);
+    RayLighting rl = ray_lighting(-normalize(mat3(u_mv) * d));
     float bs = float(u_path_brick);
     ivec3 top = textureSize(u_majorant, 0) - 1;
     for (int i = 0; i < u_max_steps; i++) {
@@ -251,7 +275,13 @@ float path_alpha(vec3 o, vec3 d, float t0, float t1, float z0, float dz, out flo
             continue;
         }
         g_lookups++;
-        T *= 1.0 - correct_opacity(classify(sample_value(p)).a, u_step);
+        float v = sample_value(p);
+        float a = correct_opacity(classify(v).a, u_step);
+        if (a > 0.0)
+            direct += T * a *
+                      shade_lit_sum(albedo_at(p, v), gradient_at(p, v), (u_mv * vec4(p, 1.0)).xyz, p, rl,
+                                    one_directional);
+        T *= 1.0 - a;
         if (isinf(depth) && 1.0 - T >= u_depth_threshold) depth = -(z0 + dz * t);
         if (1.0 - T >= u_early_termination) break;
     }
@@ -287,11 +317,12 @@ void main()
     if (!path_keep(o, dir, t0, t1)) { emit_nothing(); return; }
 
     float depth;
-    float alpha = path_alpha(o, dir, t0, t1, z0, dz, depth);
+    vec3 direct;
+    bool one_directional = u_light_count == 1 && u_light_pos[0].w == 0.0;
+    float alpha = path_primary(o, dir, t0, t1, z0, dz, one_directional, depth, direct);
     vec3 sum = vec3(0.0);
-    {
+    if (u_path_bounces > 1) {
         mat3 to_voxel = inverse(mat3(u_mv));
-        bool one_directional = u_light_count == 1 && u_light_pos[0].w == 0.0;
         uvec2 px = uvec2(gl_FragCoord.xy);
         PathRng rng;
         rng.pixel = path_hash(px.x ^ path_hash(px.y ^ path_hash(u_path_seed + 0x5bd1e995u)));
@@ -305,6 +336,6 @@ void main()
     if (old + g_lookups < old) atomicAdd(st_samples_hi, 1u);
     atomicMax(st_max_ray, g_lookups);
     atomicAdd(st_rays, 1u);
-    o_color = vec4(sum / float(u_path_samples), alpha);
+    o_color = vec4(direct + sum / float(u_path_samples), alpha);
     o_depth = depth;
 }

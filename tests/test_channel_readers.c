@@ -25,15 +25,6 @@ enum { X = 7, Y = 6, Z = 5, V = X * Y * Z };
 
 static char g_dir[64];
 
-static vxl_volume_info info_of(const vxl_volume *v)
-{
-    vxl_volume_info in;
-    memset(&in, 0, sizeof in);
-    in.struct_size = sizeof in;
-    vxl_volume_get_info(v, &in);
-    return in;
-}
-
 static vxl_volume *load(const char *name, uint32_t channels_mode, uint64_t budget)
 {
     char path[256];
@@ -86,7 +77,7 @@ TEST(ome_zarr_c_axis_loads_as_channels_with_omero_metadata)
     vxl_volume *v = load("omero.zarr", VXL_CHANNELS_AUTO, 0), *ref = reference("omero", 3);
     same_channels(T_, "omero.zarr", v, ref);
     REQUIRE(v);
-    const vxl_volume_info in = info_of(v);
+    const vxl_volume_info in = volume_info_of(v);
     CHECKF(strstr(in.notes, "OME-Zarr c axis: 3 channels (channel 0 is the scalar)") != NULL, "notes '%s'", in.notes);
     CHECK(!strcmp(in.channel_names[0], "DAPI") && !strcmp(in.channel_names[1], "GFP") &&
           !strcmp(in.channel_names[2], "mCherry") && !in.channel_names[3][0]);
@@ -102,11 +93,11 @@ TEST(ome_zarr_c_axis_loads_as_channels_with_omero_metadata)
     vxl_volume_destroy(ref);
     /* "#c=1" and channels OFF: one channel, as before */
     v = load("omero.zarr#c=1", VXL_CHANNELS_AUTO, 0);
-    CHECKF(v && info_of(v).channel_count == 0, "#c=1: %s", vxl_last_error());
-    if (v) CHECK(info_of(v).value_min == 4 && info_of(v).value_max == 134); /* channel 1's range */
+    CHECKF(v && volume_info_of(v).channel_count == 0, "#c=1: %s", vxl_last_error());
+    if (v) CHECK(volume_info_of(v).value_min == 4 && volume_info_of(v).value_max == 134); /* channel 1's range */
     vxl_volume_destroy(v);
     v = load("omero.zarr", VXL_CHANNELS_OFF, 0);
-    CHECKF(v && info_of(v).channel_count == 0 && info_of(v).value_max == 63, "off: %s", vxl_last_error());
+    CHECKF(v && volume_info_of(v).channel_count == 0 && volume_info_of(v).value_max == 63, "off: %s", vxl_last_error());
     vxl_volume_destroy(v);
 }
 
@@ -122,7 +113,7 @@ TEST(tiff_samples_and_ome_tiff_planes_load_as_channels)
         vxl_volume *v = load(cases[k].file, VXL_CHANNELS_AUTO, 0), *ref = reference(cases[k].ref, cases[k].n);
         same_channels(T_, cases[k].file, v, ref);
         if (v) {
-            const vxl_volume_info in = info_of(v);
+            const vxl_volume_info in = volume_info_of(v);
             CHECKF(strstr(in.notes, cases[k].note) != NULL, "%s: notes '%s'", cases[k].file, in.notes);
             if (cases[k].named) {
                 CHECK(!strcmp(in.channel_names[0], "DAPI") && !strcmp(in.channel_names[2], "mCherry"));
@@ -139,12 +130,12 @@ TEST(tiff_samples_and_ome_tiff_planes_load_as_channels)
     }
     /* channels OFF: as before: three samples are RGB colour, OME pages are slices */
     vxl_volume *v = load("three_samples.tif", VXL_CHANNELS_OFF, 0);
-    CHECKF(v && info_of(v).components == 3 && info_of(v).channel_count == 0, "%s", vxl_last_error());
+    CHECKF(v && volume_info_of(v).components == 3 && volume_info_of(v).channel_count == 0, "%s", vxl_last_error());
     vxl_volume_destroy(v);
     v = load("cells.ome.tif", VXL_CHANNELS_OFF, 0);
-    CHECKF(v && info_of(v).dims[2] == 3 * Z && info_of(v).channel_count == 0 &&
-               strstr(info_of(v).notes, "SizeC=3 not used (channels off)"),
-           "%s", v ? info_of(v).notes : vxl_last_error());
+    CHECKF(v && volume_info_of(v).dims[2] == 3 * Z && volume_info_of(v).channel_count == 0 &&
+               strstr(volume_info_of(v).notes, "SizeC=3 not used (channels off)"),
+           "%s", v ? volume_info_of(v).notes : vxl_last_error());
     vxl_volume_destroy(v);
 }
 
@@ -153,8 +144,8 @@ TEST(metaimage_element_channels_load_as_channels)
     vxl_volume *v = load("five.mha", VXL_CHANNELS_AUTO, 0), *ref = reference("five", 5);
     same_channels(T_, "five.mha", v, ref);
     if (v) {
-        CHECKF(strstr(info_of(v).notes, "MetaImage ElementNumberOfChannels: 5 channels") != NULL, "notes '%s'",
-               info_of(v).notes);
+        CHECKF(strstr(volume_info_of(v).notes, "MetaImage ElementNumberOfChannels: 5 channels") != NULL, "notes '%s'",
+               volume_info_of(v).notes);
         /* MetaImage geometry is LPS: x and y spacing negated into RAS */
         CHECK(v->affine[0] == -0.5 && v->affine[5] == -0.5 && v->affine[10] == 2.0);
     }

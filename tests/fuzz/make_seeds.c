@@ -106,15 +106,16 @@ int main(int argc, char **argv)
                             "NDims = 3\nDimSize = 4 2 1\nElementNumberOfChannels = 3\nElementType = MET_UCHAR\n"
                             "CompressedData = True\nElementDataFile = LOCAL\n", u8, sizeof u8, TW_ZLIB, NULL),
        "mha rgb zlib");
-    /* channels: 2 (channels under AUTO) and 6 a voxel */
-    ok(tw_write_header_data(path("metaimage", "seed_2ch.mha"),
-                            "NDims = 3\nDimSize = 4 3 1\nElementNumberOfChannels = 2\nElementType = MET_UCHAR\n"
-                            "ElementDataFile = LOCAL\n", u8, sizeof u8, TW_RAW, NULL),
-       "mha 2 channels");
-    ok(tw_write_header_data(path("metaimage", "seed_6ch_zlib.mha"),
-                            "NDims = 3\nDimSize = 2 2 1\nElementNumberOfChannels = 6\nElementType = MET_UCHAR\n"
-                            "CompressedData = True\nElementDataFile = LOCAL\n", u8, sizeof u8, TW_ZLIB, NULL),
-       "mha 6 channels zlib");
+    /* channels (the multi-channel volume's path): 2 and 6 a voxel, the 24 bytes of u8 */
+    static const struct { const char *name, *header; int codec; } mha_channels[] = {
+        {"seed_2ch.mha", "NDims = 3\nDimSize = 4 3 1\nElementNumberOfChannels = 2\nElementType = MET_UCHAR\n"
+                         "ElementDataFile = LOCAL\n", TW_RAW},
+        {"seed_6ch_zlib.mha", "NDims = 3\nDimSize = 2 2 1\nElementNumberOfChannels = 6\nElementType = MET_UCHAR\n"
+                              "CompressedData = True\nElementDataFile = LOCAL\n", TW_ZLIB},
+    };
+    for (size_t i = 0; i < sizeof mha_channels / sizeof mha_channels[0]; i++)
+        ok(tw_write_header_data(path("metaimage", mha_channels[i].name), mha_channels[i].header, u8, sizeof u8,
+                                mha_channels[i].codec, NULL), mha_channels[i].name);
 
     /* TIFF */
     ok(tw_write_tiff(path("tiff", "seed_u8_pages.tif"), 4, 3, 2, 1, 8, 1, u8), "tiff u8 pages");

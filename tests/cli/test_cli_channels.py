@@ -20,7 +20,7 @@ from test_cli import assert_clean_error, png_rgba, run, write_nifti
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from channel_files_write import (COLORS, NAMES, stack, write_mha, write_ome_tiff, write_omero_zarr,  # noqa: E402
-                                 write_sample_tiff)
+                                 write_sample_tiff, write_tiff)
 
 N = 20
 VIEW = ["--size", "%dx%d" % (N, N), "--ortho", "--no-jitter", "--no-shading", "--view", "z"]
@@ -207,3 +207,19 @@ def test_bad_channel_files_are_clean_errors(formats, tmp_path):
     nine = tmp_path / "nine.mha"
     write_mha(nine, stack(9, (4, 4, 4), np.uint16))
     assert_clean_error(run("info", nine), "9 channels per voxel is not supported", "2 to 8 channels")
+
+
+def test_an_ome_tiff_time_point_is_the_frame(tmp_path):
+    """SizeT 2, XYZCT: page z + 3 (c + 2 t) holds 100 t + 10 c + z; --frame t reads t's planes."""
+    xml = ('<OME><Image><Pixels DimensionOrder="XYZCT" SizeX="5" SizeY="4" SizeZ="3" SizeC="2" SizeT="2">'
+           '<Channel Name="a"/><Channel Name="b"/></Pixels></Image></OME>')
+    pages = [np.full((4, 5), 100 * t + 10 * c + z, np.uint16) for t in range(2) for c in range(2) for z in range(3)]
+    path = tmp_path / "t.ome.tif"
+    write_tiff(path, pages, description=xml)
+    for t in (0, 1):
+        res = run("info", path, "--frame", str(t))
+        assert res.returncode == 0, res.stderr
+        assert f"frames:      2 (this is frame {t}" in res.stdout
+        assert channel_lines(res.stdout) == [f'channel 0: {100 * t} .. {100 * t + 2}  "a"',
+                                             f'channel 1: {100 * t + 10} .. {100 * t + 12}  "b"']
+    assert_clean_error(run("info", path, "--frame", "2"), "frame 2 asked for, the OME-TIFF has 2 time points")

@@ -78,7 +78,7 @@ OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(LIB_C))) $(BUILD)/obj/shaders_
 # The platform room's files for this OS (csrc/platform/), for whatever links
 # library objects without the library.
 PLATFORM := dynlib dynlib_posix threads_posix files files_posix process_posix clock_posix os_posix
-HELPER_CORE_NAMES := helper_main volume colour_volume channel_volume brick_source error loader_util zlib_api
+HELPER_CORE_NAMES := helper_main volume colour_volume channel_volume channel_meta ome_xml brick_source error loader_util zlib_api
 HELPER_CORE := $(patsubst %,$(BUILD)/obj/%.o,$(HELPER_CORE_NAMES) helper_self_posix $(PLATFORM))
 HELPERS := $(BUILD)/voxlight-read-oiio $(BUILD)/voxlight-read-dicom $(BUILD)/voxlight-read-dicom-own \
 	$(BUILD)/voxlight-read-zarr $(BUILD)/voxlight-write-vdb
@@ -434,7 +434,7 @@ FUZZ_CXXFLAGS := -std=c++17 $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link -Icsrc
 	$(shell pkg-config --cflags OpenImageIO)
 # the core's loaders and dispatch (the helper-run readers are called
 # in-process by their targets: libFuzzer sees coverage in its own process only)
-FUZZ_LIB_C := volume.c colour_volume.c channel_volume.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
+FUZZ_LIB_C := volume.c colour_volume.c channel_volume.c channel_meta.c ome_xml.c volume_load.c error.c nifti.c nrrd.c metaimage.c loader_util.c dicom_detect.c \
 	reader_spawn.c remote_readers.c label_table.c zarr_detect.c $(notdir $(ZARR_C)) zarr_source.c brick_source.c
 # the brick cache of .nii.gz files and the TIFF directory walk: opened by the loaders, read by
 # fuzz_brick_cache and fuzz_tiff_layout; the Radiance reader of World maps, read by fuzz_hdr

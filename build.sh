@@ -451,7 +451,7 @@ case "$cmd" in
         [ "$TOTAL_FAIL" -eq 0 ] ;;
     fuzz)
         # ./build.sh fuzz [SECONDS [TARGET...]]: each loader's libFuzzer target
-        # (nifti nrrd metaimage tiff png dicom dicom_own vdb label_table zarr brick_cache tiff_layout dicom_codecs hdr) for SECONDS (default 300);
+        # (nifti nrrd metaimage tiff png dicom dicom_own vdb label_table zarr brick_cache tiff_layout dicom_codecs hdr ome_xml) for SECONDS (default 300);
         # crashes are kept in tests/crashers/<target>/. SECONDS "replay":
         # replay tests/crashers/ only
         install_deps; build

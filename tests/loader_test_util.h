@@ -1,5 +1,5 @@
 /* loader_test_util.h - helpers the loader tests share: removing their temp
- * tree, reading and writing whole files, and reading a loaded volume's data values back from its texels
+ * tree, reading and writing whole files, a volume's info, and reading a loaded volume's data values back from its texels
  * (layout from volume.h), so byte-order, offset or ordering mistakes show up
  * as wrong values. */
 #ifndef VXL_LOADER_TEST_UTIL_H
@@ -92,6 +92,16 @@ static inline long peak_rss_kb(int reset)
         if (!strncmp(line, "VmHWM:", 6)) kb = strtol(line + 6, NULL, 10);
     fclose(f);
     return kb;
+}
+
+/* Everything vxl_volume_get_info says of v (all zero when it fails). */
+__attribute__((unused)) static vxl_volume_info volume_info_of(const vxl_volume *v)
+{
+    vxl_volume_info in;
+    memset(&in, 0, sizeof in);
+    in.struct_size = sizeof in;
+    vxl_volume_get_info(v, &in);
+    return in;
 }
 
 #endif

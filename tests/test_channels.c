@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "loader_test_util.h"
 #include "nifti_writer.h"
 #include "test_util.h"
 
@@ -608,15 +609,6 @@ static int render_channels(vxl_renderer *r, const vxl_volume *v, uint32_t count,
     return render(r, &p, out);
 }
 
-static vxl_volume_info info_of(const vxl_volume *v)
-{
-    vxl_volume_info in;
-    memset(&in, 0, sizeof in);
-    in.struct_size = sizeof in;
-    vxl_volume_get_info(v, &in);
-    return in;
-}
-
 TEST(nifti_5d_and_nrrd_channel_axes_load_as_channels)
 {
     const size_t V = (size_t)N * N * N;
@@ -640,7 +632,7 @@ TEST(nifti_5d_and_nrrd_channel_axes_load_as_channels)
     vxl_volume *v = NULL, *ref = channels_volume(mem, 3, 0);
     CHECKF(vxl_volume_load(path, &lo, &v) == VXL_OK, "five.nii.gz: %s", vxl_last_error());
     REQUIRE(v && ref);
-    vxl_volume_info in = info_of(v);
+    vxl_volume_info in = volume_info_of(v);
     CHECKF(in.channel_count == 3 && in.frame_count == 2 && in.frame == 1, "channels %u frames %u", in.channel_count,
            in.frame_count);
     CHECKF(strstr(in.notes, "NIfTI dim[5]: 3 channels (channel 0 is the scalar)") != NULL, "notes '%s'", in.notes);
@@ -653,7 +645,7 @@ TEST(nifti_5d_and_nrrd_channel_axes_load_as_channels)
     v = NULL;
     CHECK(vxl_volume_load(path, &lo, &v) == VXL_OK && v);
     if (v) {
-        in = info_of(v);
+        in = volume_info_of(v);
         CHECK(in.channel_count == 0 && in.frame_count == 6);
         vxl_volume_destroy(v);
     }
@@ -676,7 +668,7 @@ TEST(nifti_5d_and_nrrd_channel_axes_load_as_channels)
     ref = channels_volume(g_six, 5, 0);
     CHECKF(vxl_volume_load(path, NULL, &v) == VXL_OK, "five.nrrd: %s", vxl_last_error());
     REQUIRE(v && ref);
-    in = info_of(v);
+    in = volume_info_of(v);
     CHECKF(in.channel_count == 5 && strstr(in.notes, "NRRD channel axis: 5 channels"), "notes '%s'", in.notes);
     REQUIRE(render_channels(r, v, 5, A) == VXL_OK && render_channels(r, ref, 5, B) == VXL_OK);
     CHECK(memcmp(A, B, sizeof A) == 0);
@@ -693,12 +685,12 @@ TEST(nifti_5d_and_nrrd_channel_axes_load_as_channels)
     CHECK(fwrite(hdr, 1, (size_t)n, f) == (size_t)n && fwrite(inter, 1, 3 * V * 2, f) == 3 * V * 2);
     fclose(f);
     v = NULL;
-    CHECK(vxl_volume_load(path, NULL, &v) == VXL_OK && v && info_of(v).components == 3 && info_of(v).channel_count == 0);
+    CHECK(vxl_volume_load(path, NULL, &v) == VXL_OK && v && volume_info_of(v).components == 3 && volume_info_of(v).channel_count == 0);
     vxl_volume_destroy(v);
     v = NULL;
     vxl_load_options on = {.struct_size = sizeof on, .channels = VXL_CHANNELS_ON, .scalar_channel = 2};
-    CHECK(vxl_volume_load(path, &on, &v) == VXL_OK && v && info_of(v).channel_count == 3 &&
-          info_of(v).scalar_channel == 2 && info_of(v).components == 1);
+    CHECK(vxl_volume_load(path, &on, &v) == VXL_OK && v && volume_info_of(v).channel_count == 3 &&
+          volume_info_of(v).scalar_channel == 2 && volume_info_of(v).components == 1);
     vxl_volume_destroy(v);
     unlink(path);
     snprintf(path, sizeof path, "%s/five.nii.gz", g_dir);

@@ -417,10 +417,12 @@ TEST(metaimage_hostile_headers_give_clear_errors)
     expect_error(T_, p, NULL, VXL_ERR_FORMAT, "ElementDataFile", NULL);
     write_text(p, "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR_ARRAY\nElementDataFile = LOCAL\n");
     expect_error(T_, p, NULL, VXL_ERR_FORMAT, "ElementType", NULL);
-    /* 3 and 4 channels are colour (test_colour_readers.c); 2 is neither */
-    write_text(p, "NDims = 3\nDimSize = 2 2 2\nElementNumberOfChannels = 2\nElementType = MET_UCHAR\n"
+    /* 3 and 4 channels are colour (test_colour_readers.c), 2..8 channels
+     * (test_channel_readers.c); 9 is neither */
+    write_text(p, "NDims = 3\nDimSize = 2 2 2\nElementNumberOfChannels = 9\nElementType = MET_UCHAR\n"
                   "ElementDataFile = LOCAL\n");
-    expect_error(T_, p, NULL, VXL_ERR_FORMAT, "2 channels per voxel is not supported (1, or 3 and 4 as RGB", NULL);
+    expect_error(T_, p, NULL, VXL_ERR_FORMAT, "9 channels per voxel is not supported (1, 3 and 4 as RGB and RGBA "
+                 "colour, or 2 to 8 channels)", NULL);
     write_text(p, "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\nCompressedData = True\n"
                   "ElementDataFile = LOCAL\nnot zlib");
     expect_error(T_, p, NULL, VXL_ERR_FORMAT, "compressed", NULL);

@@ -172,6 +172,18 @@ void vxl_cli_channels_print_info(const vxl_volume_info *in, FILE *out)
     fprintf(out, "channels:    %u (the scalar is channel %u, --channel N; %.1f MiB as 16 bits a channel; "
                  "--channels draws them)\n",
             in->channel_count, in->scalar_channel, in->channel_bytes / 1048576.0);
-    for (uint32_t k = 0; k < in->channel_count && k < VXL_MAX_CHANNELS; k++)
-        fprintf(out, "  channel %u: %g .. %g\n", k, in->channel_min[k], in->channel_max[k]);
+    for (uint32_t k = 0; k < in->channel_count && k < VXL_MAX_CHANNELS; k++) {
+        fprintf(out, "  channel %u: %g .. %g", k, in->channel_min[k], in->channel_max[k]);
+        /* what the file says of it: the colour as the file's sRGB hex, as
+         * OME writes it (--channel-color takes linear values) */
+        if (in->channel_names[k][0]) fprintf(out, "  \"%s\"", in->channel_names[k]);
+        if (in->channel_color_known[k])
+            fprintf(out, "  colour #%02X%02X%02X (sRGB)", (unsigned)(in->channel_colors[k][0] * 255.0f + 0.5f),
+                    (unsigned)(in->channel_colors[k][1] * 255.0f + 0.5f),
+                    (unsigned)(in->channel_colors[k][2] * 255.0f + 0.5f));
+        if (in->channel_window_known[k])
+            fprintf(out, "  window %g .. %g", in->channel_window_low[k], in->channel_window_high[k]);
+        if (!in->channel_active[k]) fputs("  hidden in the file", out);
+        fputc('\n', out);
+    }
 }

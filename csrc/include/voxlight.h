@@ -221,11 +221,16 @@ typedef struct vxl_load_options {
      * report) is channel scalar_channel. Which inputs load as channels:
      *   AUTO (0)  an axis that cannot be colour: NIfTI 5D whose dim[5] > 1
      *             is not an RGB(A) vector (dim[4] counts the frames), NRRD
-     *             whose component axis has more than 4 entries
+     *             whose component axis and MetaImage whose
+     *             ElementNumberOfChannels is 2 or 5..8, an OME-Zarr c axis
+     *             of 2..8 (without "#c=N"), a TIFF of 2..8 grey samples,
+     *             an OME-TIFF whose OME-XML says SizeC 2..8
      *   ON        also a 2..4-entry axis that AUTO leaves as it was (colour,
-     *             or a 5D NIfTI's frames)
-     *   OFF       none: NIfTI 5D counts every volume as a frame and NRRD
-     *             refuses a component axis over 4, as before channels
+     *             RGB(A) or grey+alpha samples, or a 5D NIfTI's frames)
+     *   OFF       none: NIfTI 5D counts every volume as a frame, NRRD and
+     *             MetaImage refuse what cannot be colour, OME-Zarr reads
+     *             channel 0, TIFF its first samples and OME-TIFF its pages
+     *             as slices, as before channels
      * The volume's notes say which was chosen and why. */
     uint32_t channels;            /* VXL_CHANNELS_* */
     uint32_t scalar_channel;      /* which channel is the scalar; 0 = the first */
@@ -236,6 +241,7 @@ typedef struct vxl_load_options {
 #define VXL_CHANNELS_OFF 2
 #define VXL_CHANNELS_COUNT 3
 #define VXL_MAX_CHANNELS 8 /* channels of one volume, sampled in one ray march */
+#define VXL_CHANNEL_NAME_MAX 64 /* vxl_volume_info.channel_names[c], its NUL included */
 VXL_API const char *vxl_channels_mode_name(uint32_t mode); /* "auto", "on", "off" */
 VXL_API int vxl_channels_mode_from_name(const char *name, uint32_t *out);
 
@@ -322,6 +328,28 @@ typedef struct vxl_volume_info {
     double channel_min[VXL_MAX_CHANNELS]; /* each channel's finite data range (after scaling) */
     double channel_max[VXL_MAX_CHANNELS];
     uint64_t channel_bytes;     /* bytes of the channels on the GL side (16 bits a channel a voxel) */
+    /* Appended (what a multi-channel file says about its channels: OME-Zarr's
+     * "omero" metadata, OME-TIFF's OME-XML <Channel>): written only when
+     * struct_size covers them; zero (and "" names) where the file says
+     * nothing, for channels >= channel_count and for volumes without
+     * channels. docs/channels.md lists what each format fills. */
+    char channel_names[VXL_MAX_CHANNELS][VXL_CHANNEL_NAME_MAX]; /* UTF-8, NUL-terminated; "" unnamed */
+    /* The file's display colour as it wrote it: sRGB, display-referred, each
+     * component in [0, 1] (OME's "RRGGBB" / 0xRRGGBBAA divided by 255), NOT
+     * decoded to linear. A renderer working in scene-linear decodes it
+     * (vxl_render_params' channel colours are linear). Meaningful only where
+     * channel_color_known[c] is 1. */
+    float channel_colors[VXL_MAX_CHANNELS][3];
+    uint32_t channel_color_known[VXL_MAX_CHANNELS];
+    /* The file's display window (data units of that channel: omero
+     * "window" start/end), meaningful where channel_window_known[c] is 1. */
+    double channel_window_low[VXL_MAX_CHANNELS];
+    double channel_window_high[VXL_MAX_CHANNELS];
+    uint32_t channel_window_known[VXL_MAX_CHANNELS];
+    /* 1: shown at first (the file says so, or says nothing); 0: the file
+     * marks the channel hidden (omero "active": false). Only for
+     * c < channel_count. */
+    uint32_t channel_active[VXL_MAX_CHANNELS];
 } vxl_volume_info;
 
 VXL_API int vxl_volume_load(const char *path, const vxl_load_options *opt, vxl_volume **out);

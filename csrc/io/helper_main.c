@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "channel_volume.h"
 #include "colour_volume.h"
 #include "helper_self.h"
 #include "os.h"
@@ -45,7 +46,7 @@ static int parse_double(const char *s, double *out)
 /* argv[3..] into options; 0 when malformed. */
 static int parse_options(char **argv, vxl_load_options *opt)
 {
-    unsigned long long max_dim, budget, frame, source, channel;
+    unsigned long long max_dim, budget, frame, source, channel, channels, scalar_channel;
     memset(opt, 0, sizeof *opt);
     opt->struct_size = sizeof *opt;
     if (!parse_u64(argv[3], &max_dim) || max_dim > UINT32_MAX || !parse_u64(argv[4], &budget)) return 0;
@@ -63,6 +64,12 @@ static int parse_options(char **argv, vxl_load_options *opt)
         return 0;
     opt->opacity_source = (uint32_t)source;
     opt->opacity_channel = (uint32_t)channel;
+    /* checked by the readers (vxl_load_channels_mode), as in process */
+    if (!parse_u64(argv[12], &channels) || channels > UINT32_MAX || !parse_u64(argv[13], &scalar_channel) ||
+        scalar_channel > UINT32_MAX)
+        return 0;
+    opt->channels = (uint32_t)channels;
+    opt->scalar_channel = (uint32_t)scalar_channel;
     return 1;
 }
 
@@ -117,6 +124,10 @@ static void volume_header(const vxl_volume *v, vxl_reader_header *h)
     h->colour_bytes = vxl_volume_colour_bytes(v);
     /* a reader's notes are terminated; a full array is cut, not sent open */
     snprintf(h->notes, sizeof h->notes, "%s", v->notes);
+    if (v->channels) {
+        vxl_reader_channel_fields(h, (vxl_volume *)v, 1);
+        h->channel_bytes = vxl_volume_channel_bytes(v);
+    }
 }
 
 int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_command *cmds, int n_cmds)
@@ -133,7 +144,7 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
     vxl_load_options opt;
     if (!cmd || !parse_options(argv, &opt)) {
         fprintf(stderr, "usage: %s COMMAND FILE MAX_DIM BUDGET_BYTES VOXEL_X VOXEL_Y VOXEL_Z FRAME SERIES "
-                "OPACITY_SOURCE OPACITY_CHANNEL "
+                "OPACITY_SOURCE OPACITY_CHANNEL CHANNELS SCALAR_CHANNEL "
                 "(started by libvoxlight; commands:", helper);
         for (int i = 0; i < n_cmds; i++) fprintf(stderr, " %s", cmds[i].name);
         fputs(")\n", stderr);
@@ -159,13 +170,14 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
     vxl_volume *v = NULL;
     vxl_dicom_series *list = NULL;
     float *image = NULL;
-    const void *body = NULL, *colour = NULL;
+    const void *body = NULL, *colour = NULL, *channels = NULL;
     if (cmd->read) {
         h.status = (uint32_t)cmd->read(path, &opt, &v, &e);
         if (h.status == VXL_OK) {
             volume_header(v, &h);
             body = v->texels;
             colour = v->colour;
+            channels = v->channels;
         }
     } else if (cmd->image) {
         uint32_t w = 0, ht = 0;
@@ -198,7 +210,8 @@ int vxl_helper_main(const char *helper, int argc, char **argv, const vxl_helper_
         rc = write_all(out, &h, sizeof h) || write_all(out, e.msg, h.msg_len) ? 3 : 1;
     } else {
         rc = write_all(out, &h, sizeof h) || write_all(out, body, (size_t)h.nbytes) ||
-                     (h.colour_bytes && write_all(out, colour, (size_t)h.colour_bytes))
+                     (h.colour_bytes && write_all(out, colour, (size_t)h.colour_bytes)) ||
+                     (h.channel_bytes && write_all(out, channels, (size_t)h.channel_bytes))
                  ? 3
                  : 0;
     }

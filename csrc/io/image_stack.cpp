@@ -15,6 +15,15 @@
 // (colour_volume.h: the scalar is the opacity source, luminance by default,
 // beside the RGB8 colour), grey+alpha the grey channel.
 //
+// Channels (docs/channels.md; vxl_load_options.channels): a TIFF of 2..8
+// samples a pixel whose photometric is grey (BlackIsZero or WhiteIsZero,
+// no alpha) is a multi-channel volume under AUTO, and any image of 2..8
+// samples is under ON. An OME-TIFF (OME-XML in the first page's
+// ImageDescription) whose Pixels say SizeC 2..8 with one page a (z, c, t)
+// plane, in any DimensionOrder, is read as channels at time point
+// vxl_load_options.frame, with each channel's Name and Color. OFF reads
+// both as before (the first samples; every page a slice, noted).
+//
 // Hostile input: the first image's header sizes pass the memory budget
 // before any voxel is allocated, every other slice must match it exactly
 // (size, channels, type), and OpenImageIO's messages are passed on with the
@@ -35,9 +44,11 @@
 #include <vector>
 
 extern "C" {
+#include "channel_volume.h"
 #include "colour_volume.h"
 #include "helper_main.h"
 #include "loader_util.h"
+#include "ome_xml.h"
 }
 
 namespace {
@@ -314,6 +325,73 @@ std::string slice_name(const Slice &s)
     return s.subimage ? s.path + " (page " + std::to_string(s.subimage + 1) + ")" : s.path;
 }
 
+// What an OME-TIFF's OME-XML made of its pages: `channels` planes of
+// `slices` (channel slowest, then z), or 0 when the pages are read as
+// before; `samples_meta` when each page holds the channels as samples.
+struct OmePlan {
+    uint32_t channels = 0;
+    bool samples_meta = false;
+    uint32_t frame_count = 1, frame = 0;
+    vxl_ome_pixels px{};
+    std::string notes;
+};
+
+// Reorders a multi-page file's slices into channel-major planar order when
+// its OME-XML says SizeC 2..8 with a page per plane (OmePlan).
+int plan_ome(const char *path, std::vector<Slice> &slices, OIIO::ImageInput *in, uint32_t mode,
+             const vxl_load_options *opt, OmePlan &plan, vxl_err *e)
+{
+    if (!in || slices.size() < 2 || slices.back().subimage == 0 || !in->seek_subimage(0, 0)) return VXL_OK;
+    const std::string desc = in->spec().get_string_attribute("ImageDescription");
+    vxl_ome_pixels &px = plan.px;
+    if (!vxl_ome_xml_parse(desc.c_str(), desc.size(), &px) || px.size[1] < 2) return VXL_OK;
+    const uint64_t nz = px.size[0], nc = px.size[1], nt = px.size[2], pages = slices.size();
+    const uint64_t frame = vxl_load_frame(opt);
+    const bool sane = nz <= pages && nc <= pages && nt <= pages; // no product below overflows
+    const bool planar = sane && nz * nc * nt == pages, interleaved = sane && nz * nt == pages;
+    if (mode == VXL_CHANNELS_OFF || (!planar && !interleaved) || (nc > VXL_MAX_CHANNELS && mode == VXL_CHANNELS_AUTO)) {
+        plan.notes = "OME-XML's SizeC=" + std::to_string(nc) + " not used (" +
+                     (mode == VXL_CHANNELS_OFF ? std::string("channels off")
+                      : !planar && !interleaved ? "its sizes do not match the " + std::to_string(pages) + " pages"
+                                                : "over the " + std::to_string(VXL_MAX_CHANNELS) + " channels of a volume") +
+                     "): every page is a slice";
+        return VXL_OK;
+    }
+    if (nc > VXL_MAX_CHANNELS)
+        return vxl_fail(e, VXL_ERR_LIMIT, "'%s': OME-XML says %llu channels, over the %d a multi-channel volume holds",
+                        path, static_cast<unsigned long long>(nc), VXL_MAX_CHANNELS);
+    if (frame >= nt)
+        return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': frame %llu asked for, the OME-TIFF has %llu time points",
+                        path, static_cast<unsigned long long>(frame), static_cast<unsigned long long>(nt));
+    if (px.channels != 0 && px.channels != nc)
+        plan.notes = "OME-XML lists " + std::to_string(px.channels) + " <Channel> for SizeC=" + std::to_string(nc) +
+                     ": names and colours not used";
+    if (px.channels != nc) std::memset(px.meta, 0, sizeof px.meta);
+    if (px.notes[0]) plan.notes += (plan.notes.empty() ? "" : "; ") + std::string(px.notes);
+    std::vector<Slice> chosen;
+    if (planar) {
+        for (uint64_t c = 0; c < nc; c++)
+            for (uint64_t z = 0; z < nz; z++) chosen.push_back(slices[vxl_ome_page(&px, z, c, frame)]);
+        plan.channels = static_cast<uint32_t>(nc);
+    } else { // the channels are each page's samples: its z planes at t
+        for (uint64_t z = 0; z < nz; z++) chosen.push_back(slices[vxl_ome_page(&px, z, 0, frame)]);
+        plan.samples_meta = true;
+    }
+    slices.swap(chosen);
+    plan.frame_count = static_cast<uint32_t>(nt);
+    plan.frame = static_cast<uint32_t>(frame);
+    return VXL_OK;
+}
+
+// Whether an image of nch samples is read as channels (see the top).
+bool samples_are_channels(const OIIO::ImageSpec &spec, int nch, uint32_t mode)
+{
+    if (nch < 2 || nch > static_cast<int>(VXL_MAX_CHANNELS) || mode == VXL_CHANNELS_OFF) return false;
+    if (mode == VXL_CHANNELS_ON) return true;
+    const int photometric = spec.get_int_attribute("tiff:PhotometricInterpretation", -1);
+    return (photometric == 0 || photometric == 1) && spec.alpha_channel < 0;
+}
+
 } // namespace
 
 extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
@@ -328,13 +406,18 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
         int rc = collect_slices(path, opt, slices, in, open_path, e);
         if (rc) return rc;
         uint32_t max_dim = (opt && opt->max_dim) ? opt->max_dim : VXL_DEFAULT_MAX_DIM;
-        if (slices.size() > max_dim)
-            return vxl_fail(e, VXL_ERR_LIMIT, "'%s': %zu slices exceed the per-axis limit of %u", path, slices.size(),
-                            max_dim);
+        uint32_t mode, scalar_channel;
+        if ((rc = vxl_load_channels_mode(opt, &mode, &scalar_channel, e))) return rc;
+        OmePlan ome;
+        if ((rc = plan_ome(path, slices, in.get(), mode, opt, ome, e))) return rc;
+        const uint32_t planes = ome.channels ? ome.channels : 1; // OME-TIFF channels: planar, slices per channel
+        if (slices.size() / planes > max_dim)
+            return vxl_fail(e, VXL_ERR_LIMIT, "'%s': %zu slices exceed the per-axis limit of %u", path,
+                            slices.size() / planes, max_dim);
 
         std::vector<unsigned char> raw, tmp;
-        uint32_t dims[3] = {0, 0, static_cast<uint32_t>(slices.size())};
-        uint32_t dtype = 0;
+        uint32_t dims[3] = {0, 0, static_cast<uint32_t>(slices.size() / planes)};
+        uint32_t dtype = 0, channels = ome.channels; // samples as channels: set by the first page
         int nch = 0, nread = 0;
         OIIO::TypeDesc read_as;
         std::string first;
@@ -368,14 +451,27 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
                 dims[0] = static_cast<uint32_t>(spec.width);
                 dims[1] = static_cast<uint32_t>(spec.height);
                 nch = spec.nchannels;
+                if (ome.channels && nch != 1)
+                    return vxl_fail(e, VXL_ERR_FORMAT, "'%s': OME-TIFF pages of %d samples with a page per channel "
+                                    "are not supported", name.c_str(), nch);
+                if (ome.samples_meta && static_cast<uint64_t>(nch) != ome.px.size[1])
+                    return vxl_fail(e, VXL_ERR_FORMAT, "'%s': OME-XML says SizeC=%llu, the pages have %d samples",
+                                    name.c_str(), static_cast<unsigned long long>(ome.px.size[1]), nch);
+                if ((ome.channels || ome.samples_meta) && (ome.px.size_x != dims[0] || ome.px.size_y != dims[1]))
+                    return vxl_fail(e, VXL_ERR_FORMAT, "'%s': OME-XML says %llux%llu, the pages are %ux%u", name.c_str(),
+                                    static_cast<unsigned long long>(ome.px.size_x),
+                                    static_cast<unsigned long long>(ome.px.size_y), dims[0], dims[1]);
+                if (!channels && samples_are_channels(spec, nch, mode)) channels = static_cast<uint32_t>(nch);
                 // RGBA: 4 channels, or more whose 4th is the image's alpha;
                 // further channels (microscopy's) are left out with a note
-                nread = nch >= 3 ? (nch == 4 || spec.alpha_channel == 3 ? 4 : 3) : 1;
+                nread = channels && !ome.channels ? nch : nch >= 3 ? (nch == 4 || spec.alpha_channel == 3 ? 4 : 3) : 1;
                 first = name;
                 uint64_t nbytes = 0;
-                rc = nread > 1 ? vxl_plan_colour_voxels(path, dims, dtype, uint32_t(nread), opt, &nbytes, e)
-                               : vxl_plan_voxels(path, dims, dtype, opt, &nbytes, e);
+                rc = channels    ? vxl_plan_channel_voxels(path, dims, dtype, channels, opt, &nbytes, e)
+                     : nread > 1 ? vxl_plan_colour_voxels(path, dims, dtype, uint32_t(nread), opt, &nbytes, e)
+                                 : vxl_plan_voxels(path, dims, dtype, opt, &nbytes, e);
                 if (rc) return rc;
+                if (channels) nbytes *= channels; // one channel's bytes: every channel is read
                 es = vxl_dtype_size(dtype);
                 slice_bytes = static_cast<size_t>(dims[0]) * dims[1] * es * static_cast<size_t>(nread);
                 raw.resize(static_cast<size_t>(nbytes));
@@ -406,15 +502,26 @@ extern "C" int vxl_image_stack_read(const char *path, const vxl_load_options *op
         vxl_load_voxel_size(opt, vs);
         std::vector<unsigned char>().swap(tmp);
         vxl_err inner = {};
-        if (nread > 1)
+        if (channels) // OME planes: planar; samples: interleaved
+            rc = vxl_volume_build_channels(raw.data(), dtype, channels, !ome.channels, dims, vs, nullptr, 0.0, 0.0, opt,
+                                           ome.channels || ome.samples_meta ? "OME-TIFF SizeC" : "TIFF samples", out,
+                                           &inner);
+        else if (nread > 1)
             rc = vxl_volume_build_colour(raw.data(), dtype, uint32_t(nread), 0, dims, vs, nullptr, 0.0, 0.0, opt,
                                          nread == 3 ? "TIFF/PNG RGB" : "TIFF/PNG RGBA", out, &inner);
         else
             rc = vxl_volume_build(raw.data(), dtype, dims, vs, nullptr, 0.0, 0.0, opt, out, &inner);
         if (rc) return vxl_fail_in(e, path, &inner);
-        if (nread > 1 && nch == nread + 1) vxl_volume_note(*out, "channel %d of %d left out", nch, nch);
-        else if (nread > 1 && nch > nread)
+        if (!channels && nread > 1 && nch == nread + 1) vxl_volume_note(*out, "channel %d of %d left out", nch, nch);
+        else if (!channels && nread > 1 && nch > nread)
             vxl_volume_note(*out, "channels %d to %d of %d left out", nread + 1, nch, nch);
+        if (channels && (ome.channels || ome.samples_meta))
+            std::memcpy((*out)->ch_meta, ome.px.meta, sizeof ome.px.meta[0] * channels);
+        if (ome.frame_count > 1 && (ome.channels || ome.samples_meta)) {
+            (*out)->frame_count = ome.frame_count;
+            (*out)->frame = ome.frame;
+        }
+        if (!ome.notes.empty()) vxl_volume_note(*out, "%s", ome.notes.c_str());
         return VXL_OK;
     } catch (const std::bad_alloc &) {
         // the helper's address-space cap (helper_main.c) turns an absurd

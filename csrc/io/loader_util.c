@@ -223,6 +223,29 @@ int vxl_plan_channel_voxels(const char *path, const uint32_t dims[3], uint32_t d
     return VXL_OK;
 }
 
+int vxl_build_interleaved(const char *path, const void *raw, uint32_t dtype, uint32_t channels, uint32_t components,
+                          const uint32_t dims[3], const double sp[3], const double A[16], const vxl_load_options *opt,
+                          const char *format, const char *channel_axis, int streaming_on, vxl_volume **out,
+                          vxl_err *e)
+{
+    char what[96];
+    vxl_err inner = {0};
+    int rc;
+    if (channels) {
+        snprintf(what, sizeof what, "%s %s", format, channel_axis);
+        rc = vxl_volume_build_channels(raw, dtype, channels, 1, dims, sp, A, 0.0, 0.0, opt, what, out, &inner);
+    } else if (components > 1) {
+        snprintf(what, sizeof what, "%s %s", format, components == 3 ? "RGB" : "RGBA");
+        rc = vxl_volume_build_colour(raw, dtype, components, 0, dims, sp, A, 0.0, 0.0, opt, what, out, &inner);
+    } else {
+        rc = vxl_volume_build(raw, dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner);
+    }
+    if (rc) return vxl_fail_in(e, path, &inner);
+    if (streaming_on && (channels || components > 1))
+        vxl_volume_note(*out, "read whole: a %s volume does not stream", channels ? "multi-channel" : "colour");
+    return VXL_OK;
+}
+
 int vxl_affine_from(const double dir[3][3], const double origin[3], double A[16])
 {
     memset(A, 0, 16 * sizeof *A);

@@ -83,6 +83,17 @@ int vxl_plan_colour_voxels(const char *path, const uint32_t dims[3], uint32_t dt
 int vxl_plan_channel_voxels(const char *path, const uint32_t dims[3], uint32_t dtype, uint32_t channels,
                             const vxl_load_options *opt, uint64_t *nbytes, vxl_err *e);
 
+/* The whole read of interleaved voxels as NRRD and MetaImage build it:
+ * `channels` (2..8) as a multi-channel volume, else `components` (3, 4) as
+ * colour, else one scalar; the notes name the input as "<format>
+ * <channel_axis>" ("NRRD channel axis") or "<format> RGB(A)". streaming_on:
+ * the load asked to stream, which channels and colour do not (noted). An
+ * error is wrapped with path. */
+int vxl_build_interleaved(const char *path, const void *raw, uint32_t dtype, uint32_t channels, uint32_t components,
+                          const uint32_t dims[3], const double sp[3], const double A[16], const vxl_load_options *opt,
+                          const char *format, const char *channel_axis, int streaming_on, vxl_volume **out,
+                          vxl_err *e);
+
 /* Wraps an error from a helper with the file name, keeping its code. */
 int vxl_fail_in(vxl_err *e, const char *path, const vxl_err *inner);
 

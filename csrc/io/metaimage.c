@@ -12,14 +12,17 @@
  * is Offset + sum_i index_i * ElementSpacing_i * direction_i, then converted
  * to RAS (x and y negated) so MetaImage and NIfTI share one world frame.
  *
- * ElementNumberOfChannels 3 or 4 (each voxel's channels together, as MetaIO
- * writes them) is RGB or RGBA: a colour volume read whole, as NRRD's colour
- * axis is (colour_volume.h). */
+ * ElementNumberOfChannels (each voxel's channels together, as MetaIO writes
+ * them) follows NRRD's channel axis rule (vxl_load_options.channels,
+ * docs/channels.md): 3 or 4 is RGB or RGBA, a colour volume read whole
+ * (colour_volume.h), unless channels is ON; 2 and 5..8 are channels
+ * (channel_volume.h) unless channels is OFF, which refuses them as before. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
+#include "channel_volume.h"
 #include "colour_volume.h"
 #include "hash.h"
 #include "loader_util.h"
@@ -43,7 +46,7 @@ typedef struct mha_hdr {
     double matrix[MHA_MAX_DIM * MHA_MAX_DIM];
     int msb;          /* 1: big-endian data */
     int compressed;
-    uint32_t channels;   /* ElementNumberOfChannels: 1 (0 unset), 3 RGB, 4 RGBA */
+    uint32_t channels;   /* ElementNumberOfChannels: 1 (0 unset) .. VXL_MAX_CHANNELS */
     int64_t header_size; /* -1: raw data ends the file; 0 default */
     const char *data_file; /* NULL or "LOCAL" = follows the header */
     uint64_t data_offset;
@@ -124,9 +127,10 @@ static int parse_field(mha_hdr *h, const char *key, char *val, const char *path,
     } else if (!strcasecmp(key, "ElementNumberOfChannels")) {
         uint64_t c;
         if (vxl_parse_u64s(val, &c, 1, 1u << 20) != 1 || c < 1) return bad(e, path, line, key, "must be >= 1");
-        if (c != 1 && c != 3 && c != 4)
+        if (c > VXL_MAX_CHANNELS)
             return vxl_fail(e, VXL_ERR_FORMAT, "'%s': MetaImage with %llu channels per voxel is not supported "
-                            "(1, or 3 and 4 as RGB and RGBA colour)", path, (unsigned long long)c);
+                            "(1, 3 and 4 as RGB and RGBA colour, or 2 to %d channels)", path, (unsigned long long)c,
+                            VXL_MAX_CHANNELS);
         h->channels = (uint32_t)c;
     } else if (!strcasecmp(key, "HeaderSize")) {
         uint64_t b;
@@ -203,6 +207,27 @@ static int parse_header(char *text, size_t len, uint64_t file_size, const char *
     return VXL_OK;
 }
 
+/* ElementNumberOfChannels under the channels mode: *channels (2..8) or
+ * *components (3, 4 colour), the other 0/1; OFF refuses what cannot be
+ * colour, as MetaImage was read before channels. */
+static int choose_channels(const mha_hdr *h, const vxl_load_options *opt, uint32_t *components, uint32_t *channels,
+                           const char *path, vxl_err *e)
+{
+    uint32_t mode, scalar;
+    int rc = vxl_load_channels_mode(opt, &mode, &scalar, e);
+    if (rc) return rc;
+    const uint32_t n = h->channels ? h->channels : 1, colour = n == 3 || n == 4;
+    *components = 1;
+    *channels = 0;
+    if (n == 1) return VXL_OK;
+    if (mode == VXL_CHANNELS_ON || (mode == VXL_CHANNELS_AUTO && !colour)) *channels = n;
+    else if (colour) *components = n;
+    else
+        return vxl_fail(e, VXL_ERR_FORMAT, "'%s': MetaImage with %u channels per voxel and channels off (only 3 and "
+                        "4 are read as colour; --channel-axis auto or on reads them as channels)", path, n);
+    return VXL_OK;
+}
+
 static int geometry(const mha_hdr *h, double sp[3], double A[16], const char *path, vxl_err *e)
 {
     int n = h->ndims;
@@ -247,14 +272,20 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
     mha_hdr h;
     uint32_t dims[3];
     int stream = 0;
+    uint32_t components = 1, channels = 0;
     const char *dpath = path;
     int rc = vxl_read_head(path, &text, &len, &file_size, e);
     if (!rc) rc = parse_header(text, len, file_size, path, &h, e);
+    if (!rc) rc = choose_channels(&h, opt, &components, &channels, path, e);
     if (!rc) {
         for (int a = 0; a < 3; a++) dims[a] = a < h.ndims ? (uint32_t)h.dimsize[a] : 1;
         /* zlib data streams through a bricked cache, inflated from where it
-         * starts; colour is read whole (colour_volume.h) */
-        if (h.channels > 1) rc = vxl_plan_colour_voxels(path, dims, h.dtype, h.channels, opt, &nbytes, e);
+         * starts; colour and channels are read whole (colour_volume.h,
+         * channel_volume.h) */
+        if (channels) {
+            rc = vxl_plan_channel_voxels(path, dims, h.dtype, channels, opt, &nbytes, e);
+            nbytes *= channels; /* interleaved: every channel's samples */
+        } else if (components > 1) rc = vxl_plan_colour_voxels(path, dims, h.dtype, components, opt, &nbytes, e);
         else rc = vxl_stream_plan(path, dims, h.dtype, opt, NULL, &stream, &nbytes, e);
     }
     if (!rc && h.data_file) {
@@ -309,16 +340,9 @@ int vxl_metaimage_load(const char *path, const vxl_load_options *opt, vxl_volume
         double sp[3], A[16];
         rc = geometry(&h, sp, A, path, e);
         if (!rc) {
-            vxl_err inner = {0};
-            if (h.channels > 1)
-                rc = vxl_volume_build_colour(raw, h.dtype, h.channels, 0, dims, sp, A, 0.0, 0.0, opt,
-                                             h.channels == 3 ? "MetaImage RGB" : "MetaImage RGBA", out, &inner);
-            else
-                rc = vxl_volume_build(raw, h.dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner);
-            if (rc) rc = vxl_fail_in(e, path, &inner);
-            else (*out)->affine_source = h.nmatrix || h.norigin ? 2 : 0;
-            if (!rc && h.channels > 1 && vxl_load_streaming(opt) == VXL_STREAMING_ON)
-                vxl_volume_note(*out, "read whole: a colour volume does not stream");
+            rc = vxl_build_interleaved(path, raw, h.dtype, channels, components, dims, sp, A, opt, "MetaImage",
+                                       "ElementNumberOfChannels", vxl_load_streaming(opt) == VXL_STREAMING_ON, out, e);
+            if (!rc) (*out)->affine_source = h.nmatrix || h.norigin ? 2 : 0;
         }
     }
     free(raw);

@@ -536,21 +536,9 @@ int vxl_nrrd_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
         double sp[3], A[16];
         rc = geometry(&h, axes, nax, sp, A, path, e);
         if (!rc) {
-            vxl_err inner = {0};
-            if (channels)
-                rc = vxl_volume_build_channels(raw, h.dtype, channels, 1, dims, sp, A, 0.0, 0.0, opt,
-                                               "NRRD channel axis", out, &inner);
-            else if (components > 1)
-                rc = vxl_volume_build_colour(raw, h.dtype, components, 0, dims, sp, A, 0.0, 0.0, opt,
-                                             components == 3 ? "NRRD RGB" : "NRRD RGBA", out, &inner);
-            else
-                rc = vxl_volume_build(raw, h.dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner);
-            if (rc) rc = vxl_fail_in(e, path, &inner);
-            else (*out)->affine_source = h.ndirs ? 2 : 0;
-            if (!rc && components > 1 && vxl_load_streaming(opt) == VXL_STREAMING_ON)
-                vxl_volume_note(*out, "read whole: a colour volume does not stream");
-            if (!rc && channels && vxl_load_streaming(opt) == VXL_STREAMING_ON)
-                vxl_volume_note(*out, "read whole: a multi-channel volume does not stream");
+            rc = vxl_build_interleaved(path, raw, h.dtype, channels, components, dims, sp, A, opt, "NRRD",
+                                       "channel axis", vxl_load_streaming(opt) == VXL_STREAMING_ON, out, e);
+            if (!rc) (*out)->affine_source = h.ndirs ? 2 : 0;
         }
     }
     free(raw);

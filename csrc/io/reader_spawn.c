@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "clock.h"
+#include "channel_volume.h"
 #include "colour_volume.h"
 #include "dynlib.h"
 #include "files.h"
@@ -91,6 +92,8 @@ typedef struct reply {
     uint64_t body_len, body_got;
     uint8_t *colour;       /* a colour volume's RGB8, after the body */
     uint64_t colour_len, colour_got;
+    uint16_t *channels;    /* a multi-channel volume's packed channels, after the colour */
+    uint64_t channels_len, channels_got;
     int extra;             /* bytes after the announced end */
     char err_tail[STDERR_KEEP + 1];
     size_t err_len;
@@ -128,6 +131,41 @@ static int notes_ok(const char *notes, size_t cap)
     return 1;
 }
 
+/* A channel's metadata: a terminated name of text, a colour in [0, 1], an
+ * ordered finite window, flags 0 or 1. */
+static int channel_meta_ok(const vxl_channel_meta *m)
+{
+    if (!notes_ok(m->name, sizeof m->name) || m->has_color > 1 || m->has_window > 1 || m->hidden > 1 || m->reserved)
+        return 0;
+    for (int k = 0; k < 3; k++)
+        if (!(m->color_srgb[k] >= 0.0f && m->color_srgb[k] <= 1.0f)) return 0;
+    return all_finite(m->window, 2) && (!m->has_window || m->window[0] < m->window[1]);
+}
+
+/* A multi-channel volume's part of the header: 0 or 2..VXL_MAX_CHANNELS
+ * channels, the scalar among them, their ranges and metadata sane, and
+ * exactly 2 bytes a channel a voxel; unused slots all zero. */
+static int check_channel_header(const vxl_reader *r, const char *path, const vxl_reader_header *h, uint64_t voxels,
+                                vxl_err *e)
+{
+    const uint32_t n = h->channel_count;
+    int ok = n == 0 ? h->scalar_channel == 0 && h->channel_bytes == 0
+                    : n >= 2 && n <= VXL_MAX_CHANNELS && h->scalar_channel < n && h->components == 1 &&
+                          h->channel_bytes == voxels * n * VXL_CHANNEL_BYTES;
+    static const vxl_channel_meta none;
+    for (uint32_t c = 0; ok && c < VXL_MAX_CHANNELS; c++) {
+        const double range[4] = {h->ch_tex_lo[c], h->ch_tex_hi[c], h->ch_min[c], h->ch_max[c]};
+        if (c >= n) ok = !memcmp(&h->ch_meta[c], &none, sizeof none) && !range[0] && !range[1] && !range[2] &&
+                         !range[3];
+        else ok = all_finite(range, 4) && range[2] <= range[3] && channel_meta_ok(&h->ch_meta[c]);
+    }
+    if (!ok)
+        return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent an inconsistent multi-channel header "
+                        "(%u channels, scalar %u, %llu channel bytes)", path, r->name, n, h->scalar_channel,
+                        (unsigned long long)h->channel_bytes);
+    return VXL_OK;
+}
+
 /* A volume header: every field the rebuilt vxl_volume will hold. */
 static int check_volume_header(const vxl_reader *r, const char *path, const vxl_reader_header *h,
                                const vxl_load_options *opt, vxl_err *e)
@@ -147,10 +185,16 @@ static int check_volume_header(const vxl_reader *r, const char *path, const vxl_
                         "(asked for %u) and %llu colour bytes", path, r->name, h->components, h->opacity_source,
                         source, (unsigned long long)h->colour_bytes);
     vxl_err inner = {0};
-    if (vxl_volume_check_limits(h->dims, h->texture_bits / 8 + (colour ? VXL_COLOUR_BYTES_PER_VOXEL : 0), opt,
-                                &inner))
+    /* everything the volume will hold, before any of it is allocated (a
+     * channel count over the limit is refused below, after dims are sane) */
+    const uint32_t channel_voxel_bytes =
+        h->channel_count <= VXL_MAX_CHANNELS ? h->channel_count * VXL_CHANNEL_BYTES : 0;
+    if (vxl_volume_check_limits(h->dims, h->texture_bits / 8 + (colour ? VXL_COLOUR_BYTES_PER_VOXEL : 0) +
+                                             channel_voxel_bytes, opt, &inner))
         return vxl_fail_in(e, path, &inner);
     const uint64_t voxels = (uint64_t)h->dims[0] * h->dims[1] * h->dims[2];
+    int rc = check_channel_header(r, path, h, voxels, e);
+    if (rc) return rc;
     const uint64_t nbytes = voxels * (h->texture_bits / 8);
     if (colour && h->colour_bytes != voxels * VXL_COLOUR_BYTES_PER_VOXEL)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s announced %llu colour bytes for %ux%ux%u voxels",
@@ -173,6 +217,19 @@ static int check_volume_header(const vxl_reader *r, const char *path, const vxl_
     return VXL_OK;
 }
 
+/* A part of the body after the texels (colour, channels): *buf of len
+ * bytes, or NULL for none. */
+static int make_room(const char *path, uint64_t len, const char *what, void **buf, uint64_t *buf_len, vxl_err *e)
+{
+    *buf_len = len;
+    if (!len) return VXL_OK;
+    *buf = malloc((size_t)len);
+    if (!*buf)
+        return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': out of memory for %llu bytes of %s", path,
+                        (unsigned long long)len, what);
+    return VXL_OK;
+}
+
 /* Checks a complete header and makes room for what follows it. */
 static int accept_header(const vxl_reader *r, const char *path, reply *rp, uint32_t kind,
                          const vxl_load_options *opt, vxl_err *e)
@@ -192,17 +249,16 @@ static int accept_header(const vxl_reader *r, const char *path, reply *rp, uint3
         int rc = check_volume_header(r, path, h, opt, e);
         if (rc) return rc;
         rp->body_len = h->nbytes;
-        if (h->colour_bytes) {
-            rp->colour_len = h->colour_bytes;
-            rp->colour = malloc((size_t)rp->colour_len);
-            if (!rp->colour)
-                return vxl_fail(e, VXL_ERR_NO_MEMORY, "cannot read '%s': out of memory for %llu bytes of colour",
-                                path, (unsigned long long)rp->colour_len);
-        }
+        void *colour = NULL, *channels = NULL;
+        if ((rc = make_room(path, h->colour_bytes, "colour", &colour, &rp->colour_len, e))) return rc;
+        rp->colour = colour;
+        if ((rc = make_room(path, h->channel_bytes, "channels", &channels, &rp->channels_len, e))) return rc;
+        rp->channels = channels;
     } else if (kind == VXL_REPLY_IMAGE) {
         /* the budget the library asked for is the image's bytes */
         const uint64_t pixels = (uint64_t)h->dims[0] * h->dims[1];
         if (h->dims[0] == 0 || h->dims[1] == 0 || h->dims[2] != 1 || h->components != 3 || h->colour_bytes ||
+            h->channel_count || h->channel_bytes ||
             pixels > vxl_load_budget(opt) / (3 * sizeof(float)) || h->nbytes != pixels * 3 * sizeof(float))
             return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s announced a %ux%ux%u image of %u components "
                             "in %llu bytes", path, r->name, h->dims[0], h->dims[1], h->dims[2], h->components,
@@ -276,6 +332,10 @@ static int read_data(const vxl_reader *r, const char *path, vxl_child *child, re
         dst = rp->colour + rp->colour_got;
         uint64_t left = rp->colour_len - rp->colour_got;
         want = left > (1u << 24) ? (1u << 24) : (size_t)left;
+    } else if (rp->channels_got < rp->channels_len) {
+        dst = (char *)rp->channels + rp->channels_got;
+        uint64_t left = rp->channels_len - rp->channels_got;
+        want = left > (1u << 24) ? (1u << 24) : (size_t)left;
     } else {
         dst = scratch;
         want = sizeof scratch;
@@ -291,7 +351,8 @@ static int read_data(const vxl_reader *r, const char *path, vxl_child *child, re
         rp->h_got += (size_t)n;
         if (rp->h_got == sizeof rp->h) return accept_header(r, path, rp, kind, opt, e);
     } else if (rp->body_got < rp->body_len) rp->body_got += (uint64_t)n;
-    else rp->colour_got += (uint64_t)n;
+    else if (rp->colour_got < rp->colour_len) rp->colour_got += (uint64_t)n;
+    else rp->channels_got += (uint64_t)n;
     return VXL_OK;
 }
 
@@ -299,7 +360,7 @@ static int read_data(const vxl_reader *r, const char *path, vxl_child *child, re
 static vxl_child *spawn_helper(const vxl_reader *r, const char *helper, const char *command, const char *path,
                                const vxl_load_options *opt, vxl_err *e)
 {
-    char max_dim[24], budget[24], vs[3][32], frame[16], source[16], channel[16];
+    char max_dim[24], budget[24], vs[3][32], frame[16], source[16], channel[16], channels[16], scalar[16];
     double voxel[3];
     vxl_load_voxel_size(opt, voxel);
     snprintf(max_dim, sizeof max_dim, "%u", opt && opt->max_dim ? opt->max_dim : VXL_DEFAULT_MAX_DIM);
@@ -312,9 +373,13 @@ static vxl_child *spawn_helper(const vxl_reader *r, const char *helper, const ch
     vxl_load_opacity_source(opt, &src, &ch);
     snprintf(source, sizeof source, "%u", src);
     snprintf(channel, sizeof channel, "%u", ch);
+    uint32_t mode = VXL_CHANNELS_AUTO, scalar_channel = 0;
+    vxl_load_channels_mode(opt, &mode, &scalar_channel, NULL); /* checked by vxl_reader_run */
+    snprintf(channels, sizeof channels, "%u", mode);
+    snprintf(scalar, sizeof scalar, "%u", scalar_channel);
     char *const argv[VXL_HELPER_ARGC + 1] = {(char *)helper, (char *)command, (char *)path, max_dim, budget,
                                              vs[0], vs[1], vs[2], frame, (char *)(series ? series : ""),
-                                             source, channel, NULL};
+                                             source, channel, channels, scalar, NULL};
     vxl_child *c = vxl_child_start(helper, argv);
     if (!c)
         vxl_fail(e, VXL_ERR_IO, "cannot read '%s': cannot start %s (%s): %s", path, r->name, helper,
@@ -418,7 +483,7 @@ static int verdict(const vxl_reader *r, const char *path, const char *helper, co
                         *said ? ")" : "");
     }
     const int complete = rp->h_got == sizeof rp->h && rp->body && rp->body_got == rp->body_len &&
-                         rp->colour_got == rp->colour_len;
+                         rp->colour_got == rp->colour_len && rp->channels_got == rp->channels_len;
     if (complete && rp->h.status != VXL_OK) {
         int code = rp->h.status >= VXL_ERR_INVALID_ARGUMENT && rp->h.status <= VXL_ERR_STATE ? (int)rp->h.status
                                                                                              : VXL_ERR_FORMAT;
@@ -429,8 +494,9 @@ static int verdict(const vxl_reader *r, const char *path, const char *helper, co
                         end->code, *said ? ": " : "", said);
     if (!complete)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': the output of %s was cut short (%llu of %llu bytes)",
-                        path, r->name, (unsigned long long)(rp->h_got + rp->body_got + rp->colour_got),
-                        (unsigned long long)(sizeof rp->h + rp->body_len + rp->colour_len));
+                        path, r->name,
+                        (unsigned long long)(rp->h_got + rp->body_got + rp->colour_got + rp->channels_got),
+                        (unsigned long long)(sizeof rp->h + rp->body_len + rp->colour_len + rp->channels_len));
     if (rp->extra)
         return vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent more than it announced", path, r->name);
     return check_body(r, path, rp, e);
@@ -438,13 +504,16 @@ static int verdict(const vxl_reader *r, const char *path, const char *helper, co
 
 int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, const vxl_load_options *opt,
                    uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, uint8_t **colour,
-                   vxl_err *e)
+                   uint16_t **channels, vxl_err *e)
 {
     *body = NULL;
     if (colour) *colour = NULL;
-    char helper[4096];
-    int rc = helper_path(r, path, helper, sizeof helper, e);
+    if (channels) *channels = NULL;
+    uint32_t mode, scalar_channel; /* an unknown channels mode is refused here, before a helper starts */
+    int rc = vxl_load_channels_mode(opt, &mode, &scalar_channel, e);
     if (rc) return rc;
+    char helper[4096];
+    if ((rc = helper_path(r, path, helper, sizeof helper, e))) return rc;
     vxl_child *child = spawn_helper(r, helper, command, path, opt, e);
     if (!child) return VXL_ERR_IO;
     reply rp;
@@ -458,13 +527,18 @@ int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, c
     if (!rc) rc = verdict(r, path, helper, &end, timed_out, limit, &rp, e);
     if (!rc && rp.colour && !colour) /* a caller that takes no colour never asked for a volume */
         rc = vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent colour where none was expected", path, r->name);
+    if (!rc && rp.channels && !channels)
+        rc = vxl_fail(e, VXL_ERR_FORMAT, "cannot read '%s': %s sent channels where none were expected", path,
+                      r->name);
     if (rc) {
         free(rp.body);
         free(rp.colour);
+        free(rp.channels);
         return rc;
     }
     *h = rp.h;
     *body = rp.body;
     if (colour) *colour = rp.colour;
+    if (channels) *channels = rp.channels;
     return VXL_OK;
 }

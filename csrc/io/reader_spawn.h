@@ -26,13 +26,16 @@ typedef struct vxl_reader {
  * body of h->nbytes (free() it): for a volume, texels that passed the
  * limits in opt (checked before allocating, with a colour volume's colour)
  * and the value checks, and *colour a colour volume's malloc'd RGB8 of
- * h->colour_bytes (NULL for grey; colour may be NULL for a series list);
+ * h->colour_bytes (NULL for grey; colour may be NULL for a series list),
+ * and *channels a multi-channel volume's malloc'd packed channels of
+ * h->channel_bytes (charged to the budget with the texels; NULL without
+ * channels; channels may be NULL for a series list);
  * for a series list, records whose strings are NUL-terminated. input_bytes (what
  * the helper will read) scales the time limit. The helper is always reaped;
  * a crash, a hang, a missing library or a bad stream is an error. */
 int vxl_reader_run(const vxl_reader *r, const char *command, const char *path, const vxl_load_options *opt,
                    uint32_t kind, uint64_t input_bytes, vxl_reader_header *h, void **body, uint8_t **colour,
-                   vxl_err *e);
+                   uint16_t **channels, vxl_err *e);
 
 /* 0 where r's library has no build for this OS (Windows and a linux_only
  * reader): vxl_reader_run then refuses its formats by name. */

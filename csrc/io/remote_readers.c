@@ -70,15 +70,18 @@ static uint64_t input_bytes(const char *path, const vxl_path_info *st, int reads
     return st->size + folder_bytes(dir, 0, &entries);
 }
 
-/* The reply's volume, taking ownership of the texels and colour: the same
- * vxl_volume the helper's reader built (a colour volume's scalar and RGB8,
- * colour_volume.h). */
-static int volume_from(const vxl_reader_header *h, void *texels, uint8_t *colour, vxl_volume **out, vxl_err *e)
+/* The reply's volume, taking ownership of the texels, colour and channels:
+ * the same vxl_volume the helper's reader built (a colour volume's scalar
+ * and RGB8, colour_volume.h; a multi-channel volume's scalar and packed
+ * channels, channel_volume.h). */
+static int volume_from(const vxl_reader_header *h, void *texels, uint8_t *colour, uint16_t *channels,
+                       vxl_volume **out, vxl_err *e)
 {
     vxl_volume *v = calloc(1, sizeof *v);
     if (!v) {
         free(texels);
         free(colour);
+        free(channels);
         return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory for the volume header");
     }
     memcpy(v->dims, h->dims, sizeof v->dims);
@@ -102,6 +105,10 @@ static int volume_from(const vxl_reader_header *h, void *texels, uint8_t *colour
     v->colour = colour;
     v->components = h->components;
     v->opacity_source = h->opacity_source;
+    if (channels) { /* names terminated, ranges finite: checked on receipt */
+        v->channels = channels;
+        vxl_reader_channel_fields((vxl_reader_header *)h, v, 0);
+    }
     *out = v;
     return VXL_OK;
 }
@@ -117,10 +124,11 @@ static int load_remote(const vxl_reader *r, const char *command, int reads_sibli
     vxl_reader_header h;
     void *body = NULL;
     uint8_t *colour = NULL;
+    uint16_t *channels = NULL;
     int rc = vxl_reader_run(r, command, path, opt, VXL_REPLY_VOLUME, input_bytes(path, &st, reads_siblings, depth),
-                            &h, &body, &colour, e);
+                            &h, &body, &colour, &channels, e);
     if (rc) return rc;
-    return volume_from(&h, body, colour, out, e);
+    return volume_from(&h, body, colour, channels, out, e);
 }
 
 int vxl_image_stack_reader_runs_here(void) { return vxl_reader_runs_here(&stack_reader); }
@@ -147,7 +155,7 @@ int vxl_environment_exr_load(const char *path, uint64_t max_pixels, float **rgb,
     vxl_reader_header h;
     void *body = NULL;
     int rc = vxl_reader_run(&environment_reader, VXL_CMD_ENVIRONMENT, path, &opt, VXL_REPLY_IMAGE,
-                            input_bytes(path, &st, 0, 0), &h, &body, NULL, e);
+                            input_bytes(path, &st, 0, 0), &h, &body, NULL, NULL, e);
     if (rc) return rc;
     *rgb = body;
     *width = h.dims[0];
@@ -182,10 +190,11 @@ int vxl_zarr_load(const char *path, const vxl_load_options *opt, vxl_volume **ou
     vxl_reader_header h;
     void *body = NULL;
     uint8_t *colour = NULL;
+    uint16_t *channels = NULL;
     int rc = vxl_reader_run(&zarr_reader, VXL_CMD_ZARR, path, opt, VXL_REPLY_VOLUME,
-                            input_bytes(folder, &st, 0, ZARR_DEPTH), &h, &body, &colour, e);
+                            input_bytes(folder, &st, 0, ZARR_DEPTH), &h, &body, &colour, &channels, e);
     if (rc) return rc;
-    return volume_from(&h, body, colour, out, e);
+    return volume_from(&h, body, colour, channels, out, e);
 }
 
 VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint32_t max, uint32_t *count)
@@ -207,7 +216,7 @@ VXL_API int vxl_dicom_list_series(const char *path, vxl_dicom_series *out, uint3
     vxl_reader_header h;
     void *body = NULL;
     int rc = vxl_reader_run(&dicom_reader, VXL_CMD_DICOM_SERIES, path, NULL, VXL_REPLY_SERIES,
-                            input_bytes(path, &st, 1, DICOM_DEPTH), &h, &body, NULL, NULL);
+                            input_bytes(path, &st, 1, DICOM_DEPTH), &h, &body, NULL, NULL, NULL);
     if (rc) return rc;
     const vxl_dicom_series *all = body;
     const size_t stride = max && out->struct_size ? out->struct_size : sizeof(vxl_dicom_series);

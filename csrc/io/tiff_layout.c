@@ -5,7 +5,9 @@
 #include "tiff_layout.h"
 #include "files.h"
 
+#include "channel_volume.h"
 #include "loader_util.h"
+#include "ome_xml.h"
 #include "stream_load.h"
 
 #include <errno.h>
@@ -23,6 +25,7 @@ typedef struct tfile {
     uint64_t size;
     int be;                 /* 1: big-endian ("MM") */
     int big;                /* 1: BigTIFF */
+    int channels_off;       /* vxl_load_options.channels is OFF: an OME-TIFF's channels are slices */
 } tfile;
 
 /* One directory entry: type, count and the raw value field (4 or 8 bytes). */
@@ -58,6 +61,28 @@ static int read_exact(const tfile *f, void *buf, size_t n, uint64_t off, vxl_err
         return vxl_fail(e, VXL_ERR_FORMAT, "'%s': truncated file: it ends at byte %llu", f->path,
                         (unsigned long long)(off + (uint64_t)got));
     return VXL_OK;
+}
+
+#define MAX_DESCRIPTION (1u << 20) /* OME-XML read from the first page's ImageDescription */
+
+/* Whether the first page's ImageDescription (tag 270 at entry p) is OME-XML
+ * of several channels, which the whole read (image_stack.cpp) makes a
+ * multi-channel volume: those pages are not slices to stream. */
+static int ome_channels(const tfile *f, const uint8_t *p, uint64_t *channels, vxl_err *e)
+{
+    const uint64_t count = get(f, p + 4, f->big ? 8 : 4), at = get(f, p + (f->big ? 12 : 8), f->big ? 8 : 4);
+    *channels = 0;
+    if (get(f, p + 2, 2) != 2 || count <= (f->big ? 8u : 4u) || count > MAX_DESCRIPTION || at > f->size ||
+        f->size - at < count)
+        return VXL_OK; /* inline, absurd or past the end: not OME-XML the whole read would take */
+    char *text = malloc((size_t)count + 1);
+    if (!text) return vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for its description", f->path);
+    int rc = read_exact(f, text, (size_t)count, at, e);
+    text[count] = '\0';
+    vxl_ome_pixels px;
+    if (!rc && vxl_ome_xml_parse(text, strlen(text), &px)) *channels = px.size[1];
+    free(text);
+    return rc;
 }
 
 static int why(vxl_tiff_layout *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -167,8 +192,12 @@ static int read_page(const tfile *f, uint64_t at, uint32_t n, uint32_t max_dim, 
     for (uint64_t i = 0; i < count && !rc && res == PAGE_OK; i++) {
         const uint8_t *p = d + i * esz;
         const uint16_t tag = (uint16_t)get(f, p, 2);
+        uint64_t channels = 0;
         if (tag >= 322 && tag <= 325) res = why(t, "tiled TIFF (page %u)", n + 1);
         else if (tag == 338) res = why(t, "TIFF with extra samples (page %u)", n + 1);
+        else if (tag == 270 && n == 0 && !f->channels_off && !(rc = ome_channels(f, p, &channels, e)) && channels > 1)
+            res = why(t, "an OME-TIFF of %llu channels (a multi-channel volume is read whole)",
+                      (unsigned long long)channels);
         for (int k = 0; k < T_N && res == PAGE_OK; k++) {
             if (k_tags[k] != tag) continue;
             if (tags[k].present) res = why(t, "TIFF with a repeated tag %u (page %u)", tag, n + 1);
@@ -348,7 +377,10 @@ int vxl_tiff_layout_probe(const char *path, const vxl_load_options *opt, vxl_tif
         vxl_file_close(fd);
         return vxl_fail(e, VXL_ERR_IO, "'%s' is not a regular file", path);
     }
-    tfile f = {fd, path, st.size, 0, 0};
+    uint32_t mode = VXL_CHANNELS_AUTO, scalar;
+    vxl_err ignore = {0};
+    if (vxl_load_channels_mode(opt, &mode, &scalar, &ignore)) mode = VXL_CHANNELS_AUTO; /* the whole read reports it */
+    tfile f = {fd, path, st.size, 0, 0, mode == VXL_CHANNELS_OFF};
     t->file_size = f.size;
     uint8_t h[16] = {0};
     int rc = VXL_OK;

@@ -60,6 +60,12 @@ typedef struct vxl_zarr_store {
     int window_count;
     unsigned char window_set[VXL_ZARR_MAX_WINDOWS];
     double window[VXL_ZARR_MAX_WINDOWS][2];
+    /* omero channels' "label", "color" ("RRGGBB", sRGB), display "window"
+     * start/end and "active", for the first VXL_MAX_CHANNELS channels: what a
+     * multi-channel read reports (docs/channels.md); a malformed entry is
+     * left unknown and said in meta_notes. */
+    vxl_channel_meta meta[VXL_MAX_CHANNELS];
+    char meta_notes[160];
     int nlevels;
     vxl_zarr_array level[VXL_ZARR_MAX_LEVELS];
     /* world = scale * index + translation, per array dimension (the
@@ -116,15 +122,27 @@ int vxl_zarr_decode(const vxl_zarr_array *a, vxl_zarr_codecs *codecs, const void
 
 /* The helper's reader: path is the store's folder, optionally followed by
  * "#level=N&c=N" (level: 0 = finest; absent = the finest that fits the
- * memory budget; c: the channel, default 0); opt->frame picks t. */
+ * memory budget; c: one channel; absent: every channel of a c axis of
+ * 2..VXL_MAX_CHANNELS as a multi-channel volume, else channel 0);
+ * opt->frame picks t. */
 int vxl_zarr_read(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e);
 
-/* The "#level=N&c=N" after a store's folder: level -1 when not given. */
+/* The "#level=N&c=N" after a store's folder: level -1 when not given;
+ * c_given 0 when "c=" is absent (a c axis of 2..VXL_MAX_CHANNELS then loads
+ * as channels unless vxl_load_options.channels is OFF). */
 typedef struct vxl_zarr_choice {
     int level;
+    int c_given;
     uint64_t c;
 } vxl_zarr_choice;
 int vxl_zarr_parse_path(const char *path, char *folder, size_t size, vxl_zarr_choice *ch, vxl_err *e);
+/* The channels a whole read of the store takes together: the c extent of
+ * level 0 when it is 2..VXL_MAX_CHANNELS, no "c=" was given and opt's
+ * channels mode is not OFF (ON with more is an error naming the limit);
+ * else 0 (one channel, ch->c). */
+int vxl_zarr_channels(const char *path, const vxl_zarr_store *s, const vxl_zarr_choice *ch,
+                      const vxl_load_options *opt, uint32_t *channels, vxl_err *e);
+
 /* Checks level and the choice of t (opt->frame) and c against the store:
  * sel[VXL_ZARR_T], sel[VXL_ZARR_C] (others 0) and the t extent *nt, or an
  * error naming path. */

@@ -1,5 +1,7 @@
 /* zarr_read.c - vxl_zarr_read: one multiscale level of an OME-Zarr image,
- * at one time point and channel, into a volume.
+ * at one time point and channel, into a volume; or, for a c axis of
+ * 2..VXL_MAX_CHANNELS, every channel into a multi-channel volume with the
+ * omero metadata's names, colours and windows (docs/channels.md).
  *
  * The path is the image's folder, optionally with "#level=N&c=N" (the load
  * options have no field for either, and the public structs stay as they
@@ -14,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "channel_volume.h"
 #include "files.h"
 #include "loader_util.h"
 #include "loaders.h"
@@ -23,6 +26,7 @@
 int vxl_zarr_parse_path(const char *path, char *folder, size_t size, vxl_zarr_choice *ch, vxl_err *e)
 {
     ch->level = -1;
+    ch->c_given = 0;
     ch->c = 0;
     const char *hash = strrchr(path, '#');
     size_t n = hash ? (size_t)(hash - path) : strlen(path);
@@ -44,7 +48,10 @@ int vxl_zarr_parse_path(const char *path, char *folder, size_t size, vxl_zarr_ch
             return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': '%s' is not NAME=NUMBER (level, c)", path, tok);
         *eq = '\0';
         if (!strcmp(tok, "level")) ch->level = (int)(v < VXL_ZARR_MAX_LEVELS ? v : VXL_ZARR_MAX_LEVELS);
-        else if (!strcmp(tok, "c")) ch->c = v;
+        else if (!strcmp(tok, "c")) {
+            ch->c = v;
+            ch->c_given = 1;
+        }
         else return vxl_fail(e, VXL_ERR_INVALID_ARGUMENT, "'%s': unknown option '%s' (level, c)", path, tok);
     }
     return VXL_OK;
@@ -71,6 +78,23 @@ int vxl_zarr_select(const char *path, const vxl_zarr_store *s, int level, const 
     return VXL_OK;
 }
 
+int vxl_zarr_channels(const char *path, const vxl_zarr_store *s, const vxl_zarr_choice *ch,
+                      const vxl_load_options *opt, uint32_t *channels, vxl_err *e)
+{
+    *channels = 0;
+    uint32_t mode, scalar;
+    int rc = vxl_load_channels_mode(opt, &mode, &scalar, e);
+    if (rc) return rc;
+    if (s->axis[VXL_ZARR_C] < 0 || ch->c_given || mode == VXL_CHANNELS_OFF) return VXL_OK;
+    const uint64_t nc = s->level[0].shape[s->axis[VXL_ZARR_C]];
+    if (nc >= 2 && nc <= VXL_MAX_CHANNELS) *channels = (uint32_t)nc;
+    else if (nc > VXL_MAX_CHANNELS && mode == VXL_CHANNELS_ON)
+        return vxl_fail(e, VXL_ERR_LIMIT, "'%s': %llu channels, over the %d a multi-channel volume holds (pick one "
+                        "with #c=N, or channels auto reads channel 0)", path, (unsigned long long)nc,
+                        VXL_MAX_CHANNELS);
+    return VXL_OK;
+}
+
 /* The level's volume dims (x, y, z). */
 static void level_dims(const vxl_zarr_store *s, int l, uint32_t dims[3])
 {
@@ -82,8 +106,10 @@ static void level_dims(const vxl_zarr_store *s, int l, uint32_t dims[3])
     dims[2] = z > UINT32_MAX ? UINT32_MAX : (uint32_t)z;
 }
 
+/* extra_bytes: what a voxel costs beyond its texel (a multi-channel read's
+ * 16-bit channels). */
 static int pick_level(const char *path, const vxl_zarr_store *s, const vxl_zarr_choice *ch,
-                      const vxl_load_options *opt, int *level, vxl_err *e)
+                      const vxl_load_options *opt, uint32_t extra_bytes, int *level, vxl_err *e)
 {
     if (ch->level >= 0) {
         if (ch->level >= s->nlevels)
@@ -96,7 +122,8 @@ static int pick_level(const char *path, const vxl_zarr_store *s, const vxl_zarr_
     for (int l = 0; l < s->nlevels; l++) {
         uint32_t dims[3];
         level_dims(s, l, dims);
-        if (!vxl_volume_check_limits(dims, vxl_texture_bits_for(s->level[l].dtype) / 8, opt, &ignore)) {
+        if (!vxl_volume_check_limits(dims, vxl_texture_bits_for(s->level[l].dtype) / 8 + extra_bytes, opt,
+                                     &ignore)) {
             *level = l;
             return VXL_OK;
         }
@@ -199,23 +226,43 @@ int vxl_zarr_read(const char *path, const vxl_load_options *opt, vxl_volume **ou
     vxl_zarr_store *s = calloc(1, sizeof *s);
     if (!s) return vxl_fail(e, VXL_ERR_NO_MEMORY, "out of memory");
     if ((rc = vxl_zarr_open(folder, s, e))) goto done;
+    uint32_t channels = 0;
+    if ((rc = vxl_zarr_channels(path, s, &ch, opt, &channels, e))) goto done;
     int l = 0;
-    if ((rc = pick_level(path, s, &ch, opt, &l, e))) goto done;
+    if ((rc = pick_level(path, s, &ch, opt, channels * VXL_CHANNEL_BYTES, &l, e))) goto done;
     const vxl_zarr_array *a = &s->level[l];
     uint64_t sel[VXL_ZARR_ROLES], nt;
     if ((rc = vxl_zarr_select(path, s, l, opt, &ch, sel, &nt, e))) goto done;
+    if (channels && a->shape[s->axis[VXL_ZARR_C]] != channels) {
+        rc = vxl_fail(e, VXL_ERR_FORMAT, "'%s': level %d has %llu channels, level 0 has %u", path, l,
+                      (unsigned long long)a->shape[s->axis[VXL_ZARR_C]], channels);
+        goto done;
+    }
     uint32_t dims[3];
     level_dims(s, l, dims);
     uint64_t nbytes;
     char where[4096 + 32];
     snprintf(where, sizeof where, "%s (level %d)", folder, l);
-    if ((rc = vxl_plan_voxels(where, dims, a->dtype, opt, &nbytes, e))) goto done;
-    unsigned char *raw = malloc((size_t)nbytes);
+    /* channels: every one's raw plane at once (planar), charged to the budget
+     * with the volume's 16-bit channels before anything is allocated */
+    if (channels) rc = vxl_plan_channel_voxels(where, dims, a->dtype, channels, opt, &nbytes, e);
+    else rc = vxl_plan_voxels(where, dims, a->dtype, opt, &nbytes, e);
+    if (rc) goto done;
+    unsigned char *raw = malloc((size_t)(nbytes * (channels ? channels : 1)));
     if (!raw) {
-        rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for %llu bytes", path, (unsigned long long)nbytes);
+        rc = vxl_fail(e, VXL_ERR_NO_MEMORY, "'%s': out of memory for %llu bytes", path,
+                      (unsigned long long)(nbytes * (channels ? channels : 1)));
         goto done;
     }
-    if (!(rc = read_level(path, s, a, sel, dims, opt, raw, e))) {
+    rc = read_level(path, s, a, sel, dims, opt, raw, e);
+    /* channel by channel, each into its plane: a chunk that spans several
+     * channels is decoded once for each (simple, and only the whole read
+     * runs this; the chunk buffer stays one chunk) */
+    for (uint32_t c = 1; c < channels && !rc; c++) { /* channel 0 was sel's */
+        sel[VXL_ZARR_C] = c;
+        rc = read_level(path, s, a, sel, dims, opt, raw + c * nbytes, e);
+    }
+    if (!rc) {
         const int ix = s->axis[VXL_ZARR_X], iy = s->axis[VXL_ZARR_Y], iz = s->axis[VXL_ZARR_Z];
         const double sp[3] = {s->scale[l][ix], s->scale[l][iy], s->scale[l][iz]};
         const double dir[3][3] = {{sp[0], 0, 0}, {0, sp[1], 0}, {0, 0, sp[2]}};
@@ -224,12 +271,18 @@ int vxl_zarr_read(const char *path, const vxl_load_options *opt, vxl_volume **ou
         vxl_err inner = {0};
         if (!vxl_affine_from(dir, org, A)) {
             rc = vxl_fail(e, VXL_ERR_FORMAT, "'%s': level %d's scale and translation make no affine", path, l);
-        } else if ((rc = vxl_volume_build(raw, a->dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner))) {
+        } else if ((rc = channels ? vxl_volume_build_channels(raw, a->dtype, channels, 0, dims, sp, A, 0.0, 0.0, opt,
+                                                              "OME-Zarr c axis", out, &inner)
+                                  : vxl_volume_build(raw, a->dtype, dims, sp, A, 0.0, 0.0, opt, out, &inner))) {
             rc = vxl_fail_in(e, path, &inner);
         } else {
             (*out)->affine_source = 2; /* a full affine from the file, as NRRD's and MetaImage's */
             (*out)->frame_count = (uint32_t)(nt > UINT32_MAX ? UINT32_MAX : nt);
             (*out)->frame = (uint32_t)sel[VXL_ZARR_T];
+            if (channels) {
+                memcpy((*out)->ch_meta, s->meta, sizeof s->meta[0] * channels);
+                if (s->meta_notes[0]) vxl_volume_note(*out, "%s", s->meta_notes);
+            }
         }
     }
     free(raw);

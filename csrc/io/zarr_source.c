@@ -588,18 +588,25 @@ fail:
 
 /* ------------------------------------------------------------- dispatch */
 
-/* AUTO: whether the level the whole read would start from (the one asked
- * for, else level 0) is over half the budget in texture bytes. */
+/* ON, or AUTO and the level the whole read would start from (the one asked
+ * for, else level 0) is over half the budget in texture bytes; never a
+ * store read as channels (multi-channel volumes are read whole: its notes
+ * say so under ON, and over the budget its error does). */
 static int wants_streaming(const char *path, const vxl_load_options *opt)
 {
     const uint32_t mode = vxl_load_streaming(opt);
-    if (mode != VXL_STREAMING_AUTO) return mode == VXL_STREAMING_ON;
+    if (mode == VXL_STREAMING_OFF) return 0;
     char folder[4096];
     vxl_zarr_choice ch;
     vxl_err ignore = {0};
     vxl_zarr_store *st = calloc(1, sizeof *st);
-    int stream = 0;
-    if (st && !vxl_zarr_parse_path(path, folder, sizeof folder, &ch, &ignore) && !vxl_zarr_open(folder, st, &ignore)) {
+    int stream = mode == VXL_STREAMING_ON; /* a store that does not open: the chosen path reports it */
+    uint32_t channels = 0;
+    const int opened =
+        st && !vxl_zarr_parse_path(path, folder, sizeof folder, &ch, &ignore) && !vxl_zarr_open(folder, st, &ignore);
+    if (opened && (vxl_zarr_channels(path, st, &ch, opt, &channels, &ignore) || channels))
+        stream = 0;
+    else if (opened && mode == VXL_STREAMING_AUTO) {
         const int l = ch.level >= 0 && ch.level < st->nlevels ? ch.level : 0;
         const vxl_zarr_array *a = &st->level[l];
         const double bytes = (double)a->shape[st->axis[VXL_ZARR_X]] * (double)a->shape[st->axis[VXL_ZARR_Y]] *
@@ -614,7 +621,12 @@ static int wants_streaming(const char *path, const vxl_load_options *opt)
 int vxl_zarr_load_any(const char *path, const vxl_load_options *opt, vxl_volume **out, vxl_err *e)
 {
     *out = NULL;
-    if (!wants_streaming(path, opt)) return vxl_zarr_load(path, opt, out, e);
+    if (!wants_streaming(path, opt)) {
+        int rc = vxl_zarr_load(path, opt, out, e);
+        if (!rc && (*out)->channels && vxl_load_streaming(opt) == VXL_STREAMING_ON)
+            vxl_volume_note(*out, "read whole: a multi-channel volume does not stream");
+        return rc;
+    }
     vxl_brick_source *s = NULL;
     vxl_zarr_source_info info;
     int rc = vxl_zarr_open_source(path, opt, &s, &info, e);

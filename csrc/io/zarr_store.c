@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "channel_meta.h"
 #include "json.h"
 #include "files.h"
 #include "loader_util.h"
@@ -206,6 +207,52 @@ static void parse_windows(const vxl_json_doc *d, const vxl_json *omero, vxl_zarr
     s->window_count = c;
 }
 
+/* Appends one sentence to s->meta_notes ("; "-joined, dropped when full). */
+static void meta_note(vxl_zarr_store *s, const char *what, int c)
+{
+    const size_t n = strlen(s->meta_notes);
+    const int w = snprintf(s->meta_notes + n, sizeof s->meta_notes - n, "%somero channel %d's %s", n ? "; " : "", c,
+                           what);
+    if (w < 0 || (size_t)w >= sizeof s->meta_notes - n) s->meta_notes[n] = '\0';
+}
+
+/* omero.channels[c]: "label", "color" (RRGGBB, sRGB), the display window
+ * "start"/"end" and "active", for the channels a multi-channel read keeps.
+ * A value of the wrong form is left unknown and noted, never guessed. */
+static void parse_channel_meta(const vxl_json_doc *d, const vxl_json *omero, vxl_zarr_store *s)
+{
+    const vxl_json *ch = vxl_json_get(d, omero, "channels");
+    if (!ch || ch->type != VXL_JSON_ARRAY) return;
+    int c = 0;
+    for (int32_t k = ch->first; k >= 0 && c < VXL_MAX_CHANNELS; k = d->nodes[k].next, c++) {
+        const vxl_json *o = &d->nodes[k];
+        vxl_channel_meta *m = &s->meta[c];
+        const vxl_json *label = vxl_json_get(d, o, "label"), *color = vxl_json_get(d, o, "color");
+        if (label) {
+            const int r = label->type == VXL_JSON_STRING ? vxl_channel_meta_name(m, label->str) : VXL_META_REFUSED;
+            if (r == VXL_META_CUT) meta_note(s, "label cut to 63 bytes", c);
+            else if (r == VXL_META_REFUSED) meta_note(s, "label ignored (not a line of text)", c);
+        }
+        if (color && (color->type != VXL_JSON_STRING || vxl_channel_meta_hex(m, color->str) != VXL_META_TAKEN))
+            meta_note(s, "color ignored (not RRGGBB)", c);
+        const vxl_json *w = vxl_json_get(d, o, "window");
+        const vxl_json *lo = vxl_json_get(d, w, "start"), *hi = vxl_json_get(d, w, "end");
+        if (lo && hi) {
+            if (lo->type == VXL_JSON_NUMBER && hi->type == VXL_JSON_NUMBER && isfinite(lo->num) &&
+                isfinite(hi->num) && lo->num < hi->num) {
+                m->window[0] = lo->num;
+                m->window[1] = hi->num;
+                m->has_window = 1;
+            } else {
+                meta_note(s, "window ignored (start is not below end)", c);
+            }
+        }
+        const vxl_json *active = vxl_json_get(d, o, "active");
+        if (active && active->type == VXL_JSON_FALSE) m->hidden = 1;
+        else if (active && active->type != VXL_JSON_TRUE) meta_note(s, "active ignored (not true or false)", c);
+    }
+}
+
 int vxl_zarr_parse_group(const char *text, size_t len, int is_v3, const char *name, vxl_zarr_store *s,
                          vxl_err *e)
 {
@@ -268,6 +315,7 @@ int vxl_zarr_parse_group(const char *text, size_t len, int is_v3, const char *na
         }
     }
     parse_windows(&d, vxl_json_get(&d, attrs, "omero"), s);
+    parse_channel_meta(&d, vxl_json_get(&d, attrs, "omero"), s);
 done:
     vxl_json_free(&d);
     return rc;

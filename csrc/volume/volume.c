@@ -324,6 +324,9 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
     /* a struct that ends inside notes would get an unterminated piece */
     const size_t notes_at = offsetof(vxl_volume_info, notes), notes_end = notes_at + sizeof out->notes;
     if (have > notes_at && have < notes_end) have = notes_at;
+    /* and one inside the channel names, unterminated names */
+    const size_t names_at = offsetof(vxl_volume_info, channel_names), names_end = names_at + sizeof out->channel_names;
+    if (have > names_at && have < names_end) have = names_at;
     vxl_volume_info info, *o = &info;
     memset(o, 0, sizeof *o);
     o->struct_size = (uint32_t)have;
@@ -364,6 +367,16 @@ int vxl_volume_get_info(const vxl_volume *v, vxl_volume_info *out)
             o->channel_max[c] = v->ch_max[c];
         }
         o->channel_bytes = vxl_volume_channel_bytes(v);
+        for (uint32_t c = 0; c < v->channel_count; c++) {
+            const vxl_channel_meta *m = &v->ch_meta[c];
+            memcpy(o->channel_names[c], m->name, sizeof o->channel_names[c]);
+            memcpy(o->channel_colors[c], m->color_srgb, sizeof o->channel_colors[c]);
+            o->channel_color_known[c] = m->has_color;
+            o->channel_window_low[c] = m->window[0];
+            o->channel_window_high[c] = m->window[1];
+            o->channel_window_known[c] = m->has_window;
+            o->channel_active[c] = !m->hidden;
+        }
     }
     memcpy(out, o, have);
     return VXL_OK;

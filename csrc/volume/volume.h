@@ -14,6 +14,17 @@
 #define VXL_DEFAULT_MAX_DIM 65536u
 #define VXL_VOLUME_NOTES_MAX 512 /* vxl_volume.notes, NUL included */
 
+/* What a file says about one of its channels (OME-Zarr omero, OME-XML),
+ * all zero when it says nothing: vxl_volume_info's channel_* fields. */
+typedef struct vxl_channel_meta {
+    double window[2];                /* display window, data units, low < high */
+    float color_srgb[3];             /* the file's sRGB display colour in [0, 1], not decoded */
+    uint8_t has_color, has_window;
+    uint8_t hidden;                  /* the file marks it not shown (omero "active": false) */
+    uint8_t reserved;
+    char name[VXL_CHANNEL_NAME_MAX]; /* UTF-8, terminated, no control characters */
+} vxl_channel_meta; /* no padding: the helper stream sends it as it is (reader_stream.h) */
+
 struct vxl_volume {
     uint32_t dims[3];
     uint32_t src_dtype;     /* VXL_DTYPE_* of the source */
@@ -56,6 +67,7 @@ struct vxl_volume {
     uint32_t scalar_channel;
     double ch_tex_lo[VXL_MAX_CHANNELS], ch_tex_hi[VXL_MAX_CHANNELS]; /* data = lo + t (hi - lo) per channel */
     double ch_min[VXL_MAX_CHANNELS], ch_max[VXL_MAX_CHANNELS];       /* finite data range per channel */
+    vxl_channel_meta ch_meta[VXL_MAX_CHANNELS];                      /* names, colours from the file */
 };
 
 /* Appends one note (printf format) to v->notes, "; "-separated; cut with

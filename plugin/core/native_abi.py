@@ -40,6 +40,7 @@ CHANNEL_BLENDS = ("add", "max")  # VXL_CHANNEL_BLEND_*
 MAX_CHANNELS = 8  # VXL_MAX_CHANNELS
 MAX_LABEL_ID = 65535  # VXL_MAX_LABEL_ID
 NOTES_MAX = 512  # VXL_NOTES_MAX: vxl_volume_info.notes, its NUL included
+CHANNEL_NAME_MAX = 64  # VXL_CHANNEL_NAME_MAX: vxl_volume_info.channel_names[c], its NUL included
 # The enumerations with vxl_<kind>_name / vxl_<kind>_from_name, and their fallbacks.
 ENUM_FALLBACKS = {"filter": FILTERS, "preset": PRESETS, "backend": BACKENDS, "storage": STORAGES,
                   "classify": CLASSIFY_MODES, "gradient_opacity": GRADIENT_OPACITY_MODES,
@@ -149,7 +150,15 @@ class VolumeInfo(ctypes.Structure):
                 ("scalar_channel", ctypes.c_uint32),
                 ("channel_min", ctypes.c_double * 8),
                 ("channel_max", ctypes.c_double * 8),
-                ("channel_bytes", ctypes.c_uint64)]
+                ("channel_bytes", ctypes.c_uint64),
+                # appended: what the file says about its channels (OME metadata)
+                ("channel_names", (ctypes.c_char * CHANNEL_NAME_MAX) * 8),
+                ("channel_colors", (ctypes.c_float * 3) * 8),  # the file's sRGB, not decoded
+                ("channel_color_known", ctypes.c_uint32 * 8),
+                ("channel_window_low", ctypes.c_double * 8),
+                ("channel_window_high", ctypes.c_double * 8),
+                ("channel_window_known", ctypes.c_uint32 * 8),
+                ("channel_active", ctypes.c_uint32 * 8)]
 
 
 class PhantomDesc(ctypes.Structure):

@@ -8,10 +8,10 @@ import os
 # The layout of vxl_reader_header (tests/python/test_vdb_isolation.py checks
 # every field; this only carries the notes, given as the last argument).
 _REPLY = """import struct, sys
-h = struct.pack("=8s16I4d3d16d5Q512s", b"VXLRD03\\0", 0, 0, 1, 0, 0, 4, 3, 2, 7, 32, 0, 2, 1, 0, 1, 0,
-                0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *[float(i % 5 == 0) for i in range(16)], 0, 0, 96, 96, 0,
-                sys.argv[-1].encode())
-assert len(h) == 808
+h = struct.pack("=8s16I4d3d16d5Q512s2I32dQ768s", b"VXLRD04\\0", 0, 0, 1, 0, 0, 4, 3, 2, 7, 32, 0, 2, 1, 0, 1,
+                0, 0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *[float(i % 5 == 0) for i in range(16)], 0, 0, 96, 96, 0,
+                sys.argv[-1].encode(), 0, 0, *[0.0] * 32, 0, b"")
+assert len(h) == 1848
 sys.stdout.buffer.write(h + bytes(96))
 """
 

@@ -6,13 +6,22 @@ its image is the sum of `--channels 0` and `--channels 1` (numpy, within the
 blob; `--channel-window` changes only its channel's pixels; `--channel N`
 renders channel N alone as a one-channel file of it; bricked, sparse and
 compressed storage draw the channels as dense storage does; bad values are
-clean errors."""
+clean errors. Then the files the helper-process readers and MetaImage read as
+channels (tests/channel_files_write.py): `info` names each channel with its
+colour, window and visibility from OME metadata, and every format of the
+same voxels renders the same image as the NIfTI of them."""
 import struct
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from test_cli import assert_clean_error, png_rgba, run, write_nifti
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from channel_files_write import (COLORS, NAMES, stack, write_mha, write_ome_tiff, write_omero_zarr,  # noqa: E402
+                                 write_sample_tiff, write_tiff)
 
 N = 20
 VIEW = ["--size", "%dx%d" % (N, N), "--ortho", "--no-jitter", "--no-shading", "--view", "z"]
@@ -147,3 +156,81 @@ def test_channels_of_a_volume_without_channels(tmp_path):
     write_nifti(grey, np.zeros((4, 4, 4), np.uint8))
     assert_clean_error(run("render", grey, "-o", tmp_path / "g.png", "--channels", "all"), "no channels")
     assert_clean_error(run("render", grey, "-o", tmp_path / "g.png", "--channel", "1"), "no channels")
+
+
+@pytest.fixture
+def formats(tmp_path):
+    """Two uint16 channels of one N^3 stack in every format that reads
+    channels (MetaImage's 3 and 4 are colour unless asked), and the NIfTI
+    of them; spacing 1 mm where the format has one."""
+    vol = stack(2, (N, N, N), np.uint16, seed=11) * 100
+    files = {"nifti": tmp_path / "ref.nii", "tiff": tmp_path / "samples.tif", "ome": tmp_path / "cells.ome.tif",
+             "zarr": tmp_path / "cells.zarr", "mha": tmp_path / "cells.mha"}
+    write_channels_nifti(files["nifti"], list(vol))
+    write_sample_tiff(files["tiff"], vol)
+    write_ome_tiff(files["ome"], vol, NAMES, COLORS, "XYCZT")
+    write_omero_zarr(files["zarr"], vol, NAMES, COLORS, [(100, 5000), (0, 9000)], [True, False])
+    write_mha(files["mha"], vol)
+    return files
+
+
+def channel_lines(out):
+    return [line.strip() for line in out.splitlines() if line.startswith("  channel ")]
+
+
+def test_info_names_the_channels_of_every_format(formats):
+    lines = {}
+    for name, path in formats.items():
+        res = run("info", path)
+        assert res.returncode == 0, res.stderr
+        assert "channels:    2 (the scalar is channel 0" in res.stdout, name
+        lines[name] = channel_lines(res.stdout)
+    assert lines["zarr"][0].endswith('"DAPI"  colour #0000FF (sRGB)  window 100 .. 5000')
+    assert lines["zarr"][1].endswith('"GFP"  colour #00FF00 (sRGB)  window 0 .. 9000  hidden in the file')
+    assert lines["ome"][1].endswith('"GFP"  colour #00FF00 (sRGB)')
+    # the files without metadata say only the ranges, the same as the NIfTI's
+    assert lines["tiff"] == lines["mha"] == lines["nifti"]
+    assert [line.split('"')[0].strip() for line in lines["ome"]] == lines["nifti"]
+    notes = {"tiff": "TIFF samples: 2 channels", "ome": "OME-TIFF SizeC: 2 channels",
+             "zarr": "OME-Zarr c axis: 2 channels", "mha": "MetaImage ElementNumberOfChannels: 2 channels"}
+    for name, note in notes.items():
+        assert note in run("info", formats[name]).stdout
+    # one channel, as before: "#c=N", and channels off
+    res = run("info", str(formats["zarr"]) + "#c=1")
+    assert res.returncode == 0 and "channels:" not in res.stdout, res.stderr
+    res = run("info", formats["tiff"], "--channel-axis", "off")
+    assert res.returncode == 0 and "channels:" not in res.stdout and "components:  1" in res.stdout, res.stderr
+
+
+def test_every_format_renders_the_niftis_image(formats):
+    """The same voxels on the same grid: the channels drawn in one march
+    give the NIfTI's image exactly (MetaImage's LPS axes mirror x and y, so
+    its view is compared against the NIfTI's turned half a turn)."""
+    ref = premultiplied(formats["nifti"], "--channels", "all")
+    assert ref[..., 3].max() > 0
+    for name in ("tiff", "ome", "zarr"):
+        assert np.array_equal(premultiplied(formats[name], "--channels", "all"), ref), name
+    assert np.array_equal(premultiplied(formats["mha"], "--channels", "all"), ref[::-1, ::-1])
+
+
+def test_bad_channel_files_are_clean_errors(formats, tmp_path):
+    assert_clean_error(run("info", formats["mha"], "--channel-axis", "off"), "2 channels per voxel and channels off")
+    nine = tmp_path / "nine.mha"
+    write_mha(nine, stack(9, (4, 4, 4), np.uint16))
+    assert_clean_error(run("info", nine), "9 channels per voxel is not supported", "2 to 8 channels")
+
+
+def test_an_ome_tiff_time_point_is_the_frame(tmp_path):
+    """SizeT 2, XYZCT: page z + 3 (c + 2 t) holds 100 t + 10 c + z; --frame t reads t's planes."""
+    xml = ('<OME><Image><Pixels DimensionOrder="XYZCT" SizeX="5" SizeY="4" SizeZ="3" SizeC="2" SizeT="2">'
+           '<Channel Name="a"/><Channel Name="b"/></Pixels></Image></OME>')
+    pages = [np.full((4, 5), 100 * t + 10 * c + z, np.uint16) for t in range(2) for c in range(2) for z in range(3)]
+    path = tmp_path / "t.ome.tif"
+    write_tiff(path, pages, description=xml)
+    for t in (0, 1):
+        res = run("info", path, "--frame", str(t))
+        assert res.returncode == 0, res.stderr
+        assert f"frames:      2 (this is frame {t}" in res.stdout
+        assert channel_lines(res.stdout) == [f'channel 0: {100 * t} .. {100 * t + 2}  "a"',
+                                             f'channel 1: {100 * t + 10} .. {100 * t + 12}  "b"']
+    assert_clean_error(run("info", path, "--frame", "2"), "frame 2 asked for, the OME-TIFF has 2 time points")

@@ -1,7 +1,7 @@
 /* make_seeds.c - writes the seed corpus for the fuzz targets: small valid
  * files of every format and the main variants (types, byte orders,
  * compression, geometry, pages, channels).
- *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png,dicom,label_table,dicom_codecs}/seed_*
+ *   make_seeds OUTDIR   ->  OUTDIR/{nifti,nrrd,metaimage,tiff,png,dicom,label_table,dicom_codecs,ome_xml}/seed_*
  * (dicom_codecs' JPEG seeds come from tests/fuzz/jpeg_seeds.py: dcmtk encodes them)
  * Built and run by `make fuzz-seeds` (./build.sh test / fuzz). */
 #include <stdint.h>
@@ -106,12 +106,40 @@ int main(int argc, char **argv)
                             "NDims = 3\nDimSize = 4 2 1\nElementNumberOfChannels = 3\nElementType = MET_UCHAR\n"
                             "CompressedData = True\nElementDataFile = LOCAL\n", u8, sizeof u8, TW_ZLIB, NULL),
        "mha rgb zlib");
+    /* channels (the multi-channel volume's path): 2 and 6 a voxel, the 24 bytes of u8 */
+    static const struct { const char *name, *header; int codec; } mha_channels[] = {
+        {"seed_2ch.mha", "NDims = 3\nDimSize = 4 3 1\nElementNumberOfChannels = 2\nElementType = MET_UCHAR\n"
+                         "ElementDataFile = LOCAL\n", TW_RAW},
+        {"seed_6ch_zlib.mha", "NDims = 3\nDimSize = 2 2 1\nElementNumberOfChannels = 6\nElementType = MET_UCHAR\n"
+                              "CompressedData = True\nElementDataFile = LOCAL\n", TW_ZLIB},
+    };
+    for (size_t i = 0; i < sizeof mha_channels / sizeof mha_channels[0]; i++)
+        ok(tw_write_header_data(path("metaimage", mha_channels[i].name), mha_channels[i].header, u8, sizeof u8,
+                                mha_channels[i].codec, NULL), mha_channels[i].name);
 
     /* TIFF */
     ok(tw_write_tiff(path("tiff", "seed_u8_pages.tif"), 4, 3, 2, 1, 8, 1, u8), "tiff u8 pages");
     ok(tw_write_tiff(path("tiff", "seed_i16.tif"), 4, 3, 1, 1, 16, 2, i16), "tiff i16");
     ok(tw_write_tiff(path("tiff", "seed_f32.tif"), 4, 3, 2, 1, 32, 3, f32), "tiff f32");
     ok(tw_write_tiff(path("tiff", "seed_rgb.tif"), 4, 2, 1, 3, 8, 1, u8), "tiff rgb");
+    ok(tw_write_tiff(path("tiff", "seed_2samples.tif"), 4, 3, 1, 2, 8, 1, u8), "tiff 2 samples (channels)");
+
+    /* OME-XML (an OME-TIFF's ImageDescription): both common orders, names
+     * with entities, signed colours, a prefixed namespace */
+    static const char *const ome[] = {
+        "<?xml version=\"1.0\"?><OME xmlns=\"http://www.openmicroscopy.org/Schemas/OME/2016-06\"><Image ID=\"Image:0\">"
+        "<Pixels DimensionOrder=\"XYZCT\" Type=\"uint16\" SizeX=\"4\" SizeY=\"3\" SizeZ=\"2\" SizeC=\"3\" "
+        "SizeT=\"1\"><Channel ID=\"Channel:0:0\" Name=\"DAPI\" Color=\"65535\"/><Channel Name=\"GFP &amp; co\" "
+        "Color=\"16711935\"/><Channel Name='Cy5' Color=\"-16711681\"/><TiffData/></Pixels></Image></OME>",
+        "<ome:OME xmlns:ome=\"x\"><ome:Image><ome:Pixels SizeT=\"2\" SizeC=\"2\" SizeZ=\"3\" SizeY=\"1\" SizeX=\"1\" "
+        "DimensionOrder=\"XYCZT\"><ome:Channel Name=\"a\"/><ome:Channel Color=\"-1\"/></ome:Pixels></ome:Image>"
+        "</ome:OME>",
+    };
+    for (size_t i = 0; i < sizeof ome / sizeof ome[0]; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "seed_%zu.xml", i);
+        ok(tw_write(path("ome_xml", name), ome[i], strlen(ome[i]), NULL, 0), "ome_xml");
+    }
 
     /* PNG */
     uint16_t u16[24];

@@ -33,18 +33,18 @@ replay_only=0
 [ "$mode" = replay ] && replay_only=1
 secs=$mode
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom dicom_own vdb label_table zarr brick_cache tiff_layout dicom_codecs hdr)
+[ ${#targets[@]} -eq 0 ] && targets=(nifti nrrd metaimage tiff png dicom dicom_own vdb label_table zarr brick_cache tiff_layout dicom_codecs hdr ome_xml)
 
 # Parsers written in this project's C: fuzzed in every mode. The rest read
 # through a third-party library inside a helper process.
-OWN_TARGETS=" nifti nrrd metaimage label_table zarr brick_cache tiff_layout dicom_codecs hdr dicom_own "
+OWN_TARGETS=" nifti nrrd metaimage label_table zarr brick_cache tiff_layout dicom_codecs hdr dicom_own ome_xml "
 is_own() { [[ $OWN_TARGETS == *" $1 "* ]]; }
 # ci: inputs per own target (about 8 s each on the 2-core CI machine;
 # VOXLIGHT_FUZZ_CI_RUNS overrides them all, as tests/cli/test_crash_replay.py
 # does) and the one seed every run uses
 declare -A CI_RUNS=([nifti]=30000 [nrrd]=100000 [metaimage]=100000 [label_table]=100000
                     [zarr]=20000 [brick_cache]=20000 [tiff_layout]=150000 [dicom_codecs]=1000000 [hdr]=300000
-                    [dicom_own]=5000)
+                    [dicom_own]=5000 [ome_xml]=300000)
 CI_SEED=20261207
 # Where a third-party reader's own frames are told apart from ours
 declare -A UPSTREAM_LIBS=([vdb]='openvdb' [tiff]='OpenImageIO|libtiff' [png]='OpenImageIO|libpng'

@@ -42,6 +42,12 @@ def main(out):
              b'"coordinateTransformations": [{"type": "scale", "scale": [1, 2, 3, 4]}]}]}], '
              b'"omero": {"channels": [{"window": {"min": -5, "max": 7.5}}, {"window": {"start": 1, "end": 0}}]}}')
     (out / "group_v2_omero_units").write_bytes(bytes([0]) + omero)
+    # omero channel names, colours, display windows and visibility (a
+    # multi-channel read's metadata), good and malformed
+    channels = (b'"omero": {"channels": [{"label": "DAPI", "color": "0000FF", "window": {"start": 10, "end": 500}, '
+                b'"active": true}, {"label": "\\u00b5 GFP", "color": "#00ff00", "active": false}, '
+                b'{"label": 7, "color": "GG0000", "window": {"start": 5, "end": 5}, "active": "yes"}]}}')
+    (out / "group_v2_omero_channels").write_bytes(bytes([0]) + omero[:omero.index(b'"omero"')] + channels)
     with tempfile.TemporaryDirectory() as tmp:
         f = (np.arange(24, dtype=np.float32) - 7).reshape(2, 3, 4)
         one = write_store(Path(tmp) / "float", [f], "zyx", 2, "zlib", [2, 3, 4], ".")

@@ -25,9 +25,13 @@ ABORTS = os.path.join(ROOT, "tests", "fuzz", "upstream", "openvdb_delayed_load_m
 # count, record_size, dims[3], src_dtype, texture_bits, nifti_version,
 # affine_source, frame_count, frame, components, opacity_source; tex_lo, tex_hi,
 # value_min, value_max; spacing[3]; affine[16]; nan_count, inf_count,
-# storage_bytes, nbytes, colour_bytes; notes[512]
-HEADER = "=8s16I4d3d16d5Q512s"
-HEADER_SIZE = 808
+# storage_bytes, nbytes, colour_bytes; notes[512]; channel_count,
+# scalar_channel; ch_tex_lo[8], ch_tex_hi[8], ch_min[8], ch_max[8];
+# channel_bytes; ch_meta[8] (vxl_channel_meta, volume.h: 96 bytes each)
+HEADER = "=8s16I4d3d16d5Q512s2I32dQ768s"
+HEADER_SIZE = 1848
+# vxl_channel_meta: window[2]; color_srgb[3]; has_color, has_window, hidden, reserved; name[64]
+CHANNEL_META = "=2d3f4B64s"
 HELPER_ENV = "VOXLIGHT_READ_OIIO"
 TIMEOUT_ENV = "VOXLIGHT_READER_TIMEOUT"
 VXL_DTYPE_F32 = 7
@@ -85,13 +89,16 @@ def _fake_helper(tmp_path, body):
     return str(p)
 
 
-def _header(status=0, dims=(4, 3, 2), nbytes=None, msg_len=0, magic=b"VXLRD03\0", kind=1, affine=None,
-            notes=b"", components=1, opacity_source=0, colour_bytes=None):
+def _header(status=0, dims=(4, 3, 2), nbytes=None, msg_len=0, magic=b"VXLRD04\0", kind=1, affine=None,
+            notes=b"", components=1, opacity_source=0, colour_bytes=None, channels=0, scalar_channel=0,
+            channel_bytes=None, meta=b""):
     n = dims[0] * dims[1] * dims[2] * 4 if nbytes is None else nbytes
     c = (dims[0] * dims[1] * dims[2] * 3 if components > 1 else 0) if colour_bytes is None else colour_bytes
+    cb = dims[0] * dims[1] * dims[2] * 2 * channels if channel_bytes is None else channel_bytes
     a = np.eye(4).T.ravel() if affine is None else affine
     return struct.pack(HEADER, magic, status, msg_len, kind, 0, 0, *dims, VXL_DTYPE_F32, 32, 0, 2, 1, 0,
-                       components, opacity_source, 0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *a, 0, 0, n, n, c, notes)
+                       components, opacity_source, 0.0, 1.0, 0.0, 1.0, 1.0, 1.0, 1.0, *a, 0, 0, n, n, c, notes,
+                       channels, scalar_channel, *([0.0] * 32), cb, meta)
 
 
 assert struct.calcsize(HEADER) == HEADER_SIZE
@@ -100,10 +107,26 @@ assert struct.calcsize(HEADER) == HEADER_SIZE
 @pytest.mark.parametrize("body, needle", [
     # a header that claims 2^30 voxels: refused by the budget before allocating
     ("out.write(%r)" % _header(dims=(1024, 1024, 1024)), r"over the memory budget of 1\.0 MiB"),
-    ("out.write(%r + bytes(10))" % _header(), r"output of the OpenVDB reader was cut short \(818 of 904 bytes\)"),
-    # an older helper's header (magic 01, no notes; 02, no colour) is refused, not misread
+    ("out.write(%r + bytes(10))" % _header(), r"output of the OpenVDB reader was cut short \(1858 of 1944 bytes\)"),
+    # an older helper's header (magic 01, no notes; 02, no colour; 03, no channels) is refused, not misread
     ("out.write(%r + bytes(96))" % _header(magic=b"VXLRD01\0"), r"sent no valid header"),
     ("out.write(%r + bytes(96))" % _header(magic=b"VXLRD02\0"), r"sent no valid header"),
+    ("out.write(%r + bytes(96))" % _header(magic=b"VXLRD03\0"), r"sent no valid header"),
+    # channels: 2 bytes a channel a voxel after the texels (and colour),
+    # charged to the budget with the texels (8 channels of 64x64x50 pass
+    # the texels' 1 MiB alone, not with them), and all of it sent
+    ("out.write(%r)" % _header(dims=(64, 64, 50), nbytes=64 * 64 * 50 * 4, channels=8),
+     r"over the memory budget of 1\.0 MiB"),
+    ("out.write(%r + bytes(96) + bytes(96))" % _header(channels=9, channel_bytes=96),
+     r"inconsistent multi-channel header \(9 channels"),
+    ("out.write(%r + bytes(96) + bytes(96))" % _header(channels=2, scalar_channel=2),
+     r"inconsistent multi-channel header \(2 channels, scalar 2"),
+    ("out.write(%r + bytes(96) + bytes(94))" % _header(channels=2, channel_bytes=94),
+     r"inconsistent multi-channel header \(2 channels, scalar 0, 94 channel bytes\)"),
+    ("out.write(%r + bytes(96) + bytes(96))" % _header(channels=2, meta=struct.pack(CHANNEL_META, 0, 0, 2.0, 0, 0,
+                                                                                      1, 0, 0, 0, b"x")),
+     r"inconsistent multi-channel header"),
+    ("out.write(%r + bytes(96) + bytes(95))" % _header(channels=2), r"cut short \(2039 of 2040 bytes\)"),
     # colour: 3 bytes a voxel after the texels, the opacity source asked for,
     # charged to the budget with the texels, and all of it sent
     ("out.write(%r + bytes(96) + bytes(72))" % _header(components=2), r"sent 2 components"),
@@ -113,14 +136,14 @@ assert struct.calcsize(HEADER) == HEADER_SIZE
     ("out.write(%r + bytes(96) + bytes(70))" % _header(components=3, colour_bytes=70),
      r"announced 70 colour bytes for 4x3x2 voxels"),
     ("out.write(%r + bytes(96) + bytes(71))" % _header(components=3),
-     r"cut short \(975 of 976 bytes\)"),
+     r"cut short \(2015 of 2016 bytes\)"),
     ("out.write(%r + bytes(96) + bytes(73))" % _header(components=3), r"more than it announced"),
     ("out.write(%r)" % _header(dims=(64, 64, 50), components=3), r"over the memory budget of 1\.0 MiB"),
     # notes: terminated inside their 512 bytes, one line of text
     ("out.write(%r + bytes(96))" % _header(notes=b"n" * 512), r"sent notes that are not one terminated line"),
     ("out.write(%r + bytes(96))" % _header(notes=b"two\nlines"), r"sent notes that are not one terminated line"),
     ("out.write(%r)" % _header(nbytes=5), r"announced 5 bytes for 4x3x2 voxels of 32 bits"),
-    ("out.write(b'hello world' * 80)", r"sent no valid header"),
+    ("out.write(b'hello world' * 200)", r"sent no valid header"),
     ("out.write(%r + bytes(96) + b'x')" % _header(), r"more than it announced"),
     ("out.write(%r + bytes(96))" % _header(kind=2), r"reply of kind 2, not 1"),
     ("out.write(%r + bytes(96))" % _header(affine=[float("nan")] * 16), r"transform is not finite"),
@@ -155,13 +178,39 @@ def test_helper_notes_reach_the_volume_info(lib, small_vdb, tmp_path, monkeypatc
 def test_helper_colour_reaches_the_volume(lib, small_vdb, tmp_path, monkeypatch):
     """A colour volume's RGB8 follows its texels (3 bytes a voxel), and the
     opacity source the caller asked for is on the helper's command line."""
-    body = ("assert sys.argv[10:] == ['0', '0'], sys.argv\n"
+    body = ("assert sys.argv[10:] == ['0', '0', '0', '0'], sys.argv\n"
             "out.write(%r + bytes(96) + bytes(range(72)))" % _header(components=4))
     monkeypatch.setenv(HELPER_ENV, _fake_helper(tmp_path, body))
     with native.Volume.load(small_vdb, lib=lib) as v:
         info = native_abi._sized(native_abi.VolumeInfo)
         lib.check(lib.cdll.vxl_volume_get_info(v._handle, ctypes.byref(info)))
         assert (info.components, info.opacity_source, info.color_bytes) == (4, 0, 72)
+    assert _children() == []
+
+
+def test_helper_channels_reach_the_volume(lib, small_vdb, tmp_path, monkeypatch):
+    """A multi-channel volume's packed channels follow its texels, with
+    each channel's name, sRGB colour, window and visibility; the channels
+    mode and scalar channel asked for are on the helper's command line."""
+    meta = (struct.pack(CHANNEL_META, 10.0, 500.0, 0.0, 0.0, 1.0, 1, 1, 0, 0, "DAPI \u00b5".encode()) +
+            struct.pack(CHANNEL_META, 0.0, 0.0, 1.0, 0.5, 0.0, 1, 0, 1, 0, b"GFP") + bytes(96 * 6))
+    body = ("assert sys.argv[12:] == ['1', '1'], sys.argv\n"
+            "out.write(%r + bytes(96) + bytes(range(96)))" % _header(channels=2, scalar_channel=1, meta=meta))
+    monkeypatch.setenv(HELPER_ENV, _fake_helper(tmp_path, body))
+    opt = native_abi._sized(native_abi.LoadOptions)
+    opt.channels, opt.scalar_channel = 1, 1  # VXL_CHANNELS_ON
+    h = ctypes.c_void_p()
+    lib.check(lib.cdll.vxl_volume_load(os.fsencode(small_vdb), ctypes.byref(opt), ctypes.byref(h)))
+    with native.Volume(lib, h) as v:
+        info = native_abi._sized(native_abi.VolumeInfo)
+        lib.check(lib.cdll.vxl_volume_get_info(v._handle, ctypes.byref(info)))
+        assert (info.channel_count, info.scalar_channel, info.channel_bytes) == (2, 1, 96)
+        assert info.channel_names[0].value.decode() == "DAPI \u00b5" and info.channel_names[1].value == b"GFP"
+        assert list(info.channel_colors[0]) == [0.0, 0.0, 1.0] and list(info.channel_colors[1]) == [1.0, 0.5, 0.0]
+        assert list(info.channel_color_known)[:3] == [1, 1, 0]
+        assert (info.channel_window_known[0], info.channel_window_low[0], info.channel_window_high[0]) == (1, 10, 500)
+        assert info.channel_window_known[1] == 0
+        assert list(info.channel_active)[:3] == [1, 0, 0]  # the third is no channel
     assert _children() == []
 
 

@@ -80,6 +80,7 @@ def fill(props, info):
         ch.color = d["color"]
         ch.data_min, ch.data_max = d["range"]
         ch.window_low, ch.window_high = d["window"]
+        ch.visible = d["visible"]
         if c < len(hists):
             ch.histogram = [int(min(n, 2**31 - 1)) for n in hists[c]]
     props.active_channel = 0

@@ -105,14 +105,18 @@ def channel_count(info):
 
 
 def channel_defaults(info):
-    """[{name, color, dye, window: (lo, hi), range: (lo, hi), decided}, ...]
-    per channel of a multi-channel volume's information (a dict as
-    Volume.info, or the library's info struct), [] for a one-channel
-    volume. `decided` says where the colour came from ("metadata",
-    "dye named", "default of its index"), for the panel and the notes."""
+    """[{name, color, dye, window: (lo, hi), range: (lo, hi), visible,
+    decided}, ...] per channel of a multi-channel volume's information (a
+    dict as Volume.info, or the library's info struct), [] for a
+    one-channel volume. `decided` says where the colour came from
+    ("metadata", "dye named", "default of its index"), for the panel and
+    the notes. The file's display window (`channel_windows`, a (lo, hi) or
+    None per channel) and visibility (`channel_active`) are taken when it
+    gives them; else the window is the channel's range and it is shown."""
     n = channel_count(info)
     lows, highs = _field(info, "channel_min"), _field(info, "channel_max")
     names, colours = _field(info, "channel_names"), _field(info, "channel_colors")
+    windows, active = _field(info, "channel_windows"), _field(info, "channel_active")
     out = []
     for c in range(n):
         name = _listed(names, c)
@@ -129,6 +133,14 @@ def channel_defaults(info):
             colour, decided = DYE_COLORS[dye], "dye named"
         else:
             colour, decided = LIBRARY_COLORS[c % len(LIBRARY_COLORS)], "default of its index"
-        out.append(dict(name=name, color=colour, dye=dye, window=(lo, hi), range=(lo, hi),
-                        decided=decided))
+        window = _listed(windows, c)
+        try:
+            wlo, whi = (float(window[0]), float(window[1])) if window is not None else (lo, hi)
+        except (TypeError, ValueError, IndexError):
+            wlo, whi = lo, hi
+        if not whi > wlo:
+            wlo, whi = lo, hi
+        shown = _listed(active, c)
+        out.append(dict(name=name, color=colour, dye=dye, window=(wlo, whi), range=(lo, hi),
+                        visible=True if shown is None else bool(shown), decided=decided))
     return out

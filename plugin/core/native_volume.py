@@ -183,6 +183,14 @@ class Volume(LibraryObject):
             "scalar_channel": int(info.scalar_channel),
             "channel_min": [float(v) for v in info.channel_min[:info.channel_count]],
             "channel_max": [float(v) for v in info.channel_max[:info.channel_count]],
+            # what the file says about each channel (OME metadata); None where it says nothing
+            "channel_names": [bytes(info.channel_names[c].value).decode("utf-8", "replace")
+                              for c in range(info.channel_count)],
+            "channel_colors": [tuple(float(v) for v in info.channel_colors[c])
+                               if info.channel_color_known[c] else None for c in range(info.channel_count)],
+            "channel_windows": [(float(info.channel_window_low[c]), float(info.channel_window_high[c]))
+                                if info.channel_window_known[c] else None for c in range(info.channel_count)],
+            "channel_active": [bool(info.channel_active[c]) for c in range(info.channel_count)],
         }
 
     def histogram(self, bins=32, lo=None, hi=None, channel=None):

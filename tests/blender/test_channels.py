@@ -327,4 +327,29 @@ def the_panel_lists_the_channels_shows_the_active_one_and_says_why_not():
     assert not bpy.types.VOXLIGHT_PT_volume_channels.poll(Ctx)
 
 
+
+@test
+def an_ome_zarrs_names_colours_windows_and_visibility_seed_the_channels():
+    """The file's omero metadata (tests/channel_files_write.py writes it)
+    reaches the channel list through the library's information: names,
+    colours decoded from the file's sRGB, display windows, and a channel the
+    file hides imported hidden."""
+    sys.path.insert(0, os.path.join(u.ROOT, "tests"))
+    from channel_files_write import write_omero_zarr, stack  # noqa: E402
+    u.reset_scene()
+    vol = stack(3, (5, 6, 7), np.uint16)
+    store = write_omero_zarr(os.path.join(u.TMP, "omero.zarr"), vol, ["DAPI", "GFP", "Membrane"],
+                             [(0, 0, 255), (0, 255, 0), (255, 128, 0)], [(10, 500), (20, 600), (30, 700)],
+                             [True, False, True])
+    ob = u.import_volume(str(store))
+    chans = ob.voxlight.channels
+    assert [c.name for c in chans] == ["DAPI", "GFP", "Membrane"], [c.name for c in chans]
+    # sRGB 128/255 decoded to linear (IEC 61966-2-1, written out here)
+    half = ((128 / 255 + 0.055) / 1.055) ** 2.4
+    assert np.allclose(tuple(chans[2].color), (1.0, half, 0.0), atol=1e-5), tuple(chans[2].color)
+    assert np.allclose(tuple(chans[0].color), (0.0, 0.0, 1.0))
+    assert [(c.window_low, c.window_high) for c in chans] == [(10, 500), (20, 600), (30, 700)]
+    assert [c.visible for c in chans] == [True, False, True]
+
+
 u.run("test_channels")

@@ -1,6 +1,7 @@
 """core/channel_defaults.py: a multi-channel volume's per-channel defaults
-from its information, with and without the metadata fields (channel_names,
-channel_colors) the library does not give yet."""
+from its information, with and without the metadata fields the library
+gives from OME files (channel_names, channel_colors, channel_windows,
+channel_active: plugin/core/native_volume.py's info)."""
 
 import types
 
@@ -53,6 +54,16 @@ def test_metadata_colours_win_and_are_decoded_from_srgb():
     assert np.allclose(out[0]["color"], ref, atol=1e-6) and out[0]["decided"] == "metadata"
     assert out[1]["color"] == (0.0, 1.0, 0.0)  # out of range: not a colour, index default
     assert out[2]["color"] == (0.0, 0.0, 1.0)
+
+
+def test_the_files_windows_and_visibility_are_taken_where_given():
+    out = cd.channel_defaults(info(3, channel_windows=[(20.0, 60.0), None, (9.0, 3.0)],
+                                   channel_active=[True, False, True]))
+    assert out[0]["window"] == (20.0, 60.0) and out[0]["range"] == (0.0, 100.0)
+    assert out[1]["window"] == (10.0, 110.0)  # none given: the channel's range
+    assert out[2]["window"] == (20.0, 120.0)  # not a window: the range, not a guess
+    assert [d["visible"] for d in out] == [True, False, True]
+    assert all(d["visible"] for d in cd.channel_defaults(info(2)))
 
 
 def test_an_empty_range_still_gives_a_window():

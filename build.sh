@@ -355,7 +355,11 @@ run_c_tests() {
             p=$((p + $(echo "$line" | grep -oE '^[0-9]+')))
             f=$((f + $(echo "$line" | sed -E 's/^[0-9]+ passed, ([0-9]+) failed.*/\1/')))
         fi
-        if [ "$rc" -ne 0 ] && { [ -z "$line" ] || echo "$line" | grep -q ' 0 failed'; }; then f=$((f + 1)); fi
+        if [ "$rc" -ne 0 ] && [ -n "$line" ] && [ "$rc" -eq 137 ] && [ "${VXL_SIGKILL_AFTER_SUMMARY_OK:-0}" = 1 ]; then
+            echo "  ($(basename "$t") was killed after its summary line: counted as the summary says)"
+        elif [ "$rc" -ne 0 ] && { [ -z "$line" ] || echo "$line" | grep -q ' 0 failed'; }; then
+            f=$((f + 1))
+        fi
     done
     rm -rf "$out_dir"
     echo "$p passed, $f failed"
@@ -404,7 +408,15 @@ run_wine_tests() {
         echo "0 passed, 1 failed"
         return 1
     fi
-    WINEPREFIX="$ROOT/build/wine" WINEDEBUG=-all with_xvfb run_c_tests "$dir" timeout 600 "$wine"
+    # Wine's server ends with SIGKILL a process that is slow to finish
+    # exiting: on a loaded machine a test program that has run every test and
+    # printed its summary was killed while its threads and DLLs shut down
+    # (CI counted it as one failure, in two runs, with every program's
+    # summary saying 0 failed), which says nothing of the tests. The summary
+    # line is the verdict then; a program killed before printing it still
+    # fails, and the kill is printed.
+    WINEPREFIX="$ROOT/build/wine" WINEDEBUG=-all VXL_SIGKILL_AFTER_SUMMARY_OK=1 \
+        with_xvfb run_c_tests "$dir" timeout 600 "$wine"
 }
 
 cmd=${1:-build}

@@ -416,7 +416,17 @@ run_wine_tests() {
     # line is the verdict then; a program killed before printing it still
     # fails, and the kill is printed.
     WINEPREFIX="$ROOT/build/wine" WINEDEBUG=-all VXL_SIGKILL_AFTER_SUMMARY_OK=1 \
-        with_xvfb run_c_tests "$dir" timeout 600 "$wine"
+        with_xvfb wine_prefix_then_tests "$wine" "$dir"
+}
+
+# A new Wine prefix is made by the first program that runs in it; two test
+# programs starting at once in a fresh clone raced for it (one lost its
+# server: "chdir to ... server-...: No such file or directory"). So the
+# prefix is made first, alone, then the programs run side by side.
+wine_prefix_then_tests() {
+    local wine=$1 dir=$2
+    timeout 300 "$wine" wineboot --init >/dev/null 2>&1 || true
+    run_c_tests "$dir" timeout 600 "$wine"
 }
 
 cmd=${1:-build}
